@@ -1,0 +1,233 @@
+// overlap_node: the overlap Q(t), its error bars and tau_alpha, computed
+// live from the frames on DYNHET_FRAME and published on DYNHET_OVERLAP (one
+// message per cutoff a) after every frame that adds a pair. It holds only
+// the origin frames that some later frame still needs.
+//
+// Usage: overlap_node [--lcm-url URL] [--publish-url URL]
+// With --lcm-url file://LOG?speed=0 it re-runs the analysis from an
+// lcm-logger log at full speed and publishes on --publish-url.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include "dynhet/analysis/overlap.hpp"
+#include "dynhet/chunking.hpp"
+#include "dynhet/frame_chunk_t.hpp"
+#include "dynhet/lcm_url.hpp"
+#include "dynhet/node_status_t.hpp"
+#include "dynhet/overlap_t.hpp"
+#include "dynhet/run_info_t.hpp"
+#include "dynhet/sim_status_t.hpp"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+int64_t utime_now() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+namespace an = dynhet::analysis;
+
+class OverlapNode {
+public:
+  OverlapNode(lcm::LCM& out, int64_t run_filter) : out_(out), run_filter_(run_filter) {
+    status_.node = "overlap";
+    status_.state = "waiting";
+  }
+
+  bool finished() const { return finished_; }
+  bool has_run() const { return info_ != nullptr; }
+  int exit_code() const { return exit_code_; }
+
+  void on_run(const lcm::ReceiveBuffer*, const std::string&, const dynhet::run_info_t* m) {
+    if (info_ || (run_filter_ && m->run_id != run_filter_)) return;
+    info_ = std::make_unique<dynhet::run_info_t>(*m);
+    status_.run_id = m->run_id;
+    status_.frames_expected = m->n_frames;
+    status_.state = "running";
+    grid_ = an::make_subbox_grid(m->n_particles, m->box_length, m->overlap_subbox_particles);
+    for (int c = 0; c < m->n_cutoffs; ++c) acc_.emplace_back(m->n_origins, m->lag_time);
+    // Which origins and which (origin, lag) pairs each frame serves.
+    origin_at_.assign(m->n_frames, -1);
+    pairs_at_.assign(m->n_frames, {});
+    last_use_.assign(m->n_origins, -1);
+    for (int k = 0; k < m->n_origins; ++k) {
+      origin_at_[m->origin_frame[k]] = k;
+      for (int j = 0; j < m->n_lags; ++j) {
+        const int f = m->pair_frame[static_cast<size_t>(k) * m->n_lags + j];
+        if (f < 0) continue;
+        pairs_at_[f].push_back({k, j});
+        last_use_[k] = std::max(last_use_[k], f);
+      }
+    }
+    std::fprintf(stderr, "overlap_node: run %lld, N=%d, %d frames, %d origins x %d lags, %dx%d sub-boxes of N=%.1f\n",
+                 static_cast<long long>(m->run_id), m->n_particles, m->n_frames, m->n_origins,
+                 m->n_lags, grid_.per_side, grid_.per_side, grid_.mean_particles);
+  }
+
+  void on_chunk(const lcm::ReceiveBuffer*, const std::string&, const dynhet::frame_chunk_t* m) {
+    if (!info_ || m->run_id != info_->run_id || m->n_values != 2 * m->count) return;
+    const dynhet::ChunkHeader h{m->frame_index, m->time,           m->n_particles, m->chunk_index,
+                                m->chunk_count, m->first_particle, m->count};
+    auto frame = assembler_.add(h, m->position.data());
+    if (frame && frame->index < info_->n_frames) on_frame(*frame);
+  }
+
+  void on_sim_status(const lcm::ReceiveBuffer*, const std::string&, const dynhet::sim_status_t* m) {
+    if (!info_ || m->run_id != info_->run_id || finished_) return;
+    if (m->phase == "done") finish(0, "");
+    if (m->phase == "failed") finish(1, "sim failed: " + m->message);
+  }
+
+  // The input ended (log replayed to its end) before the sim said done.
+  void input_ended() {
+    if (!finished_) finish(1, info_ ? "input ended before the run did" : "no run info in the input");
+  }
+
+  void publish_status() {
+    status_.utime = utime_now();
+    status_.frames_whole = assembler_.frames_whole();
+    status_.frames_lost = assembler_.frames_lost();
+    status_.chunks_received = assembler_.chunks_received();
+    status_.pairs_done = pairs_done_;
+    status_.origins_held = static_cast<int32_t>(origins_.size());
+    out_.publish(dynhet::kChanNodeStatus, &status_);
+    last_status_ = Clock::now();
+  }
+  void tick() {
+    if (std::chrono::duration<double>(Clock::now() - last_status_).count() >= 1.0) publish_status();
+  }
+
+private:
+  void on_frame(const dynhet::Frame& f) {
+    const int k0 = origin_at_[f.index];
+    if (k0 >= 0) origins_[k0] = f.position;
+    bool added = false;
+    for (const auto& [k, j] : pairs_at_[f.index]) {
+      auto it = origins_.find(k);
+      if (it == origins_.end()) continue; // the origin frame was lost
+      an::overlap_subboxes(it->second.data(), f.position.data(), info_->n_particles, grid_,
+                           info_->cutoff_a, qr_);
+      const int nb = grid_.per_side * grid_.per_side;
+      for (size_t c = 0; c < acc_.size(); ++c) acc_[c].add(k, j, qr_.data() + c * nb, nb);
+      ++pairs_done_;
+      added = true;
+    }
+    // Drop origins no later frame needs.
+    for (auto it = origins_.begin(); it != origins_.end();)
+      it = last_use_[it->first] <= f.index ? origins_.erase(it) : std::next(it);
+    last_frame_ = f.index;
+    last_time_ = f.time;
+    if (added) publish_results(false);
+    tick();
+  }
+
+  void publish_results(bool final) {
+    for (size_t c = 0; c < acc_.size(); ++c) {
+      const auto r = acc_[c].result();
+      dynhet::overlap_t m{};
+      m.utime = utime_now();
+      m.run_id = info_->run_id;
+      m.sim_time = last_time_;
+      m.frame_index = last_frame_;
+      m.is_final = final;
+      m.cutoff_a = info_->cutoff_a[c];
+      m.subbox_per_side = grid_.per_side;
+      m.subbox_particles = grid_.mean_particles;
+      m.n_lags = info_->n_lags;
+      m.lag_time = info_->lag_time;
+      m.q = r.q;
+      m.q_err = r.q_err;
+      m.n_origins = r.n_origins;
+      m.qr_var = r.qr_var;
+      m.tau_alpha = r.tau_alpha;
+      m.tau_alpha_err = r.tau_alpha_err;
+      out_.publish(dynhet::kChanOverlap, &m);
+      if (final)
+        std::fprintf(stderr, "overlap_node: a=%g tau_alpha=%.5g +- %.2g (%d pairs)\n", m.cutoff_a,
+                     m.tau_alpha, m.tau_alpha_err, pairs_done_);
+    }
+  }
+
+  void finish(int code, const std::string& why) {
+    if (info_) assembler_.finish(info_->n_frames);
+    if (info_) publish_results(true);
+    status_.state = code == 0 ? "done" : "failed";
+    status_.message = why;
+    publish_status();
+    std::fprintf(stderr, "overlap_node: %s: %d frames whole, %d lost%s%s\n", status_.state.c_str(),
+                 assembler_.frames_whole(), assembler_.frames_lost(), why.empty() ? "" : "; ",
+                 why.c_str());
+    finished_ = true;
+    exit_code_ = code;
+  }
+
+  lcm::LCM& out_;
+  int64_t run_filter_;
+  std::unique_ptr<dynhet::run_info_t> info_;
+  an::SubboxGrid grid_{};
+  std::vector<an::OverlapAccumulator> acc_; // one per cutoff
+  std::vector<int> origin_at_, last_use_;
+  std::vector<std::vector<std::pair<int, int>>> pairs_at_;
+  std::map<int, std::vector<double>> origins_; // origin k -> positions at t0
+  std::vector<double> qr_;
+  dynhet::FrameAssembler assembler_;
+  dynhet::node_status_t status_{};
+  Clock::time_point last_status_ = Clock::now();
+  int pairs_done_ = 0, last_frame_ = -1;
+  double last_time_ = 0;
+  bool finished_ = false;
+  int exit_code_ = 0;
+};
+
+} // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"dynhet overlap_node: Q(t), tau_alpha from frames on LCM"};
+  std::string url, publish_url;
+  int64_t run_id = 0;
+  double wait_run = 300;
+  app.add_option("--lcm-url", url, "LCM URL to read from (file://LOG?speed=0 replays a log)");
+  app.add_option("--publish-url", publish_url, "LCM URL to publish on (default: the input bus)");
+  app.add_option("--run-id", run_id, "only this run (default: the first one seen)");
+  app.add_option("--wait-run", wait_run, "give up after this many seconds without run info");
+  CLI11_PARSE(app, argc, argv);
+
+  const std::string in_url = dynhet::resolve_lcm_url(url);
+  const bool replay = in_url.rfind("file://", 0) == 0;
+  lcm::LCM in(in_url);
+  std::unique_ptr<lcm::LCM> out_owned;
+  if (!publish_url.empty() || replay) out_owned = std::make_unique<lcm::LCM>(dynhet::resolve_lcm_url(publish_url));
+  lcm::LCM& out = out_owned ? *out_owned : in;
+  if (!in.good() || !out.good()) {
+    std::fprintf(stderr, "overlap_node: cannot open LCM (%s)\n", in_url.c_str());
+    return 3;
+  }
+
+  OverlapNode node(out, run_id);
+  in.subscribe(dynhet::kChanRun, &OverlapNode::on_run, &node);
+  in.subscribe(dynhet::kChanFrame, &OverlapNode::on_chunk, &node)->setQueueCapacity(100000);
+  in.subscribe(dynhet::kChanSimStatus, &OverlapNode::on_sim_status, &node);
+
+  const auto start = Clock::now();
+  while (!node.finished()) {
+    if (in.handleTimeout(200) < 0) { // a replayed log has ended
+      node.input_ended();
+      break;
+    }
+    node.tick();
+    if (!node.has_run() && std::chrono::duration<double>(Clock::now() - start).count() > wait_run) {
+      std::fprintf(stderr, "overlap_node: no run info on %s within %g s\n", in_url.c_str(), wait_run);
+      return 4;
+    }
+  }
+  return node.exit_code();
+}

@@ -1,0 +1,67 @@
+#include "dynhet/chunking.hpp"
+
+#include <algorithm>
+
+namespace dynhet {
+
+std::vector<ChunkRange> chunk_ranges(int n, int per_chunk) {
+  std::vector<ChunkRange> r;
+  for (int first = 0; first < n; first += per_chunk) r.push_back({first, std::min(per_chunk, n - first)});
+  return r;
+}
+
+void FrameAssembler::mark_done(int index) {
+  if (index >= static_cast<int>(done_.size())) done_.resize(index + 1, false);
+  done_[index] = true;
+}
+
+std::optional<Frame> FrameAssembler::add(const ChunkHeader& h, const double* position) {
+  ++chunks_;
+  const bool sane = h.frame_index >= 0 && h.n_particles > 0 && h.chunk_count > 0 &&
+                    h.chunk_index >= 0 && h.chunk_index < h.chunk_count && h.first_particle >= 0 &&
+                    h.count > 0 && h.first_particle + h.count <= h.n_particles;
+  if (!sane) {
+    ++malformed_;
+    return std::nullopt;
+  }
+  // Frames far behind this one will not complete any more.
+  for (auto it = pending_.begin(); it != pending_.end() && it->first + window_ < h.frame_index;) {
+    ++lost_;
+    mark_done(it->first);
+    it = pending_.erase(it);
+  }
+  if (is_done(h.frame_index)) return std::nullopt; // duplicate, or too late
+
+  auto [it, fresh] = pending_.try_emplace(h.frame_index);
+  Pending& p = it->second;
+  if (fresh) {
+    p.frame.index = h.frame_index;
+    p.frame.time = h.time;
+    p.frame.position.assign(2 * static_cast<size_t>(h.n_particles), 0.0);
+    p.have.assign(h.chunk_count, false);
+    p.missing = h.chunk_count;
+  } else if (static_cast<int>(p.have.size()) != h.chunk_count ||
+             p.frame.position.size() != 2 * static_cast<size_t>(h.n_particles)) {
+    ++malformed_;
+    return std::nullopt;
+  }
+  if (p.have[h.chunk_index]) return std::nullopt; // duplicate chunk
+  p.have[h.chunk_index] = true;
+  --p.missing;
+  std::copy(position, position + 2 * h.count, p.frame.position.begin() + 2 * h.first_particle);
+  if (p.missing > 0) return std::nullopt;
+
+  Frame f = std::move(p.frame);
+  pending_.erase(it);
+  mark_done(f.index);
+  ++whole_;
+  return f;
+}
+
+void FrameAssembler::finish(int frames_expected) {
+  pending_.clear();
+  lost_ = std::max(0, frames_expected - whole_);
+  for (int i = 0; i < frames_expected; ++i) mark_done(i);
+}
+
+} // namespace dynhet

@@ -1,0 +1,72 @@
+// Frames travel as chunks of at most 1 MiB (UDP loses bigger messages
+// whole); these pieces split a frame and put it back together, counting
+// frames that never complete. No LCM here: the nodes copy message fields
+// into a ChunkHeader.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <vector>
+
+namespace dynhet {
+
+struct ChunkRange {
+  int first;
+  int count;
+};
+// Consecutive ranges of at most `per_chunk` particles covering [0, n).
+std::vector<ChunkRange> chunk_ranges(int n_particles, int per_chunk);
+
+struct ChunkHeader {
+  int frame_index;
+  double time;
+  int n_particles;
+  int chunk_index;
+  int chunk_count;
+  int first_particle;
+  int count;
+};
+
+struct Frame {
+  int index = -1;
+  double time = 0;
+  std::vector<double> position; // x0 y0 x1 y1 ..., unwrapped
+};
+
+class FrameAssembler {
+public:
+  // Frames arrive in index order from one publisher; a frame still
+  // incomplete when a chunk of frame index + `reorder_window` + 1 arrives
+  // is given up as lost.
+  explicit FrameAssembler(int reorder_window = 1) : window_(reorder_window) {}
+
+  // Adds one chunk (positions of header.count particles). Returns the frame
+  // when this chunk completes it. Malformed chunks are counted and dropped.
+  std::optional<Frame> add(const ChunkHeader& h, const double* position);
+
+  // The run has ended after `frames_expected` frames: whatever is not whole
+  // now is lost.
+  void finish(int frames_expected);
+
+  int frames_whole() const { return whole_; }
+  int frames_lost() const { return lost_; }
+  int64_t chunks_received() const { return chunks_; }
+  int64_t chunks_malformed() const { return malformed_; }
+
+private:
+  struct Pending {
+    Frame frame;
+    std::vector<bool> have;
+    int missing;
+  };
+  int window_;
+  std::map<int, Pending> pending_;
+  std::vector<bool> done_; // frame index -> completed or given up
+  int whole_ = 0, lost_ = 0;
+  int64_t chunks_ = 0, malformed_ = 0;
+  void mark_done(int index);
+  bool is_done(int index) const { return index < static_cast<int>(done_.size()) && done_[index]; }
+};
+
+} // namespace dynhet

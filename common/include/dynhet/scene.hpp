@@ -1,0 +1,74 @@
+// Scene files: what to simulate and what to measure (TOML, see scenes/).
+// parse_scene() refuses unknown keys, wrong types and impossible values
+// before anything runs, with a message naming the key, the value and what
+// is allowed.
+#pragma once
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace dynhet {
+
+struct SceneError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+struct ScheduleSpec {
+  int origins = 10;             // number of time origins t0
+  double origin_spacing = 10.0; // dt0 between origins
+  double lag_min = 0.1;         // smallest lag tau
+  double lag_max = 100.0;       // largest lag tau
+  int lags_per_decade = 8;      // log spacing of the lags
+};
+
+struct Scene {
+  std::string path;
+  std::string text; // the whole file, recorded in the HDF5 parameters
+
+  // [system]
+  int64_t n_particles = 1000;
+  double packing_fraction = 0.7;
+  double restitution = 0.9;
+  double radius_ratio = 1.43; // r2 / r1; 1 is monodisperse
+  uint64_t seed = 1;
+
+  // [driving]
+  bool driving = true;
+  // Kicks per particle per unit time; < 0 means the Enskog collision
+  // frequency of the paper, omega = 2.59 phi G_c / sqrt(pi).
+  double kick_rate = -1.0;
+  // Pair correlation at contact G_c used in omega; < 0 means Henderson's
+  // (1 - 7 phi / 16) / (1 - phi)^2 for hard disks.
+  double contact_value = -1.0;
+
+  // [run]
+  double equilibration_time = 100.0;
+  double production_time = -1.0; // < 0: exactly what the schedule needs
+
+  ScheduleSpec schedule;
+
+  // [observables]
+  std::vector<std::string> observables{"overlap"};
+  std::vector<double> cutoff_a{0.6};
+  bool keep_frames = false;
+
+  // [overlap]
+  int overlap_subbox_particles = 100; // target N = <N_r> per sub-box
+
+  // [transport]
+  int chunk_particles = 8192; // 16 bytes each: 128 KiB of positions
+
+  bool wants(const std::string& observable) const;
+};
+
+// Parse and validate a scene given its text; `origin` names it in errors.
+Scene parse_scene_text(const std::string& text, const std::string& origin);
+// Read the file and parse it.
+Scene parse_scene_file(const std::string& path);
+
+// Observables this build knows how to compute.
+const std::vector<std::string>& known_observables();
+
+} // namespace dynhet

@@ -1,0 +1,313 @@
+#include "dynhet/scene.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+
+#include <toml++/toml.h>
+
+#include "dynhet/model.hpp"
+
+namespace dynhet {
+namespace {
+
+const char* type_name(const toml::node& n) {
+  switch (n.type()) {
+  case toml::node_type::string: return "a string";
+  case toml::node_type::integer: return "an integer";
+  case toml::node_type::floating_point: return "a float";
+  case toml::node_type::boolean: return "a boolean";
+  case toml::node_type::array: return "an array";
+  case toml::node_type::table: return "a table";
+  default: return "a date/time";
+  }
+}
+
+std::string show(const toml::node& n) {
+  std::ostringstream s;
+  if (n.is_table()) return "{...}";
+  n.visit([&](auto&& v) { s << v; });
+  return s.str();
+}
+
+// Collects every problem of a scene, then throws them together.
+class Checker {
+public:
+  explicit Checker(std::string origin) : origin_(std::move(origin)) {}
+
+  void fail(const std::string& key, const std::string& what) {
+    errors_.push_back(origin_ + ": " + key + ": " + what);
+  }
+  void bad_value(const std::string& key, const toml::node& n, const std::string& allowed) {
+    fail(key, "value " + show(n) + " is not allowed; " + allowed);
+  }
+  void bad_type(const std::string& key, const toml::node& n, const std::string& expected) {
+    fail(key, "value " + show(n) + " is " + type_name(n) + ", expected " + expected);
+  }
+  bool ok() const { return errors_.empty(); }
+  void throw_if_failed() const {
+    if (errors_.empty()) return;
+    std::string msg = "invalid scene (" + std::to_string(errors_.size()) + " problem" +
+                      (errors_.size() > 1 ? "s" : "") + "):";
+    for (const auto& e : errors_) msg += "\n  " + e;
+    throw SceneError(msg);
+  }
+
+  bool get_int(const std::string& key, const toml::node& n, int64_t& out) {
+    if (auto v = n.value_exact<int64_t>()) { out = *v; return true; }
+    bad_type(key, n, "an integer");
+    return false;
+  }
+  bool get_double(const std::string& key, const toml::node& n, double& out) {
+    if (n.is_integer() || n.is_floating_point()) {
+      out = *n.value<double>();
+      if (std::isfinite(out)) return true;
+      bad_value(key, n, "it must be a finite number");
+      return false;
+    }
+    bad_type(key, n, "a number");
+    return false;
+  }
+  bool get_bool(const std::string& key, const toml::node& n, bool& out) {
+    if (auto v = n.value_exact<bool>()) { out = *v; return true; }
+    bad_type(key, n, "a boolean (true or false)");
+    return false;
+  }
+
+private:
+  std::string origin_;
+  std::vector<std::string> errors_;
+};
+
+using Handler = std::function<void(const std::string& key, const toml::node&)>;
+using Table = std::map<std::string, Handler>;
+
+std::string known_keys(const Table& t) {
+  std::string s;
+  for (const auto& [k, h] : t) s += (s.empty() ? "" : ", ") + k;
+  return s;
+}
+
+} // namespace
+
+const std::vector<std::string>& known_observables() {
+  static const std::vector<std::string> v{"overlap"};
+  return v;
+}
+
+bool Scene::wants(const std::string& o) const {
+  return std::find(observables.begin(), observables.end(), o) != observables.end();
+}
+
+Scene parse_scene_text(const std::string& text, const std::string& origin) {
+  Scene s;
+  s.path = origin;
+  s.text = text;
+  toml::table root;
+  try {
+    root = toml::parse(text, origin);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream m;
+    m << origin << ":" << e.source().begin.line << ":" << e.source().begin.column
+      << ": not valid TOML: " << e.description();
+    throw SceneError(m.str());
+  }
+
+  Checker c(origin);
+  // A positive number (time or length) under `key`.
+  auto positive = [&](double& out) {
+    return [&c, &out](const std::string& key, const toml::node& n) {
+      double v;
+      if (!c.get_double(key, n, v)) return;
+      if (v <= 0) return c.bad_value(key, n, "it must be > 0");
+      out = v;
+    };
+  };
+  auto non_negative = [&](double& out) {
+    return [&c, &out](const std::string& key, const toml::node& n) {
+      double v;
+      if (!c.get_double(key, n, v)) return;
+      if (v < 0) return c.bad_value(key, n, "it must be >= 0");
+      out = v;
+    };
+  };
+  auto int_in = [&](auto& out, int64_t lo, int64_t hi) {
+    return [&c, &out, lo, hi](const std::string& key, const toml::node& n) {
+      int64_t v;
+      if (!c.get_int(key, n, v)) return;
+      if (v < lo || v > hi)
+        return c.bad_value(key, n,
+                           "allowed: " + std::to_string(lo) + " <= value <= " + std::to_string(hi));
+      out = static_cast<std::remove_reference_t<decltype(out)>>(v);
+    };
+  };
+  // A number, or a string naming the default recipe (stored as -1).
+  auto number_or = [&](double& out, const std::string& word) {
+    return [&c, &out, word](const std::string& key, const toml::node& n) {
+      if (n.is_string()) {
+        if (*n.value<std::string>() != word)
+          return c.bad_value(key, n, "allowed: \"" + word + "\" or a number > 0");
+        out = -1.0;
+        return;
+      }
+      double v;
+      if (!c.get_double(key, n, v)) return;
+      if (v <= 0) return c.bad_value(key, n, "allowed: \"" + word + "\" or a number > 0");
+      out = v;
+    };
+  };
+
+  std::map<std::string, Table> schema;
+  schema["system"] = {
+      {"n_particles", int_in(s.n_particles, 2, int64_t(1) << 31)},
+      {"packing_fraction",
+       [&](const std::string& key, const toml::node& n) {
+         double v;
+         if (!c.get_double(key, n, v)) return;
+         if (!(v > 0 && v < 0.9))
+           return c.bad_value(key, n, "allowed: 0 < phi < 0.9 (hard disks jam below 0.9)");
+         s.packing_fraction = v;
+       }},
+      {"restitution",
+       [&](const std::string& key, const toml::node& n) {
+         double v;
+         if (!c.get_double(key, n, v)) return;
+         if (!(v > 0 && v <= 1)) return c.bad_value(key, n, "allowed: 0 < eps <= 1");
+         s.restitution = v;
+       }},
+      {"radius_ratio",
+       [&](const std::string& key, const toml::node& n) {
+         double v;
+         if (!c.get_double(key, n, v)) return;
+         if (!(v >= 1 && v <= 10)) return c.bad_value(key, n, "allowed: 1 <= r2/r1 <= 10");
+         s.radius_ratio = v;
+       }},
+      {"seed",
+       [&](const std::string& key, const toml::node& n) {
+         int64_t v;
+         if (!c.get_int(key, n, v)) return;
+         if (v < 0) return c.bad_value(key, n, "it must be >= 0");
+         s.seed = static_cast<uint64_t>(v);
+       }},
+  };
+  schema["driving"] = {
+      {"enabled", [&](const std::string& key, const toml::node& n) { c.get_bool(key, n, s.driving); }},
+      {"kick_rate", number_or(s.kick_rate, "enskog")},
+      {"contact_value", number_or(s.contact_value, "henderson")},
+  };
+  schema["run"] = {
+      {"equilibration_time", non_negative(s.equilibration_time)},
+      {"production_time", positive(s.production_time)},
+  };
+  schema["schedule"] = {
+      {"origins", int_in(s.schedule.origins, 1, 1000000)},
+      {"origin_spacing", positive(s.schedule.origin_spacing)},
+      {"lag_min", positive(s.schedule.lag_min)},
+      {"lag_max", positive(s.schedule.lag_max)},
+      {"lags_per_decade", int_in(s.schedule.lags_per_decade, 1, 1000)},
+  };
+  schema["observables"] = {
+      {"compute",
+       [&](const std::string& key, const toml::node& n) {
+         const auto* arr = n.as_array();
+         if (!arr) return c.bad_type(key, n, "an array of strings");
+         s.observables.clear();
+         for (const auto& e : *arr) {
+           auto v = e.value_exact<std::string>();
+           if (!v) return c.bad_type(key, e, "a string");
+           const auto& known = known_observables();
+           if (std::find(known.begin(), known.end(), *v) == known.end()) {
+             std::string list;
+             for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
+             return c.bad_value(key, e, "known observables: " + list);
+           }
+           s.observables.push_back(*v);
+         }
+       }},
+      {"cutoff_a",
+       [&](const std::string& key, const toml::node& n) {
+         const auto* arr = n.as_array();
+         if (!arr || arr->empty()) return c.bad_type(key, n, "a non-empty array of numbers");
+         s.cutoff_a.clear();
+         for (const auto& e : *arr) {
+           double v;
+           if (!c.get_double(key, e, v)) return;
+           if (v <= 0) return c.bad_value(key, e, "every cutoff a must be > 0");
+           s.cutoff_a.push_back(v);
+         }
+       }},
+      {"keep_frames",
+       [&](const std::string& key, const toml::node& n) { c.get_bool(key, n, s.keep_frames); }},
+  };
+  schema["overlap"] = {
+      {"subbox_particles", int_in(s.overlap_subbox_particles, 1, int64_t(1) << 31)},
+  };
+  schema["transport"] = {
+      {"chunk_particles", int_in(s.chunk_particles, 1, 65000)}, // 16 B each: < 1 MiB
+  };
+
+  for (const auto& [table_name, node] : root) {
+    const std::string tname(table_name.str());
+    auto it = schema.find(tname);
+    if (it == schema.end()) {
+      std::string list;
+      for (const auto& [k, t] : schema) list += (list.empty() ? "" : ", ") + ("[" + k + "]");
+      c.fail(tname, "unknown table; known tables: " + list);
+      continue;
+    }
+    const auto* table = node.as_table();
+    if (!table) {
+      c.bad_type(tname, node, "a table [" + tname + "]");
+      continue;
+    }
+    for (const auto& [key, value] : *table) {
+      const std::string full = tname + "." + std::string(key.str());
+      auto h = it->second.find(std::string(key.str()));
+      if (h == it->second.end()) {
+        c.fail(full, "unknown key; known keys in [" + tname + "]: " + known_keys(it->second));
+        continue;
+      }
+      h->second(full, value);
+    }
+  }
+  c.throw_if_failed();
+
+  // Relations between keys.
+  const auto& sch = s.schedule;
+  if (sch.lag_min >= sch.lag_max)
+    c.fail("schedule.lag_min", "value " + std::to_string(sch.lag_min) +
+                                   " must be smaller than schedule.lag_max = " +
+                                   std::to_string(sch.lag_max));
+  const double needed = (sch.origins - 1) * sch.origin_spacing + sch.lag_max;
+  if (s.production_time < 0) {
+    s.production_time = needed;
+  } else if (s.production_time < needed * (1 - 1e-12)) {
+    c.fail("run.production_time",
+           "value " + std::to_string(s.production_time) + " is shorter than the schedule needs: " +
+               "(origins - 1) * origin_spacing + lag_max = " + std::to_string(needed));
+  }
+  const Model m = make_model(s.n_particles, s.packing_fraction, s.radius_ratio);
+  const double min_box = 3 * 2 * std::max(m.radius[0], m.radius[1]);
+  if (m.box_length < min_box)
+    c.fail("system.n_particles",
+           "value " + std::to_string(s.n_particles) + " is too small at this packing fraction: " +
+               "the box side " + std::to_string(m.box_length) +
+               " must hold 3 cells of the largest diameter (" + std::to_string(min_box) + ")");
+  if (s.observables.empty())
+    c.fail("observables.compute", "is empty; name at least one of the known observables");
+  c.throw_if_failed();
+  return s;
+}
+
+Scene parse_scene_file(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw SceneError(path + ": cannot open the scene file");
+  std::stringstream buf;
+  buf << in.rdbuf();
+  return parse_scene_text(buf.str(), path);
+}
+
+} // namespace dynhet

@@ -1,0 +1,414 @@
+#include "dynhet/engine/engine.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+#include "dynhet/engine/collision.hpp"
+#include "dynhet/model.hpp"
+
+namespace dynhet::engine {
+
+Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution), rng_(p.seed) {
+  if (n_ < 2) throw std::invalid_argument("engine: need at least 2 particles");
+  const Model m = make_model(n_, p.packing_fraction, p.radius_ratio);
+  box_ = m.box_length;
+  for (int s = 0; s < 2; ++s) {
+    radius_[s] = m.radius[s];
+    mass_[s] = m.mass[s];
+  }
+  species_.resize(n_);
+  for (long i = 0; i < n_; ++i) species_[i] = static_cast<uint8_t>(species_of(i, n_));
+
+  // Cells at least as wide as the largest contact distance, at least 3 a side.
+  nc_ = static_cast<int>(std::floor(box_ / (2.0 * std::max(radius_[0], radius_[1]))));
+  if (nc_ < 3)
+    throw std::invalid_argument("engine: box of side " + std::to_string(box_) +
+                                " holds fewer than 3 cells; use more particles");
+  cw_ = box_ / nc_;
+
+  part_.assign(n_, Particle{0, 0, 0, 0, 0});
+  image_x_.assign(n_, 0);
+  image_y_.assign(n_, 0);
+  coll_count_.assign(n_, 0);
+  event_.assign(n_, Event{-1, kCross, 0});
+  kick_leaf_ = static_cast<int>(n_);
+  cal_.reset(static_cast<int>(n_) + 1, kNever);
+}
+
+double Engine::packing_fraction() const {
+  double a = 0;
+  for (long i = 0; i < n_; ++i) a += M_PI * radius_[species_[i]] * radius_[species_[i]];
+  return a * scale() * scale() / (box_ * box_);
+}
+
+// ---------------------------------------------------------------- cells
+
+void Engine::cell_insert(int i, int c) {
+  cell_of_[i] = c;
+  prev_[i] = -1;
+  next_[i] = head_[c];
+  if (head_[c] >= 0) prev_[head_[c]] = i;
+  head_[c] = i;
+}
+
+void Engine::cell_remove(int i) {
+  const int c = cell_of_[i];
+  if (prev_[i] >= 0)
+    next_[prev_[i]] = next_[i];
+  else
+    head_[c] = next_[i];
+  if (next_[i] >= 0) prev_[next_[i]] = prev_[i];
+}
+
+void Engine::build_cells() {
+  head_.assign(static_cast<size_t>(nc_) * nc_, -1);
+  cell_of_.assign(n_, -1);
+  next_.assign(n_, -1);
+  prev_.assign(n_, -1);
+  for (long i = 0; i < n_; ++i) {
+    const int cx = std::min(nc_ - 1, static_cast<int>(part_[i].x / cw_));
+    const int cy = std::min(nc_ - 1, static_cast<int>(part_[i].y / cw_));
+    cell_insert(static_cast<int>(i), cell_index(cx, cy));
+  }
+}
+
+void Engine::image_shift(int i, int j, double& sx, double& sy) const {
+  const int dx = cell_of_[j] % nc_ - cell_of_[i] % nc_;
+  const int dy = cell_of_[j] / nc_ - cell_of_[i] / nc_;
+  sx = dx > 1 ? -box_ : (dx < -1 ? box_ : 0.0);
+  sy = dy > 1 ? -box_ : (dy < -1 ? box_ : 0.0);
+}
+
+// ---------------------------------------------------------------- events
+
+void Engine::sync(int i) {
+  Particle& a = part_[i];
+  const double dt = now_ - a.t;
+  a.x += a.vx * dt;
+  a.y += a.vy * dt;
+  a.t = now_;
+}
+
+// Next event of particle i (synchronised to now): leaving its cell, or the
+// earliest collision with a particle of the 3x3 cells around it. A neighbour
+// for which the collision with i comes before its own next event takes it.
+void Engine::predict(int i) {
+  const Particle& a = part_[i];
+  const int c = cell_of_[i], cx = c % nc_, cy = c / nc_;
+
+  // Leaving the cell: direction 0 (+x), 1 (-x), 2 (+y), 3 (-y).
+  double best = kNever;
+  Event ev{-1, kCross, 0};
+  if (a.vx > 0) best = ((cx + 1) * cw_ - a.x) / a.vx, ev.partner = 0;
+  if (a.vx < 0) best = (cx * cw_ - a.x) / a.vx, ev.partner = 1;
+  if (a.vy != 0) {
+    const double ty = a.vy > 0 ? ((cy + 1) * cw_ - a.y) / a.vy : (cy * cw_ - a.y) / a.vy;
+    if (ty < best) best = ty, ev.partner = a.vy > 0 ? 2 : 3;
+  }
+  best = std::max(best, 0.0);
+
+  for (int dy = -1; dy <= 1; ++dy) {
+    const int ny = (cy + dy + nc_) % nc_;
+    const double sy = cy + dy < 0 ? -box_ : (cy + dy >= nc_ ? box_ : 0.0);
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int nx = (cx + dx + nc_) % nc_;
+      const double sx = cx + dx < 0 ? -box_ : (cx + dx >= nc_ ? box_ : 0.0);
+      for (int j = head_[cell_index(nx, ny)]; j >= 0; j = next_[j]) {
+        if (j == i) continue;
+        const Particle& b = part_[j];
+        const double bdt = now_ - b.t;
+        const double ddx = a.x - (b.x + b.vx * bdt + sx), ddy = a.y - (b.y + b.vy * bdt + sy);
+        const double dt =
+            pair_collision_time(ddx, ddy, a.vx - b.vx, a.vy - b.vy, sigma(i, j), growth(i, j));
+        if (dt == kNever) continue;
+        const double t = now_ + dt;
+        if (dt < best) best = dt, ev = Event{j, kCollision, coll_count_[j]};
+        if (t < cal_.time(j)) {
+          event_[j] = Event{i, kCollision, coll_count_[i]};
+          cal_.set(j, t);
+        }
+      }
+    }
+  }
+  event_[i] = ev;
+  cal_.set(i, now_ + best);
+}
+
+void Engine::clear_events() {
+  for (long i = 0; i < n_; ++i) cal_.set(static_cast<int>(i), kNever);
+  cal_.set(kick_leaf_, driving_ ? now_ + rng_.exponential(kick_pair_rate_) : kNever);
+  for (long i = 0; i < n_; ++i) predict(static_cast<int>(i));
+}
+
+void Engine::collide(int i, int j) {
+  sync(i);
+  sync(j);
+  double sx, sy;
+  image_shift(i, j, sx, sy);
+  Particle &a = part_[i], &b = part_[j];
+  collide_pair(a.x - (b.x + sx), a.y - (b.y + sy), mass_[species_[i]], mass_[species_[j]], eps_,
+               a.vx, a.vy, b.vx, b.vy, growth(i, j));
+  ++coll_count_[i];
+  ++coll_count_[j];
+  ++count_.collisions;
+  predict(i);
+  predict(j);
+}
+
+void Engine::cross(int i, int dir) {
+  sync(i);
+  Particle& a = part_[i];
+  int cx = cell_of_[i] % nc_, cy = cell_of_[i] / nc_;
+  switch (dir) {
+  case 0:
+    if (++cx == nc_) cx = 0, a.x -= box_, ++image_x_[i];
+    break;
+  case 1:
+    if (--cx < 0) cx = nc_ - 1, a.x += box_, --image_x_[i];
+    break;
+  case 2:
+    if (++cy == nc_) cy = 0, a.y -= box_, ++image_y_[i];
+    break;
+  default:
+    if (--cy < 0) cy = nc_ - 1, a.y += box_, --image_y_[i];
+  }
+  cell_remove(i);
+  cell_insert(i, cell_index(cx, cy));
+  ++count_.cell_crossings;
+  predict(i);
+}
+
+// Driving (paper, section 2): a random pair gets opposite momenta
+// +-p_Dr kappa, kappa a 2D standard Gaussian vector, so total momentum is
+// conserved. Choice where the paper is silent: the pair is two distinct
+// particles drawn uniformly from the whole system, and with the two species
+// the amplitude is p_Dr^2 = (1 - eps^2) m1 m2 / (m1 + m2) for every pair.
+void Engine::kick() {
+  const int i = static_cast<int>(rng_.below(n_));
+  int j = static_cast<int>(rng_.below(n_ - 1));
+  if (j >= i) ++j;
+  double kx, ky;
+  rng_.normal_pair(kx, ky);
+  const double p = kick_amplitude(eps_, mass_[0], mass_[1]);
+  sync(i);
+  sync(j);
+  const double mi = mass_[species_[i]], mj = mass_[species_[j]];
+  part_[i].vx += p * kx / mi;
+  part_[i].vy += p * ky / mi;
+  part_[j].vx -= p * kx / mj;
+  part_[j].vy -= p * ky / mj;
+  ++coll_count_[i];
+  ++coll_count_[j];
+  ++count_.kicks;
+  cal_.set(kick_leaf_, now_ + rng_.exponential(kick_pair_rate_));
+  predict(i);
+  predict(j);
+}
+
+// Keep absolute time small: move every clock so that now is 0.
+void Engine::rebase() {
+  for (long i = 0; i < n_; ++i) {
+    sync(static_cast<int>(i));
+    part_[i].t = 0;
+  }
+  cal_.shift(now_);
+  scale0_ += grow_ * now_;
+  offset_ += now_;
+  now_ = 0;
+  events_since_rebase_ = 0;
+}
+
+bool Engine::run_until(double t_abs, int64_t max_events) {
+  const double target = t_abs - offset_;
+  for (int64_t done = 0; done < max_events; ++done) {
+    const int leaf = cal_.top();
+    const double t = cal_.top_time();
+    if (t > target) {
+      now_ = std::max(now_, target);
+      if (events_since_rebase_ > 10 * n_) rebase();
+      return true;
+    }
+    now_ = t;
+    ++events_since_rebase_;
+    if (leaf == kick_leaf_) {
+      kick();
+      continue;
+    }
+    const Event e = event_[leaf];
+    if (e.type == kCross) {
+      cross(leaf, e.partner);
+    } else if (coll_count_[e.partner] != e.partner_seen) {
+      ++count_.stale;
+      sync(leaf);
+      predict(leaf);
+    } else {
+      collide(leaf, e.partner);
+    }
+  }
+  return false;
+}
+
+// ---------------------------------------------------------------- setup
+
+void Engine::thermalize(double energy) {
+  double px = 0, py = 0, mtot = 0;
+  for (long i = 0; i < n_; ++i) {
+    const double m = mass_[species_[i]];
+    double gx, gy;
+    rng_.normal_pair(gx, gy);
+    part_[i].vx = gx / std::sqrt(m);
+    part_[i].vy = gy / std::sqrt(m);
+    px += m * part_[i].vx;
+    py += m * part_[i].vy;
+    mtot += m;
+  }
+  for (long i = 0; i < n_; ++i) part_[i].vx -= px / mtot, part_[i].vy -= py / mtot;
+  rescale_velocities(energy);
+}
+
+// Random sequential placement with radii scaled by `scale` (cells make each
+// trial O(1)).
+void Engine::place_random(double scale) {
+  scale0_ = scale;
+  grow_ = 0;
+  now_ = 0;
+  head_.assign(static_cast<size_t>(nc_) * nc_, -1);
+  cell_of_.assign(n_, -1);
+  next_.assign(n_, -1);
+  prev_.assign(n_, -1);
+  for (long i = 0; i < n_; ++i) {
+    bool placed = false;
+    for (int attempt = 0; attempt < 100000 && !placed; ++attempt) {
+      const double x = rng_.uniform() * box_, y = rng_.uniform() * box_;
+      const int cx = std::min(nc_ - 1, static_cast<int>(x / cw_));
+      const int cy = std::min(nc_ - 1, static_cast<int>(y / cw_));
+      placed = true;
+      for (int dy = -1; dy <= 1 && placed; ++dy)
+        for (int dx = -1; dx <= 1 && placed; ++dx) {
+          const int c = cell_index((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_);
+          for (int j = head_[c]; j >= 0; j = next_[j]) {
+            double ddx = x - part_[j].x, ddy = y - part_[j].y;
+            ddx -= box_ * std::round(ddx / box_);
+            ddy -= box_ * std::round(ddy / box_);
+            const double s = sigma(static_cast<int>(i), j);
+            if (ddx * ddx + ddy * ddy < s * s) {
+              placed = false;
+              break;
+            }
+          }
+        }
+      if (placed) {
+        part_[i] = Particle{x, y, 0, 0, 0};
+        cell_insert(static_cast<int>(i), cell_index(cx, cy));
+      }
+    }
+    if (!placed) throw std::runtime_error("engine: random placement failed at particle " + std::to_string(i));
+  }
+}
+
+void Engine::rescale_velocities(double energy) {
+  const double f = std::sqrt(energy / kinetic_energy_per_particle());
+  for (auto& a : part_) a.vx *= f, a.vy *= f;
+}
+
+void Engine::prepare(const std::function<void(double)>& progress) {
+  const double phi = p_.packing_fraction;
+  const double phi_start = std::min(phi, 0.35);
+  place_random(std::sqrt(phi_start / phi));
+  if (progress) progress(packing_fraction());
+
+  // Grow elastically and without driving, radii scale0_ + grow_ t. The
+  // rate is slow against the thermal speed (~1) so the packing stays a
+  // fluid and does not jam early.
+  eps_ = 1.0;
+  driving_ = false;
+  now_ = offset_ = 0;
+  thermalize(1.0);
+  grow_ = 0.002;
+  const double t_end = (1.0 - scale0_) / grow_; // absolute time
+  clear_events();
+  while (time() < t_end) {
+    // About a collision per particle, then back to kinetic energy 1 (growth
+    // heats the system) and predict everything again.
+    run_until(std::min(t_end, time() + 1.0), 2 * n_);
+    for (long i = 0; i < n_; ++i) sync(static_cast<int>(i));
+    if (count_.collisions > 20000 * n_)
+      throw std::runtime_error("engine: compression stalled at phi = " +
+                               std::to_string(packing_fraction()) + " (target " +
+                               std::to_string(phi) + "): the packing jams; lower phi");
+    rescale_velocities(1.0);
+    clear_events();
+    if (progress) progress(packing_fraction());
+  }
+  // Exactly the true radii from here on.
+  for (long i = 0; i < n_; ++i) sync(static_cast<int>(i)), part_[i].t = 0;
+  grow_ = 0;
+  scale0_ = 1.0;
+
+  // The run proper starts at t = 0 with kinetic energy 1 per particle.
+  now_ = offset_ = 0;
+  events_since_rebase_ = 0;
+  count_ = Counters{};
+  eps_ = p_.restitution;
+  driving_ = p_.driving && p_.kick_rate > 0 && eps_ < 1.0;
+  kick_pair_rate_ = 0.5 * p_.kick_rate * n_;
+  thermalize(1.0);
+  clear_events();
+}
+
+// ---------------------------------------------------------------- checks
+
+double Engine::kinetic_energy_per_particle() const {
+  double e = 0;
+  for (long i = 0; i < n_; ++i) {
+    const auto& a = part_[i];
+    e += 0.5 * mass_[species_[i]] * (a.vx * a.vx + a.vy * a.vy);
+  }
+  return e / n_;
+}
+
+void Engine::momentum(double& px, double& py) const {
+  px = py = 0;
+  for (long i = 0; i < n_; ++i) {
+    px += mass_[species_[i]] * part_[i].vx;
+    py += mass_[species_[i]] * part_[i].vy;
+  }
+}
+
+void Engine::unwrapped_positions(std::vector<double>& xy) const {
+  xy.resize(2 * n_);
+  for (long i = 0; i < n_; ++i) {
+    const auto& a = part_[i];
+    const double dt = now_ - a.t;
+    xy[2 * i] = a.x + a.vx * dt + image_x_[i] * box_;
+    xy[2 * i + 1] = a.y + a.vy * dt + image_y_[i] * box_;
+  }
+}
+
+double Engine::min_gap_ratio() const {
+  double best = kNever;
+  for (long i = 0; i < n_; ++i) {
+    const auto& a = part_[i];
+    const double ax = a.x + a.vx * (now_ - a.t), ay = a.y + a.vy * (now_ - a.t);
+    const int c = cell_of_[i], cx = c % nc_, cy = c / nc_;
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const double sx = cx + dx < 0 ? -box_ : (cx + dx >= nc_ ? box_ : 0.0);
+        const double sy = cy + dy < 0 ? -box_ : (cy + dy >= nc_ ? box_ : 0.0);
+        for (int j = head_[cell_index((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_)]; j >= 0; j = next_[j]) {
+          if (j <= i) continue;
+          const auto& b = part_[j];
+          const double ddx = ax - (b.x + b.vx * (now_ - b.t) + sx);
+          const double ddy = ay - (b.y + b.vy * (now_ - b.t) + sy);
+          best = std::min(best, std::sqrt(ddx * ddx + ddy * ddy) / sigma(static_cast<int>(i), j));
+        }
+      }
+  }
+  return best;
+}
+
+double Engine::max_overlap() const { return 1.0 - min_gap_ratio(); }
+
+} // namespace dynhet::engine

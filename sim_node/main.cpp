@@ -1,0 +1,272 @@
+// sim_node: runs a scene's EDMD simulation and publishes, over LCM, the run
+// info, a status at least once a second, and the frames the scene's
+// observables need (in chunks). Usage: sim_node SCENE.toml [--lcm-url URL]
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <thread>
+#include <unistd.h>
+
+#include <CLI/CLI.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include "dynhet/chunking.hpp"
+#include "dynhet/engine/engine.hpp"
+#include "dynhet/frame_chunk_t.hpp"
+#include "dynhet/lcm_url.hpp"
+#include "dynhet/model.hpp"
+#include "dynhet/run_info_t.hpp"
+#include "dynhet/scene.hpp"
+#include "dynhet/schedule.hpp"
+#include "dynhet/sim_status_t.hpp"
+
+namespace {
+
+std::atomic<int> g_signal{0};
+void on_signal(int s) { g_signal = s; }
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) {
+  return std::chrono::duration<double>(Clock::now() - t0).count();
+}
+int64_t utime_now() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
+}
+
+std::string hms(double s) {
+  if (!(s >= 0) || !std::isfinite(s)) return "?";
+  char buf[32];
+  const long t = std::lround(s);
+  std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
+  return buf;
+}
+
+dynhet::run_info_t make_run_info(const dynhet::Scene& sc, const dynhet::engine::Engine& e,
+                                 const dynhet::FrameSchedule& s, int64_t run_id) {
+  dynhet::run_info_t m{};
+  m.run_id = run_id;
+  m.n_particles = static_cast<int32_t>(e.size());
+  m.box_length = e.box_length();
+  m.packing_fraction = sc.packing_fraction;
+  m.restitution = sc.restitution;
+  for (int k = 0; k < 2; ++k) m.radius[k] = e.radius(k), m.mass[k] = e.mass(k);
+  m.species.assign(e.species().begin(), e.species().end());
+  m.frame_time = s.frame_time;
+  m.n_frames = static_cast<int32_t>(m.frame_time.size());
+  m.origin_frame = s.origin_frame;
+  m.n_origins = static_cast<int32_t>(m.origin_frame.size());
+  m.lag_time = s.lag_time;
+  m.n_lags = static_cast<int32_t>(m.lag_time.size());
+  m.pair_frame = s.pair_frame;
+  m.n_pairs = static_cast<int32_t>(m.pair_frame.size());
+  m.cutoff_a = sc.cutoff_a;
+  m.n_cutoffs = static_cast<int32_t>(m.cutoff_a.size());
+  m.observables = sc.observables;
+  m.n_observables = static_cast<int32_t>(m.observables.size());
+  m.overlap_subbox_particles = sc.overlap_subbox_particles;
+  m.keep_frames = sc.keep_frames;
+  m.chunk_particles = sc.chunk_particles;
+  m.scene_toml = sc.text;
+  return m;
+}
+
+// Everything the status message and the terminal line show.
+class Reporter {
+public:
+  Reporter(lcm::LCM& lcm, int64_t run_id, bool tty) : lcm_(lcm), tty_(tty) {
+    msg_.run_id = run_id;
+    msg_.eta_seconds = -1;
+  }
+  dynhet::sim_status_t& msg() { return msg_; }
+
+  // Publishes (and prints) if a second has passed, or if forced.
+  void update(const dynhet::engine::Engine& e, double remaining_sim_time, bool force = false) {
+    const double dt = seconds_since(last_);
+    if (!force && dt < 1.0) return;
+    const auto& c = e.counters();
+    msg_.utime = utime_now();
+    msg_.sim_time = e.time();
+    msg_.packing_fraction = e.packing_fraction();
+    msg_.n_collisions = c.collisions;
+    msg_.n_kicks = c.kicks;
+    const double dsim = e.time() - last_sim_;
+    msg_.collisions_per_second = dt > 0 && c.collisions >= last_coll_ ? (c.collisions - last_coll_) / dt : 0;
+    msg_.kinetic_energy = e.kinetic_energy_per_particle();
+    if (dsim > 0 && remaining_sim_time >= 0) msg_.eta_seconds = remaining_sim_time / (dsim / dt);
+    lcm_.publish(dynhet::kChanSimStatus, &msg_);
+    print();
+    last_ = Clock::now();
+    last_sim_ = e.time();
+    last_coll_ = c.collisions;
+  }
+  void reset_rates(const dynhet::engine::Engine& e) {
+    last_sim_ = e.time();
+    last_coll_ = e.counters().collisions;
+    msg_.eta_seconds = -1;
+  }
+  void print() {
+    std::fprintf(stderr, "%s[%-11s] t=%-10.4g/%-10.4g phi=%.4f  coll/s=%.3g  KE=%.4f  frames %d/%d  ETA %s%s",
+                 tty_ ? "\r" : "", msg_.phase.c_str(), msg_.sim_time, msg_.phase_end_time,
+                 msg_.packing_fraction, msg_.collisions_per_second, msg_.kinetic_energy,
+                 msg_.frames_published, msg_.frames_total, hms(msg_.eta_seconds).c_str(),
+                 tty_ ? "   " : "\n");
+    std::fflush(stderr);
+  }
+
+private:
+  lcm::LCM& lcm_;
+  bool tty_;
+  dynhet::sim_status_t msg_{};
+  Clock::time_point last_ = Clock::now();
+  double last_sim_ = 0;
+  int64_t last_coll_ = 0;
+};
+
+} // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"dynhet sim_node: event-driven MD of a driven granular fluid, frames over LCM"};
+  std::string scene_path, url;
+  int64_t run_id = 0;
+  app.add_option("scene", scene_path, "scene file (TOML)")->required();
+  app.add_option("--lcm-url", url, "LCM URL (default $LCM_DEFAULT_URL or " + std::string(dynhet::kDefaultLcmUrl) + ")");
+  app.add_option("--run-id", run_id, "run id (default: random)");
+  CLI11_PARSE(app, argc, argv);
+
+  dynhet::Scene scene;
+  try {
+    scene = dynhet::parse_scene_file(scene_path);
+  } catch (const dynhet::SceneError& e) {
+    std::fprintf(stderr, "sim_node: %s\n", e.what());
+    return 2;
+  }
+  if (run_id == 0) run_id = static_cast<int64_t>(std::random_device{}() & 0x7fffffff) << 20 ^ getpid();
+
+  lcm::LCM lcm(dynhet::resolve_lcm_url(url));
+  if (!lcm.good()) {
+    std::fprintf(stderr, "sim_node: cannot open LCM at %s\n", dynhet::resolve_lcm_url(url).c_str());
+    return 3;
+  }
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+
+  Reporter rep(lcm, run_id, isatty(STDERR_FILENO));
+  auto fail = [&](const std::string& why) {
+    rep.msg().phase = "failed";
+    rep.msg().message = why;
+    rep.msg().utime = utime_now();
+    for (int i = 0; i < 3; ++i) lcm.publish(dynhet::kChanSimStatus, &rep.msg());
+    std::fprintf(stderr, "\nsim_node: %s\n", why.c_str());
+  };
+
+  try {
+    dynhet::engine::Params p;
+    p.n_particles = scene.n_particles;
+    p.packing_fraction = scene.packing_fraction;
+    p.restitution = scene.restitution;
+    p.radius_ratio = scene.radius_ratio;
+    p.seed = scene.seed;
+    p.driving = scene.driving;
+    const double gc = scene.contact_value > 0 ? scene.contact_value
+                                              : dynhet::henderson_contact_value(scene.packing_fraction);
+    p.kick_rate = scene.kick_rate > 0 ? scene.kick_rate : dynhet::enskog_frequency(scene.packing_fraction, gc);
+    dynhet::engine::Engine eng(p);
+    std::fprintf(stderr, "sim_node: run %lld, N=%ld phi=%.4f eps=%.3f L=%.4f, kicks %s (%.4g per particle per unit time)\n",
+                 static_cast<long long>(run_id), eng.size(), scene.packing_fraction, scene.restitution,
+                 eng.box_length(), p.driving && scene.restitution < 1 ? "on" : "off", p.kick_rate);
+
+    // Compression to the scene's packing fraction.
+    const auto t_wall = Clock::now();
+    rep.msg().phase = "compress";
+    rep.msg().phase_end_time = 0;
+    eng.prepare([&](double) {
+      rep.update(eng, -1);
+      if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
+    });
+    std::fprintf(stderr, "\nsim_node: compressed to phi=%.4f in %.1f s, max overlap %.2g\n",
+                 eng.packing_fraction(), seconds_since(t_wall), std::max(0.0, eng.max_overlap()));
+
+    const dynhet::FrameSchedule sched = dynhet::make_schedule(scene.schedule, scene.equilibration_time);
+    const double t_end = scene.equilibration_time + scene.production_time;
+    dynhet::run_info_t info = make_run_info(scene, eng, sched, run_id);
+    rep.msg().frames_total = info.n_frames;
+    auto last_info = Clock::now();
+    auto publish_info = [&] {
+      info.utime = utime_now();
+      lcm.publish(dynhet::kChanRun, &info);
+      last_info = Clock::now();
+    };
+    publish_info();
+
+    // Advance to time t in slices, so that status and run info go out and
+    // signals are seen at least once a second.
+    auto advance = [&](double t) {
+      while (!eng.run_until(t, 200000)) {
+        rep.update(eng, t_end - eng.time());
+        if (seconds_since(last_info) > 2.0) publish_info();
+        if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
+      }
+      rep.update(eng, t_end - eng.time());
+    };
+
+    rep.msg().phase = "equilibrate";
+    rep.msg().phase_end_time = scene.equilibration_time;
+    rep.reset_rates(eng);
+    advance(scene.equilibration_time);
+
+    rep.msg().phase = "production";
+    rep.msg().phase_end_time = t_end;
+    const auto ranges = dynhet::chunk_ranges(static_cast<int>(eng.size()), scene.chunk_particles);
+    std::vector<double> xy;
+    dynhet::frame_chunk_t chunk{};
+    chunk.run_id = run_id;
+    chunk.n_particles = static_cast<int32_t>(eng.size());
+    chunk.chunk_count = static_cast<int32_t>(ranges.size());
+    for (int f = 0; f < info.n_frames; ++f) {
+      advance(sched.frame_time[f]);
+      eng.unwrapped_positions(xy);
+      chunk.utime = utime_now();
+      chunk.frame_index = f;
+      chunk.time = sched.frame_time[f];
+      for (size_t c = 0; c < ranges.size(); ++c) {
+        chunk.chunk_index = static_cast<int32_t>(c);
+        chunk.first_particle = ranges[c].first;
+        chunk.count = ranges[c].count;
+        chunk.n_values = 2 * ranges[c].count;
+        chunk.position.assign(xy.begin() + 2 * ranges[c].first,
+                              xy.begin() + 2 * (ranges[c].first + ranges[c].count));
+        lcm.publish(dynhet::kChanFrame, &chunk);
+        // Pace multi-chunk frames so receivers' socket buffers keep up.
+        if (ranges.size() > 1) std::this_thread::sleep_for(std::chrono::microseconds(300));
+      }
+      rep.msg().frames_published = f + 1;
+    }
+    advance(t_end);
+
+    rep.msg().phase = "done";
+    rep.msg().eta_seconds = 0;
+    publish_info();
+    for (int i = 0; i < 3; ++i) {
+      rep.update(eng, 0, true);
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    double px, py;
+    eng.momentum(px, py);
+    std::fprintf(stderr,
+                 "\nsim_node: done in %.1f s: %lld collisions, %lld kicks, %d frames, KE/N=%.4f, "
+                 "total momentum (%.2g, %.2g), max overlap %.2g\n",
+                 seconds_since(t_wall), static_cast<long long>(eng.counters().collisions),
+                 static_cast<long long>(eng.counters().kicks), info.n_frames,
+                 eng.kinetic_energy_per_particle(), px, py, std::max(0.0, eng.max_overlap()));
+  } catch (const std::exception& e) {
+    fail(e.what());
+    return g_signal ? 128 + g_signal : 1;
+  }
+  return 0;
+}

@@ -1,0 +1,84 @@
+// Scene validation: bad input is refused before anything runs, with a
+// message naming the key, the value and what is allowed.
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "dynhet/scene.hpp"
+
+using dynhet::parse_scene_text;
+using dynhet::SceneError;
+
+namespace {
+
+// The error text of parsing `text`, or "" if it parses.
+std::string error_of(const std::string& text) {
+  try {
+    parse_scene_text(text, "test.toml");
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+void expect_error(const std::string& text, std::initializer_list<const char*> parts) {
+  const std::string err = error_of(text);
+  ASSERT_FALSE(err.empty()) << "accepted:\n" << text;
+  for (const char* p : parts) EXPECT_NE(err.find(p), std::string::npos) << "'" << p << "' not in: " << err;
+}
+
+} // namespace
+
+TEST(Scene, ShippedScenesParse) {
+  for (const char* name : {"default.toml", "tiny.toml"}) {
+    const auto s = dynhet::parse_scene_file(std::string(DYNHET_SOURCE_DIR) + "/scenes/" + name);
+    EXPECT_GT(s.n_particles, 1);
+    EXPECT_TRUE(s.wants("overlap"));
+    EXPECT_GE(s.production_time, (s.schedule.origins - 1) * s.schedule.origin_spacing + s.schedule.lag_max);
+  }
+}
+
+TEST(Scene, EmptySceneTakesDefaults) {
+  const auto s = parse_scene_text("", "empty");
+  EXPECT_EQ(s.n_particles, 1000);
+  EXPECT_DOUBLE_EQ(s.radius_ratio, 1.43);
+  EXPECT_DOUBLE_EQ(s.cutoff_a.at(0), 0.6);
+}
+
+TEST(Scene, UnknownKeyAndTableAreRefused) {
+  expect_error("[system]\nn_partcles = 100\n", {"system.n_partcles", "unknown key", "n_particles"});
+  expect_error("[sytem]\nn_particles = 100\n", {"sytem", "unknown table"});
+}
+
+TEST(Scene, WrongTypesAreRefused) {
+  expect_error("[system]\nn_particles = \"many\"\n", {"system.n_particles", "many", "a string", "an integer"});
+  expect_error("[system]\nn_particles = 100.5\n", {"system.n_particles", "100.5", "an integer"});
+  expect_error("[driving]\nenabled = 1\n", {"driving.enabled", "boolean"});
+  expect_error("[observables]\ncutoff_a = 0.6\n", {"observables.cutoff_a", "array"});
+}
+
+TEST(Scene, ImpossibleValuesAreRefused) {
+  expect_error("[system]\npacking_fraction = 0.9\n", {"system.packing_fraction", "0.9", "0 < phi < 0.9"});
+  expect_error("[system]\npacking_fraction = -0.1\n", {"system.packing_fraction"});
+  expect_error("[system]\nrestitution = 0.0\n", {"system.restitution", "0 < eps <= 1"});
+  expect_error("[system]\nrestitution = 1.2\n", {"system.restitution", "1.2"});
+  expect_error("[system]\nn_particles = 1\n", {"system.n_particles", "2 <= value"});
+  expect_error("[system]\nn_particles = 10\n", {"system.n_particles", "too small"});
+  expect_error("[run]\nequilibration_time = -5\n", {"run.equilibration_time", "-5", ">= 0"});
+  expect_error("[schedule]\nlag_min = -1\n", {"schedule.lag_min", "> 0"});
+  expect_error("[schedule]\nlag_min = 10\nlag_max = 5\n", {"schedule.lag_min", "smaller than schedule.lag_max"});
+  expect_error("[run]\nproduction_time = 5\n", {"run.production_time", "shorter than the schedule needs"});
+  expect_error("[observables]\ncompute = [\"entropy\"]\n", {"observables.compute", "entropy", "overlap"});
+  expect_error("[observables]\ncutoff_a = [0.6, -1]\n", {"observables.cutoff_a", "-1"});
+  expect_error("[driving]\nkick_rate = \"fast\"\n", {"driving.kick_rate", "enskog"});
+  expect_error("[transport]\nchunk_particles = 100000\n", {"transport.chunk_particles", "65000"});
+}
+
+TEST(Scene, AllProblemsAreReportedTogether) {
+  const std::string err = error_of("[system]\nrestitution = 2\npacking_fraction = 0.95\n");
+  EXPECT_NE(err.find("2 problems"), std::string::npos) << err;
+}
+
+TEST(Scene, SyntaxErrorNamesLine) {
+  expect_error("[system]\nn_particles = = 3\n", {"test.toml:2", "not valid TOML"});
+}
