@@ -217,6 +217,7 @@ int main(int argc, char** argv) {
   in.subscribe(dynhet::kChanFrame, &OverlapNode::on_chunk, &node)->setQueueCapacity(100000);
   in.subscribe(dynhet::kChanSimStatus, &OverlapNode::on_sim_status, &node);
 
+  std::fprintf(stderr, "overlap_node: ready, reading %s\n", in_url.c_str());
   const auto start = Clock::now();
   while (!node.finished()) {
     if (in.handleTimeout(200) < 0) { // a replayed log has ended

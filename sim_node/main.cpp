@@ -137,6 +137,8 @@ int main(int argc, char** argv) {
   app.add_option("scene", scene_path, "scene file (TOML)")->required();
   app.add_option("--lcm-url", url, "LCM URL (default $LCM_DEFAULT_URL or " + std::string(dynhet::kDefaultLcmUrl) + ")");
   app.add_option("--run-id", run_id, "run id (default: random)");
+  bool check = false;
+  app.add_flag("--check", check, "validate the scene, print what it needs (nodes, frames) and exit");
   CLI11_PARSE(app, argc, argv);
 
   dynhet::Scene scene;
@@ -145,6 +147,16 @@ int main(int argc, char** argv) {
   } catch (const dynhet::SceneError& e) {
     std::fprintf(stderr, "sim_node: %s\n", e.what());
     return 2;
+  }
+  if (check) {
+    // One line per fact, for the launch scripts and for people.
+    const auto sched = dynhet::make_schedule(scene.schedule, scene.equilibration_time);
+    std::printf("scene %s: valid\n", scene_path.c_str());
+    std::printf("nodes:");
+    for (const auto& o : scene.observables) std::printf(" %s_node", o.c_str());
+    std::printf("\nframes: %zu\nparticles: %lld\nsim_time: %g\n", sched.frame_time.size(),
+                static_cast<long long>(scene.n_particles), scene.equilibration_time + scene.production_time);
+    return 0;
   }
   if (run_id == 0) run_id = static_cast<int64_t>(std::random_device{}() & 0x7fffffff) << 20 ^ getpid();
 

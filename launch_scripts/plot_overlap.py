@@ -1,0 +1,62 @@
+#!/usr/bin/python3
+"""Plot the overlap Q(t) of a dynhet run (HDF5, H5MD layout) with its error
+bars, the 1/e line and tau_alpha, one curve per cutoff a.
+
+Usage: plot_overlap.py RUN.h5 OUT.png
+"""
+import math
+import sys
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def last(group, name):
+    """The newest record of the time series group/name."""
+    return group[name]["value"][-1]
+
+
+def main(path, png):
+    with h5py.File(path, "r") as f:
+        if "observables/overlap" not in f:
+            print(f"plot_overlap: {path} has no overlap results", file=sys.stderr)
+            return 1
+        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        for name, g in sorted(f["observables/overlap"].items()):
+            t = g["lag_time"][()]
+            q, err = last(g, "q"), last(g, "q_err")
+            tau, tau_err = last(g, "tau_alpha"), last(g, "tau_alpha_err")
+            a = g.attrs.get("cutoff_a", name)
+            label = f"a = {a}"
+            if math.isfinite(tau):
+                label += rf", $\tau_\alpha$ = {tau:.4g}" + (f" ± {tau_err:.2g}" if math.isfinite(tau_err) else "")
+            line = ax.errorbar(t, q, yerr=np.nan_to_num(err), marker="o", ms=3, capsize=2, label=label)
+            if math.isfinite(tau):
+                ax.axvline(tau, color=line[0].get_color(), ls=":", lw=1)
+        ax.axhline(math.exp(-1), color="gray", ls="--", lw=1, label="1/e")
+        ax.set_xscale("log")
+        ax.set_xlabel("t")
+        ax.set_ylabel("Q(t)")
+        ax.set_ylim(0, 1.05)
+        title = "overlap"
+        if "parameters/system" in f:
+            p = f["parameters/system"].attrs
+            bits = [f"{k}={p[k]}" for k in ("n_particles", "packing_fraction", "restitution") if k in p]
+            title += " (" + ", ".join(bits) + ")"
+        ax.set_title(title, fontsize=10)
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(png, dpi=120)
+    print(f"plot_overlap: wrote {png}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3:
+        print(__doc__, file=sys.stderr)
+        sys.exit(2)
+    sys.exit(main(sys.argv[1], sys.argv[2]))

@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# Re-runs the analysis of a recorded run from its lcm-logger log, at full
+# speed, through LCM's file:// provider, into a new HDF5 file. The nodes
+# read frames, run info and sim status from the log and publish their
+# results on a private bus, where the recorder picks them up (run info and
+# status it reads from the log too).
+#
+# Usage: launch_scripts/replay.sh LOG --out DIR [--no-build]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${BUILD_DIR:-$root/build}
+bin=$build/bin
+
+log="" out="" build_first=1
+while (($#)); do
+  case "$1" in
+  --out) out=$2; shift 2 ;;
+  --no-build) build_first=0; shift ;;
+  -h | --help) sed -n '2,9p' "$0"; exit 0 ;;
+  -*) echo "replay: unknown option $1" >&2; exit 2 ;;
+  *) log=$1; shift ;;
+  esac
+done
+[[ -n $log && -n $out ]] || { echo "usage: replay.sh LOG --out DIR" >&2; exit 2; }
+[[ -f $log ]] || { echo "replay: no log file $log" >&2; exit 2; }
+log=$(cd "$(dirname "$log")" && pwd)/$(basename "$log")
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+
+if [[ -z ${DYNHET_IN_NETNS:-} ]]; then
+  ((build_first)) && BUILD_DIR=$build "$root/launch_scripts/setup.sh"
+  exec "$root/launch_scripts/netns.sh" "$0" "$log" --out "$out" --no-build
+fi
+
+# Which nodes ran: the observables named in the run info of the log. The
+# scene text is in the log; nodes are found by their results channels.
+nodes=$("$bin/recorder" --list-nodes "$log") || { echo "replay: cannot read run info from $log" >&2; exit 1; }
+bus="udpm://239.255.76.67:7670?ttl=0&recv_buf_size=4194304"
+
+"$bin/recorder" --lcm-url "$bus" --from-log "$log" --out "$out/run.h5" 2>"$out/recorder.log" &
+rec=$!
+for _ in $(seq 100); do grep -q ready "$out/recorder.log" && break; sleep 0.1; done
+status=0
+for n in $nodes; do
+  "$bin/$n" --lcm-url "file://$log?speed=0" --publish-url "$bus" 2>"$out/$n.log" || {
+    echo "replay: $n failed; log $out/$n.log" >&2; tail -3 "$out/$n.log" >&2; status=1; }
+done
+wait $rec || { echo "replay: recorder failed; log $out/recorder.log" >&2; tail -3 "$out/recorder.log" >&2; status=1; }
+grep -h -E "tau_alpha|frames whole" "$out"/*_node.log >&2 || true
+if [[ -f $out/run.h5 ]]; then
+  /usr/bin/python3 "$root/launch_scripts/plot_overlap.py" "$out/run.h5" "$out/overlap.png" || status=1
+fi
+exit $status

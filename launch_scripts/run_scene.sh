@@ -1,0 +1,119 @@
+#!/usr/bin/env bash
+# Runs a scene end to end: the sim, the analysis nodes the scene needs and
+# the recorder, then plots. Exits non-zero if any process failed.
+#
+# Usage: launch_scripts/run_scene.sh SCENE.toml [options]
+#   --out DIR       where run.h5, plots and logs go (default runs/<scene>-<time>)
+#   --bus private   (default) a private network namespace: no packet leaves
+#                   the machine, nothing else on the host sees the run
+#   --bus host      the host's LCM bus ($LCM_DEFAULT_URL or the default URL),
+#                   so lcm-spy (spy.sh) and other hosts can watch
+#   --url URL       LCM URL (default udpm://239.255.76.67:7667?ttl=0)
+#   --record LOG    also record everything with lcm-logger into LOG
+#   --no-build      skip setup.sh (packages and build)
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${BUILD_DIR:-$root/build}
+bin=$build/bin
+
+scene="" out="" bus=private url="" record="" build_first=1
+while (($#)); do
+  case "$1" in
+  --out) out=$2; shift 2 ;;
+  --bus) bus=$2; shift 2 ;;
+  --url) url=$2; shift 2 ;;
+  --record) record=$2; shift 2 ;;
+  --no-build) build_first=0; shift ;;
+  -h | --help) sed -n '2,15p' "$0"; exit 0 ;;
+  -*) echo "run_scene: unknown option $1" >&2; exit 2 ;;
+  *) [[ -z $scene ]] || { echo "run_scene: one scene only" >&2; exit 2; }; scene=$1; shift ;;
+  esac
+done
+[[ -n $scene ]] || { echo "usage: run_scene.sh SCENE.toml [--out DIR] [--bus private|host] [--url URL] [--record LOG]" >&2; exit 2; }
+[[ -f $scene ]] || { echo "run_scene: no scene file $scene" >&2; exit 2; }
+[[ $bus == private || $bus == host ]] || { echo "run_scene: --bus is private or host, not $bus" >&2; exit 2; }
+
+if ((build_first)) && [[ -z ${DYNHET_IN_NETNS:-} ]]; then BUILD_DIR=$build "$root/launch_scripts/setup.sh"; fi
+
+# Refuse a bad scene before anything starts.
+check=$("$bin/sim_node" "$scene" --check) || exit 2
+nodes=$(sed -n 's/^nodes: *//p' <<<"$check")
+
+name=$(basename "$scene" .toml)
+out=${out:-$root/runs/$name-$(date +%Y%m%d-%H%M%S)}
+mkdir -p "$out"
+out=$(cd "$out" && pwd)
+[[ -z $record ]] || record=$(cd "$(dirname "$record")" && pwd)/$(basename "$record")
+
+if [[ $bus == private && -z ${DYNHET_IN_NETNS:-} ]]; then
+  args=(--out "$out" --bus private --no-build)
+  [[ -z $url ]] || args+=(--url "$url")
+  [[ -z $record ]] || args+=(--record "$record")
+  exec "$root/launch_scripts/netns.sh" "$0" "$scene" "${args[@]}"
+fi
+if [[ -n $url ]]; then export LCM_DEFAULT_URL=$url; fi
+url=${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0}
+# Frames come in bursts of chunks: ask for a big socket receive buffer.
+[[ $url == udpm://* && $url != *recv_buf_size* ]] && url="$url&recv_buf_size=4194304"
+export LCM_DEFAULT_URL=$url
+
+pids=() names=()
+cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
+trap cleanup EXIT
+trap 'echo "run_scene: interrupted" >&2; exit 130' INT TERM
+
+start() { # name, then the command; waits for its "ready" line
+  local n=$1; shift
+  "$@" 2>"$out/$n.log" &
+  pids+=($!) names+=("$n")
+  for _ in $(seq 100); do
+    grep -q "ready" "$out/$n.log" 2>/dev/null && return 0
+    kill -0 "${pids[-1]}" 2>/dev/null || { echo "run_scene: $n died at start:" >&2; cat "$out/$n.log" >&2; exit 1; }
+    sleep 0.1
+  done
+  echo "run_scene: $n did not get ready in 10 s" >&2; exit 1
+}
+
+echo "run_scene: $scene -> $out (bus $bus, $url)" >&2
+if [[ -n $record ]]; then
+  lcm-logger --lcm-url="$url" --force "$record" >"$out/lcm-logger.log" 2>&1 &
+  logger_pid=$!
+  sleep 0.3
+fi
+start recorder "$bin/recorder" --out "$out/run.h5"
+for n in $nodes; do start "$n" "$bin/$n"; done
+
+# The sim in the foreground (its progress line goes to the terminal and
+# sim_node.log).
+set +e
+"$bin/sim_node" "$scene" 2> >(tee "$out/sim_node.log" >&2)
+sim_rc=$?
+set -e
+[[ $sim_rc -eq 0 ]] || echo "run_scene: sim_node failed (exit $sim_rc)" >&2
+
+status=$sim_rc
+for i in "${!pids[@]}"; do
+  set +e
+  wait "${pids[$i]}"
+  rc=$?
+  set -e
+  if [[ $rc -ne 0 ]]; then
+    echo "run_scene: ${names[$i]} failed (exit $rc); its log: $out/${names[$i]}.log" >&2
+    tail -5 "$out/${names[$i]}.log" >&2
+    status=1
+  fi
+done
+pids=()
+if [[ -n $record ]]; then
+  sleep 0.3
+  kill -INT "$logger_pid" 2>/dev/null || true
+  wait "$logger_pid" 2>/dev/null || true
+fi
+grep -h -E "tau_alpha|frames whole|complete|missing" "$out"/*_node.log "$out/recorder.log" >&2 || true
+
+if [[ -f $out/run.h5 ]]; then
+  /usr/bin/python3 "$root/launch_scripts/plot_overlap.py" "$out/run.h5" "$out/overlap.png" ||
+    { echo "run_scene: plotting failed" >&2; status=1; }
+fi
+echo "run_scene: results in $out (exit $status)" >&2
+exit $status

@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Sets up (packages, build) and runs the default test suite (everything but
+# the long stress runs). Usage: launch_scripts/test.sh [extra ctest args]
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${BUILD_DIR:-$root/build}
+BUILD_DIR=$build "$root/launch_scripts/setup.sh"
+cd "$build"
+ctest --output-on-failure -j2 -LE stress --timeout 600 "$@"

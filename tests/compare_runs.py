@@ -1,0 +1,50 @@
+#!/usr/bin/python3
+"""Replays must reproduce the live Q(t) bit for bit (if the live run lost
+no frame) and must be identical to each other.
+
+Usage: compare_runs.py LIVE.h5 REPLAY1.h5 REPLAY2.h5
+"""
+import sys
+
+import h5py
+import numpy as np
+
+
+def final_results(path):
+    with h5py.File(path, "r") as f:
+        out = {}
+        for name, g in f["observables/overlap"].items():
+            for obs in ("q", "q_err", "qr_var", "tau_alpha", "tau_alpha_err"):
+                out[f"{name}/{obs}"] = np.atleast_1d(g[obs]["value"][-1])
+        lost = int(f["observables/nodes/overlap/frames_lost/value"][-1])
+        return out, lost
+
+
+def same(a, b):
+    return a.keys() == b.keys() and all(
+        np.array_equal(a[k].view(np.uint64), b[k].view(np.uint64)) for k in a)
+
+
+def main(live, r1, r2):
+    (lv, lost), (a, _), (b, _) = final_results(live), final_results(r1), final_results(r2)
+    ok = True
+    if same(a, b):
+        print("ok   replay 1 and replay 2 are identical bit for bit")
+    else:
+        print("FAIL replay 1 and replay 2 differ")
+        ok = False
+    if lost:
+        print(f"note live run lost {lost} frames: no bitwise comparison with live")
+    elif same(lv, a):
+        print("ok   replay reproduces the live Q(t), tau_alpha bit for bit")
+    else:
+        print("FAIL replay differs from the live run")
+        for k in lv:
+            if not np.array_equal(lv[k].view(np.uint64), a[k].view(np.uint64)):
+                print(f"     {k}: live {lv[k][:4]} replay {a[k][:4]}")
+        ok = False
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main(*sys.argv[1:4]))
