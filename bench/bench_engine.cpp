@@ -1,0 +1,89 @@
+// Engine benchmark: events per second and ns per collision against N and
+// phi, memory per particle, and the energy drift of elastic runs, as a
+// table. Usage: bench_engine [--n 10000,100000] [--phi 0.6,0.78] [--coll 50]
+//   [--eps 1.0] [--driven]
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "dynhet/engine/engine.hpp"
+#include "dynhet/model.hpp"
+
+namespace {
+
+long rss_kib() {
+  std::ifstream f("/proc/self/status");
+  std::string line;
+  while (std::getline(f, line))
+    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
+  return 0;
+}
+
+double seconds(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"dynhet engine benchmark"};
+  std::vector<long> ns{10000, 100000};
+  std::vector<double> phis{0.60, 0.70, 0.78, 0.805};
+  double coll_per_particle = 50, eps = 1.0;
+  bool driven = false;
+  app.add_option("--n", ns, "particle numbers")->delimiter(',');
+  app.add_option("--phi", phis, "packing fractions")->delimiter(',');
+  app.add_option("--coll", coll_per_particle, "collisions per particle to time");
+  app.add_option("--eps", eps, "restitution");
+  app.add_flag("--driven", driven, "kicks at the Enskog frequency");
+  CLI11_PARSE(app, argc, argv);
+
+  std::printf("# dynhet engine, one core; eps=%g, %s; timed over %g collisions per particle\n", eps,
+              driven ? "driven" : "undriven", coll_per_particle);
+  std::printf("%9s %6s %9s %10s %10s %10s %10s %9s %9s %11s\n", "N", "phi", "prep_s", "coll/s",
+              "kicks/s", "cross/s", "stale/s", "ns/coll", "B/part", "dE/E");
+  for (long n : ns)
+    for (double phi : phis) {
+      const long rss0 = rss_kib();
+      dynhet::engine::Params p;
+      p.n_particles = n;
+      p.packing_fraction = phi;
+      p.restitution = eps;
+      p.driving = driven;
+      p.kick_rate = dynhet::enskog_frequency(phi, dynhet::henderson_contact_value(phi));
+      p.seed = 1;
+      dynhet::engine::Engine e(p);
+      auto t0 = std::chrono::steady_clock::now();
+      try {
+        e.prepare();
+      } catch (const std::exception& ex) {
+        std::printf("%9ld %6.3f  failed: %s\n", n, phi, ex.what());
+        continue;
+      }
+      const double prep = seconds(t0);
+      const double bytes = (rss_kib() - rss0) * 1024.0 / n;
+      const double e0 = e.kinetic_energy_per_particle();
+      // Short warm-up to learn the collision rate, then the timed run.
+      e.run_until(1.0);
+      const double rate = e.counters().collisions / 1.0; // per unit time, whole system
+      const auto c0 = e.counters();
+      const double t_run = coll_per_particle * n / std::max(rate, 1.0);
+      t0 = std::chrono::steady_clock::now();
+      e.run_until(e.time() + t_run);
+      const double wall = seconds(t0);
+      const auto c1 = e.counters();
+      const double coll = double(c1.collisions - c0.collisions);
+      std::printf("%9ld %6.3f %9.2f %10.3g %10.3g %10.3g %10.3g %9.1f %9.0f %11.2e\n", n, phi, prep,
+                  coll / wall, (c1.kicks - c0.kicks) / wall, (c1.cell_crossings - c0.cell_crossings) / wall,
+                  (c1.stale - c0.stale) / wall, 1e9 * wall / coll, bytes,
+                  eps == 1.0 && !driven ? e.kinetic_energy_per_particle() / e0 - 1 : NAN);
+      std::fflush(stdout);
+    }
+  return 0;
+}

@@ -1,0 +1,50 @@
+// What a run still owes the recorder before its file is complete: the
+// sim's last phase, each named observable's node state and final results,
+// and (when the trajectory is kept) the frames. Plain bookkeeping: no LCM,
+// no HDF5.
+#pragma once
+
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+namespace dynhet {
+
+// "a0.6": how a cutoff names its results in the file and in messages.
+std::string cutoff_label(double cutoff_a);
+
+class Completion {
+public:
+  Completion() = default;
+  // The observables the run names and, for the overlap, its cutoffs.
+  Completion(const std::vector<std::string> &observables, const std::vector<double> &cutoffs);
+
+  void sim_phase(const std::string &phase, const std::string &message);
+  void node_state(const std::string &node, const std::string &state);
+  void final_overlap(double cutoff_a) { finals_.insert(cutoff_label(cutoff_a)); }
+  void frames(int lost, int expected);
+
+  // The sim has said done or failed.
+  bool sim_ended() const { return phase_ == "done" || phase_ == "failed"; }
+  // Nothing more is coming: the sim ended and every node needed has said
+  // done (with all its final results) or failed.
+  bool settled() const;
+  // What is missing for a complete file, one line each; empty if complete.
+  std::vector<std::string> missing() const;
+
+  const std::string &phase() const { return phase_; }
+
+private:
+  std::vector<std::string> observables_;
+  std::vector<std::string> cutoffs_; // labels
+  std::string phase_ = "unknown", sim_message_;
+  std::map<std::string, std::string> node_state_;
+  std::set<std::string> finals_;
+  int frames_lost_ = 0, frames_expected_ = 0;
+
+  bool finals_complete(const std::string &observable) const;
+  std::string state_of(const std::string &node) const;
+};
+
+} // namespace dynhet

@@ -1,0 +1,258 @@
+// recorder: writes one run to an H5MD file. It locks on to the first run
+// info it hears, records sim status, node status and the observables'
+// results (and the frames, if the scene keeps them), and closes the file
+// when the sim has ended and every observable the run names has its final
+// result and its node has said done.
+//
+// `recorder --list-nodes LOG` prints the analysis nodes the run in an
+// lcm-logger log needs (for replays) and exits.
+//
+// Exit: 0 complete; 1 incomplete (sim failed, results missing after
+// --timeout, no run info within --wait-run); 2 interrupted (SIGINT or
+// SIGTERM; the file is closed cleanly); 3 could not start (bus, log or
+// output file).
+#include <atomic>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <lcm/lcm-cpp.hpp>
+
+#include "dynhet/lcm_url.hpp"
+#include "run_recorder.hpp"
+
+namespace {
+
+std::atomic<int> g_signal{0};
+void on_signal(int sig) { g_signal = sig; }
+
+using Clock = std::chrono::steady_clock;
+double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
+
+struct Options {
+  std::string url, out, from_log;
+  double timeout = 60, wait_run = 120;
+};
+
+template <class Msg> bool decode(const lcm::LogEvent &e, Msg &m) {
+  return m.decode(e.data, 0, e.datalen) >= 0;
+}
+
+// The bus (and optionally a log) on one side, the RunRecorder on the
+// other, and the clocks that decide when to stop waiting.
+class Session {
+public:
+  Session(lcm::LCM &lcm, const Options &o)
+      : lcm_(lcm), opt_(o), rec_(o.out, DYNHET_VERSION), start_(Clock::now()) {}
+
+  int run();
+
+private:
+  lcm::LCM &lcm_;
+  Options opt_;
+  dynhet::RunRecorder rec_;
+  std::unique_ptr<lcm::LogFile> log_;
+  lcm::Subscription *frames_ = nullptr;
+  bool log_done_ = false;
+  Clock::time_point start_, last_sim_, last_progress_;
+  std::string fatal_, early_failure_;
+
+  void subscribe();
+  bool read_log(int max_events);
+  int step(); // -1: keep going, else the exit code
+  int finish(const std::string &reason);
+  bool sim_ended() const { return rec_.completion().sim_ended() || log_done_; }
+
+  void take_run(const dynhet::run_info_t &m);
+  void take_sim(const dynhet::sim_status_t &m);
+  void on_run(const lcm::ReceiveBuffer *, const std::string &, const dynhet::run_info_t *m) { take_run(*m); }
+  void on_sim(const lcm::ReceiveBuffer *, const std::string &, const dynhet::sim_status_t *m) {
+    take_sim(*m);
+  }
+  void on_node(const lcm::ReceiveBuffer *, const std::string &, const dynhet::node_status_t *m) {
+    if (rec_.on_node_status(*m)) last_progress_ = Clock::now();
+  }
+  void on_overlap(const lcm::ReceiveBuffer *, const std::string &, const dynhet::overlap_t *m) {
+    if (rec_.on_overlap(*m)) last_progress_ = Clock::now();
+  }
+  void on_frame(const lcm::ReceiveBuffer *, const std::string &, const dynhet::frame_chunk_t *m) {
+    rec_.on_frame_chunk(*m);
+  }
+};
+
+// Run info and sim status come from the log when one is given, results
+// always from the bus. Queues are deep: results and chunks come in bursts.
+void Session::subscribe() {
+  if (!opt_.from_log.empty()) {
+    log_ = std::make_unique<lcm::LogFile>(opt_.from_log, "r");
+    if (!log_->good()) fatal_ = "cannot read the log " + opt_.from_log;
+  } else {
+    lcm_.subscribe(dynhet::kChanRun, &Session::on_run, this)->setQueueCapacity(100);
+    lcm_.subscribe(dynhet::kChanSimStatus, &Session::on_sim, this)->setQueueCapacity(1000);
+    // Frames from the start: the first ones can follow the run info
+    // closely, and LCM drops what arrives on a channel nobody subscribes.
+    frames_ = lcm_.subscribe(dynhet::kChanFrame, &Session::on_frame, this);
+    frames_->setQueueCapacity(10000);
+  }
+  lcm_.subscribe(dynhet::kChanNodeStatus, &Session::on_node, this)->setQueueCapacity(1000);
+  lcm_.subscribe(dynhet::kChanOverlap, &Session::on_overlap, this)->setQueueCapacity(10000);
+  // The launch scripts wait for this line before starting the sim.
+  std::fprintf(stderr, "recorder: ready, waiting for run info%s%s\n", log_ ? " in " : "",
+               log_ ? opt_.from_log.c_str() : "");
+}
+
+void Session::take_run(const dynhet::run_info_t &m) {
+  try {
+    if (!rec_.on_run(m)) return;
+  } catch (const std::exception &e) {
+    fatal_ = e.what(); // the file cannot be written
+    return;
+  }
+  last_sim_ = last_progress_ = Clock::now();
+  std::fprintf(stderr, "recorder: run %lld, N=%d, %d frames%s -> %s\n", static_cast<long long>(m.run_id),
+               m.n_particles, m.n_frames, m.keep_frames ? " (kept)" : "", opt_.out.c_str());
+}
+
+void Session::take_sim(const dynhet::sim_status_t &m) {
+  if (!rec_.has_run() && m.phase == "failed") early_failure_ = m.message;
+  if (!rec_.on_sim_status(m)) return;
+  last_sim_ = Clock::now();
+  if (rec_.completion().sim_ended()) last_progress_ = Clock::now();
+}
+
+// Feeds up to `max_events` of the log's run info, sim status and (when
+// kept) frame chunks. Returns false at the end of the log.
+bool Session::read_log(int max_events) {
+  for (int i = 0; i < max_events; ++i) {
+    const lcm::LogEvent *e = log_->readNextEvent();
+    if (!e) return false;
+    dynhet::run_info_t run;
+    dynhet::sim_status_t sim;
+    dynhet::frame_chunk_t chunk;
+    if (e->channel == dynhet::kChanRun && decode(*e, run)) take_run(run);
+    if (e->channel == dynhet::kChanSimStatus && decode(*e, sim)) take_sim(sim);
+    if (e->channel == dynhet::kChanFrame && rec_.keep_frames() && decode(*e, chunk))
+      rec_.on_frame_chunk(chunk);
+  }
+  return true;
+}
+
+int Session::run() {
+  subscribe();
+  for (;;) {
+    if (log_ && !log_done_ && fatal_.empty()) {
+      log_done_ = !read_log(1000);
+      if (log_done_) last_progress_ = Clock::now(); // the wait for results starts now
+      lcm_.handleTimeout(0);
+    } else if (lcm_.handleTimeout(100) < 0 && !g_signal) {
+      return finish("LCM: receive failed");
+    }
+    const int code = step();
+    if (code >= 0) return code;
+  }
+}
+
+// One look at the clocks and the bookkeeping after a round of messages.
+int Session::step() {
+  if (!fatal_.empty()) {
+    std::fprintf(stderr, "recorder: %s\n", fatal_.c_str());
+    return 3;
+  }
+  if (g_signal && !rec_.has_run()) {
+    std::fprintf(stderr, "recorder: interrupted before any run info; no file written\n");
+    return 2;
+  }
+  if (g_signal) return finish("interrupted by signal " + std::to_string(g_signal.load()));
+  if (!rec_.has_run()) {
+    if (!early_failure_.empty() || log_done_ || since(start_) > opt_.wait_run) {
+      std::fprintf(stderr, "recorder: no run info %s; no file written\n",
+                   !early_failure_.empty() ? ("(the sim failed: " + early_failure_ + ")").c_str()
+                   : log_done_             ? "in the log"
+                                           : "within --wait-run");
+      return 1;
+    }
+    return -1;
+  }
+  if (frames_ && !rec_.keep_frames()) { // the scene does not keep them
+    lcm_.unsubscribe(frames_);
+    frames_ = nullptr;
+  }
+  if (rec_.completion().settled()) return finish("");
+  const int t = static_cast<int>(opt_.timeout);
+  if (sim_ended() && since(last_progress_) > opt_.timeout)
+    return finish("timeout: no results for " + std::to_string(t) + " s after the sim ended");
+  if (!sim_ended() && !log_ && since(last_sim_) > opt_.timeout)
+    return finish("sim: silent for " + std::to_string(t) + " s");
+  return -1;
+}
+
+int Session::finish(const std::string &reason) {
+  const std::vector<std::string> missing = rec_.finish(reason);
+  const long long id = rec_.run_id();
+  if (missing.empty()) {
+    std::fprintf(stderr, "recorder: run %lld complete -> %s\n", id, opt_.out.c_str());
+    return 0;
+  }
+  std::string list;
+  for (const std::string &m : missing) list += "\n  " + m;
+  std::fprintf(stderr, "recorder: run %lld INCOMPLETE -> %s; missing:%s\n", id, opt_.out.c_str(),
+               list.c_str());
+  return g_signal ? 2 : 1;
+}
+
+// The nodes the run in `log_path` needs, named as the launch scripts
+// start them ("overlap" -> overlap_node), on one line.
+int list_nodes(const std::string &log_path) {
+  lcm::LogFile log(log_path, "r");
+  if (!log.good()) {
+    std::fprintf(stderr, "recorder: cannot read the log %s\n", log_path.c_str());
+    return 3;
+  }
+  while (const lcm::LogEvent *e = log.readNextEvent()) {
+    dynhet::run_info_t run;
+    if (e->channel != dynhet::kChanRun || !decode(*e, run)) continue;
+    std::string line;
+    for (const std::string &obs : run.observables) line += (line.empty() ? "" : " ") + obs + "_node";
+    std::printf("%s\n", line.c_str());
+    return 0;
+  }
+  std::fprintf(stderr, "recorder: no run info in %s\n", log_path.c_str());
+  return 1;
+}
+
+} // namespace
+
+int main(int argc, char **argv) {
+  CLI::App app{"dynhet recorder: one run's results into an H5MD file"};
+  Options o;
+  std::string list_log;
+  app.add_option("--lcm-url", o.url, "LCM URL (default: $LCM_DEFAULT_URL, else the project's)");
+  app.add_option("--out", o.out, "output file (.h5); required unless --list-nodes");
+  app.add_option("--from-log", o.from_log,
+                 "read run info, sim status and frames from this lcm-logger log; "
+                 "results still come from the bus");
+  app.add_option("--timeout", o.timeout,
+                 "seconds to wait for results once the sim has ended (counted from the "
+                 "last result or node progress), and for a silent sim")
+      ->capture_default_str();
+  app.add_option("--wait-run", o.wait_run, "seconds to wait for the run info")->capture_default_str();
+  app.add_option("--list-nodes", list_log,
+                 "print the analysis nodes the run in this lcm-logger log needs, and exit");
+  CLI11_PARSE(app, argc, argv);
+  if (!list_log.empty()) return list_nodes(list_log);
+  if (o.out.empty()) return app.exit(CLI::RequiredError("--out"));
+
+  const std::string url = dynhet::resolve_lcm_url(o.url);
+  lcm::LCM lcm(url);
+  if (!lcm.good()) {
+    std::fprintf(stderr, "recorder: cannot open LCM at %s\n", url.c_str());
+    return 3;
+  }
+  std::signal(SIGINT, on_signal);
+  std::signal(SIGTERM, on_signal);
+  Session session(lcm, o);
+  return session.run();
+}

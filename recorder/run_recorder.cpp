@@ -1,0 +1,210 @@
+#include "run_recorder.hpp"
+
+#include <cstdio>
+
+namespace dynhet {
+
+namespace {
+
+// A node's name as a path component.
+std::string node_key(const std::string &node) {
+  std::string key = node.empty() ? "unnamed" : node;
+  for (char &c : key)
+    if (c == '/') c = '_';
+  return key;
+}
+
+std::string join(const std::vector<std::string> &lines, const char *sep) {
+  std::string out;
+  for (const std::string &l : lines) out += (out.empty() ? "" : sep) + l;
+  return out;
+}
+
+bool ended(const std::string &phase) { return phase == "done" || phase == "failed"; }
+
+} // namespace
+
+RunRecorder::RunRecorder(std::string out_path, std::string creator_version)
+    : out_path_(std::move(out_path)), creator_version_(std::move(creator_version)) {}
+
+// A failed write costs that record, not the run: it is reported on
+// stderr (the first few times) and counted against completeness.
+template <class F> void RunRecorder::guarded(const char *what, F &&write) {
+  try {
+    write();
+    writer_->flush();
+  } catch (const std::exception &e) {
+    if (++write_errors_ <= 10) std::fprintf(stderr, "recorder: %s: %s\n", what, e.what());
+    if (write_errors_ == 10) std::fprintf(stderr, "recorder: further write errors not shown\n");
+  }
+}
+
+bool RunRecorder::on_run(const run_info_t &m) {
+  if (info_) return false;
+  writer_ = std::make_unique<H5mdWriter>(out_path_, "dynhet recorder", creator_version_);
+  info_ = std::make_unique<run_info_t>(m);
+  writer_->set_auto_flush(false); // one flush per message, in guarded()
+  completion_ = Completion(m.observables, m.cutoff_a);
+  write_run_info(m);
+  return true;
+}
+
+void RunRecorder::write_run_info(const run_info_t &m) {
+  guarded("parameters", [&] { writer_->write_parameters(m.scene_toml); });
+  guarded("particles", [&] { writer_->set_particles("all", m.box_length, m.species); });
+  guarded("run info", [&] {
+    const std::string p = "parameters/run_info";
+    writer_->set_attribute(p, "run_id", m.run_id);
+    writer_->set_attribute(p, "n_particles", m.n_particles);
+    writer_->set_attribute(p, "box_length", m.box_length);
+    writer_->set_attribute(p, "packing_fraction", m.packing_fraction);
+    writer_->set_attribute(p, "restitution", m.restitution);
+    writer_->set_attribute(p, "radius", std::vector<double>(m.radius, m.radius + 2));
+    writer_->set_attribute(p, "mass", std::vector<double>(m.mass, m.mass + 2));
+    writer_->set_attribute(p, "observables", join(m.observables, ","));
+    writer_->set_attribute(p, "overlap_subbox_particles", m.overlap_subbox_particles);
+    writer_->set_attribute(p, "keep_frames", int32_t{m.keep_frames});
+    writer_->set_attribute(p, "chunk_particles", m.chunk_particles);
+  });
+  guarded("schedule", [&] {
+    writer_->write_fixed("schedule/frame_time", m.frame_time);
+    writer_->write_fixed("schedule/origin_frame", m.origin_frame);
+    writer_->write_fixed("schedule/lag_time", m.lag_time);
+    writer_->write_fixed("schedule/pair_frame", m.pair_frame);
+    writer_->write_fixed("schedule/cutoff_a", m.cutoff_a);
+    writer_->set_attribute("observables/schedule", "n_origins", m.n_origins);
+    writer_->set_attribute("observables/schedule", "n_lags", m.n_lags);
+  });
+}
+
+bool RunRecorder::on_sim_status(const sim_status_t &m) {
+  if (!info_ || m.run_id != info_->run_id) return false;
+  if (sim_.take(m, m.phase)) guarded("sim status", [&] { write_sim(m); });
+  if (ended(m.phase) && !completion_.sim_ended()) sim_ended(m);
+  completion_.sim_phase(m.phase, m.message);
+  return true;
+}
+
+// EDMD has no time step; its events (collisions and kicks) stand in.
+void RunRecorder::write_sim(const sim_status_t &m) {
+  const int64_t step = m.n_collisions + m.n_kicks;
+  const double t = m.sim_time;
+  writer_->append_observable("sim/kinetic_energy", step, t, &m.kinetic_energy, 1);
+  writer_->append_observable("sim/n_collisions", step, t, &m.n_collisions, 1);
+  writer_->append_observable("sim/n_kicks", step, t, &m.n_kicks, 1);
+  writer_->append_observable("sim/packing_fraction", step, t, &m.packing_fraction, 1);
+  writer_->append_observable("sim/collisions_per_second", step, t, &m.collisions_per_second, 1);
+  writer_->append_observable("sim/frames_published", step, t, &m.frames_published, 1);
+}
+
+// All chunks the sim sent before saying it ended have been handled by
+// now, so frames still incomplete are lost.
+void RunRecorder::sim_ended(const sim_status_t &m) {
+  if (!info_->keep_frames) return;
+  const int expected = m.frames_published > 0 ? m.frames_published : info_->n_frames;
+  assembler_.finish(expected);
+  completion_.frames(assembler_.frames_lost(), expected);
+}
+
+bool RunRecorder::on_node_status(const node_status_t &m) {
+  if (!info_ || m.run_id != info_->run_id) return false;
+  Node &n = nodes_[node_key(m.node)];
+  const bool progress = n.latest.utime == 0 || m.state != n.latest.state ||
+                        m.frames_whole != n.latest.frames_whole || m.pairs_done != n.latest.pairs_done;
+  n.latest = m;
+  completion_.node_state(m.node, m.state);
+  if (n.thin.take(m, m.state)) guarded("node status", [&] { write_node(m); });
+  return progress;
+}
+
+// Node status has no simulation time of its own: time is wall-clock
+// seconds since the first node status of the run (node clocks are the
+// host's; the run info's own stamp is old in a replay), step the frames
+// the node has handled.
+void RunRecorder::write_node(const node_status_t &m) {
+  const std::string base = "nodes/" + node_key(m.node) + "/";
+  const int64_t step = int64_t{m.frames_whole} + m.frames_lost;
+  if (!node_clock_zero_) node_clock_zero_ = m.utime;
+  const double t = 1e-6 * static_cast<double>(m.utime - *node_clock_zero_);
+  writer_->append_observable(base + "frames_whole", step, t, &m.frames_whole, 1);
+  writer_->append_observable(base + "frames_lost", step, t, &m.frames_lost, 1);
+  writer_->append_observable(base + "chunks_received", step, t, &m.chunks_received, 1);
+  writer_->append_observable(base + "pairs_done", step, t, &m.pairs_done, 1);
+}
+
+bool RunRecorder::on_overlap(const overlap_t &m) {
+  if (!info_ || m.run_id != info_->run_id) return false;
+  guarded("overlap", [&] { write_overlap(m); });
+  if (m.is_final) completion_.final_overlap(m.cutoff_a);
+  return true;
+}
+
+void RunRecorder::write_overlap(const overlap_t &m) {
+  const std::string label = cutoff_label(m.cutoff_a);
+  const std::string base = "overlap/" + label + "/";
+  if (!overlap_started_[label]) {
+    writer_->write_fixed(base + "lag_time", m.lag_time);
+    writer_->set_attribute("observables/" + base, "cutoff_a", m.cutoff_a);
+    writer_->set_attribute("observables/" + base, "subbox_per_side", m.subbox_per_side);
+    writer_->set_attribute("observables/" + base, "subbox_particles", m.subbox_particles);
+    overlap_started_[label] = true;
+  }
+  if (m.n_lags <= 0) return;
+  const int64_t step = m.frame_index;
+  const double t = m.sim_time;
+  writer_->append_observable(base + "q", step, t, m.q);
+  writer_->append_observable(base + "q_err", step, t, m.q_err);
+  writer_->append_observable(base + "n_origins", step, t, m.n_origins);
+  writer_->append_observable(base + "qr_var", step, t, m.qr_var);
+  writer_->append_observable(base + "tau_alpha", step, t, &m.tau_alpha, 1);
+  writer_->append_observable(base + "tau_alpha_err", step, t, &m.tau_alpha_err, 1);
+}
+
+bool RunRecorder::on_frame_chunk(const frame_chunk_t &m) {
+  if (!info_ || !info_->keep_frames || m.run_id != info_->run_id) return false;
+  if (m.n_values != 2 * m.count || static_cast<int>(m.position.size()) != m.n_values) return false;
+  const ChunkHeader h{m.frame_index, m.time,           m.n_particles, m.chunk_index,
+                      m.chunk_count, m.first_particle, m.count};
+  std::optional<Frame> f = assembler_.add(h, m.position.data());
+  if (f) guarded("frame", [&] { writer_->append_frame(f->index, f->time, f->position); });
+  return true;
+}
+
+std::vector<std::string> RunRecorder::finish(const std::string &reason) {
+  std::vector<std::string> missing;
+  if (!reason.empty()) missing.push_back(reason);
+  if (!info_) return missing;
+  // The last word of each status stream.
+  if (sim_.held) guarded("sim status", [&] { write_sim(*sim_.held); });
+  for (auto &[key, n] : nodes_)
+    if (n.thin.held) guarded("node status", [&] { write_node(*n.thin.held); });
+
+  for (const std::string &m : completion_.missing()) missing.push_back(m);
+  if (write_errors_ > 0) missing.push_back(std::to_string(write_errors_) + " failed writes");
+  write_summary(missing);
+  writer_->close();
+  return missing;
+}
+
+void RunRecorder::write_summary(const std::vector<std::string> &missing) {
+  guarded("summary", [&] {
+    writer_->set_attribute("", "complete", int32_t{missing.empty()});
+    writer_->set_attribute("", "missing", join(missing, "; "));
+    writer_->set_attribute("", "run_id", info_->run_id);
+    writer_->set_attribute("", "sim_phase", completion_.phase());
+    if (info_->keep_frames) writer_->set_attribute("", "frames_lost_recorder", assembler_.frames_lost());
+    for (const auto &[key, n] : nodes_) {
+      const node_status_t &s = n.latest;
+      const std::string g = "observables/nodes/" + key;
+      writer_->set_attribute("", "frames_lost_" + key, s.frames_lost);
+      writer_->set_attribute(g, "state", s.state);
+      writer_->set_attribute(g, "message", s.message);
+      writer_->set_attribute(g, "frames_expected", s.frames_expected);
+      writer_->set_attribute(g, "frames_whole", s.frames_whole);
+      writer_->set_attribute(g, "frames_lost", s.frames_lost);
+      writer_->set_attribute(g, "chunks_received", s.chunks_received);
+    }
+  });
+}
+
+} // namespace dynhet

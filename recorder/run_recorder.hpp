@@ -1,0 +1,105 @@
+// Writes one run's messages into its H5MD file. The first run info fixes
+// the run (its run_id); messages of other runs are ignored. No bus here:
+// main() hands the messages over, which keeps this testable in-process.
+//
+// What goes where (paths under observables/ unless absolute):
+//   /parameters/scene_toml, /parameters/<table>   the scene (H5mdWriter)
+//   /parameters/run_info                          attrs: run id, N, L, phi, ...
+//   /particles/all/{box, species, position, image} (frames only if kept)
+//   schedule/{frame_time, origin_frame, lag_time, pair_frame, cutoff_a}
+//   sim/<field>            {step = collisions + kicks, time = sim time}
+//   nodes/<node>/<field>   {step = frames handled, time = wall s since the first node status}
+//   overlap/a<cutoff>/<field> {step = frame index, time = sim time}, lag_time
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "completion.hpp"
+#include "dynhet/chunking.hpp"
+#include "dynhet/frame_chunk_t.hpp"
+#include "dynhet/h5md.hpp"
+#include "dynhet/node_status_t.hpp"
+#include "dynhet/overlap_t.hpp"
+#include "dynhet/run_info_t.hpp"
+#include "dynhet/sim_status_t.hpp"
+
+namespace dynhet {
+
+// Thins a status stream to about one record a second by the publisher's
+// clock, always keeping a change of phase or state, and holds the latest
+// unwritten message back so that the stream's last word can be written.
+template <class Msg> struct Thinned {
+  std::optional<int64_t> last_utime;
+  std::string last_state;
+  std::optional<Msg> held;
+
+  // True: write `m` now. False: it is held.
+  bool take(const Msg &m, const std::string &state) {
+    if (!last_utime || state != last_state || m.utime - *last_utime >= 1000000) {
+      last_utime = m.utime;
+      last_state = state;
+      held.reset();
+      return true;
+    }
+    held = m;
+    return false;
+  }
+};
+
+class RunRecorder {
+public:
+  RunRecorder(std::string out_path, std::string creator_version);
+
+  // Each returns true when the message belongs to the run and was taken;
+  // a node status only when the node made progress, so that the caller
+  // can tell a working pipeline from a stalled one. on_run creates the
+  // file on the first run info and throws if it cannot.
+  bool on_run(const run_info_t &m);
+  bool on_sim_status(const sim_status_t &m);
+  bool on_node_status(const node_status_t &m);
+  bool on_overlap(const overlap_t &m);
+  bool on_frame_chunk(const frame_chunk_t &m);
+
+  bool has_run() const { return info_ != nullptr; }
+  int64_t run_id() const { return info_ ? info_->run_id : 0; }
+  bool keep_frames() const { return info_ && info_->keep_frames; }
+  const Completion &completion() const { return completion_; }
+  int frames_whole() const { return assembler_.frames_whole(); }
+
+  // Writes the held statuses and the summary attributes (complete,
+  // missing, frames lost per node), closes the file, and returns what is
+  // missing, with `reason` (e.g. "interrupted") first when given.
+  std::vector<std::string> finish(const std::string &reason = "");
+
+private:
+  struct Node {
+    Thinned<node_status_t> thin;
+    node_status_t latest;
+  };
+
+  std::string out_path_, creator_version_;
+  std::unique_ptr<run_info_t> info_;
+  std::unique_ptr<H5mdWriter> writer_;
+  Completion completion_;
+  FrameAssembler assembler_{1};
+  Thinned<sim_status_t> sim_;
+  std::map<std::string, Node> nodes_;
+  std::map<std::string, bool> overlap_started_; // by cutoff label
+  std::optional<int64_t> node_clock_zero_;      // utime of the first node status
+  int write_errors_ = 0;
+
+  void write_run_info(const run_info_t &m);
+  void write_sim(const sim_status_t &m);
+  void write_node(const node_status_t &m);
+  void write_overlap(const overlap_t &m);
+  void write_summary(const std::vector<std::string> &missing);
+  void sim_ended(const sim_status_t &m);
+  template <class F> void guarded(const char *what, F &&write);
+};
+
+} // namespace dynhet

@@ -1,0 +1,232 @@
+// RunRecorder fed with synthetic messages (no bus): what it writes, when a
+// run counts as settled, and that anything missing is named in the file.
+#include <gtest/gtest.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "h5_read.hpp"
+#include "run_recorder.hpp"
+
+namespace {
+
+using h5read::Attr;
+using Shape = std::vector<hsize_t>;
+constexpr int64_t kRun = 42;
+
+std::string temp_file(const std::string &name) {
+  return ::testing::TempDir() + "dynhet_rec_" + std::to_string(getpid()) + "_" + name + ".h5";
+}
+
+// Four particles in a box of 10, three frames, one origin and two lags,
+// two cutoffs, frames kept in chunks of two particles.
+dynhet::run_info_t run_info() {
+  dynhet::run_info_t m{};
+  m.utime = 1'000'000;
+  m.run_id = kRun;
+  m.n_particles = 4;
+  m.box_length = 10;
+  m.packing_fraction = 0.5;
+  m.restitution = 0.9;
+  m.radius[0] = 1, m.radius[1] = 1.43;
+  m.mass[0] = 1, m.mass[1] = 1.43 * 1.43;
+  m.species = {0, 1, 0, 1};
+  m.frame_time = {100, 100.5, 101};
+  m.n_frames = 3;
+  m.origin_frame = {0};
+  m.n_origins = 1;
+  m.lag_time = {0.5, 1};
+  m.n_lags = 2;
+  m.pair_frame = {1, 2};
+  m.n_pairs = 2;
+  m.cutoff_a = {0.6, 1.8};
+  m.n_cutoffs = 2;
+  m.observables = {"overlap"};
+  m.n_observables = 1;
+  m.overlap_subbox_particles = 4;
+  m.keep_frames = true;
+  m.chunk_particles = 2;
+  m.scene_toml = "[system]\nn_particles = 4\n";
+  return m;
+}
+
+dynhet::sim_status_t sim(double wall_s, const std::string &phase, double t) {
+  dynhet::sim_status_t m{};
+  m.utime = static_cast<int64_t>(wall_s * 1e6);
+  m.run_id = kRun;
+  m.phase = phase;
+  m.sim_time = t;
+  m.n_collisions = static_cast<int64_t>(1000 * t);
+  m.kinetic_energy = 1.0;
+  m.frames_published = 3;
+  return m;
+}
+
+dynhet::node_status_t node(double wall_s, const std::string &state, int whole) {
+  dynhet::node_status_t m{};
+  m.utime = static_cast<int64_t>(wall_s * 1e6);
+  m.run_id = kRun;
+  m.node = "overlap";
+  m.state = state;
+  m.frames_expected = 3;
+  m.frames_whole = whole;
+  return m;
+}
+
+dynhet::overlap_t overlap(double a, bool final, int frame) {
+  dynhet::overlap_t m{};
+  m.run_id = kRun;
+  m.sim_time = 100 + 0.5 * frame;
+  m.frame_index = frame;
+  m.is_final = final;
+  m.cutoff_a = a;
+  m.subbox_per_side = 1;
+  m.subbox_particles = 4;
+  m.n_lags = 2;
+  m.lag_time = {0.5, 1};
+  m.q = {0.9, frame > 1 ? 0.5 : NAN};
+  m.q_err = {NAN, NAN};
+  m.n_origins = {1, frame > 1 ? 1 : 0};
+  m.qr_var = {0, 0};
+  m.tau_alpha = NAN;
+  m.tau_alpha_err = NAN;
+  return m;
+}
+
+// Frame f as two chunks (particles 0-1 and 2-3), positions f + particle.
+void send_frame(dynhet::RunRecorder &rec, int f, bool drop_second_chunk = false) {
+  for (int c = 0; c < (drop_second_chunk ? 1 : 2); ++c) {
+    dynhet::frame_chunk_t m{};
+    m.run_id = kRun;
+    m.frame_index = f;
+    m.time = 100 + 0.5 * f;
+    m.n_particles = 4;
+    m.chunk_index = c;
+    m.chunk_count = 2;
+    m.first_particle = 2 * c;
+    m.count = 2;
+    m.n_values = 4;
+    for (int i = 0; i < 4; ++i) m.position.push_back(f + 2 * c + 0.25 * i);
+    EXPECT_TRUE(rec.on_frame_chunk(m));
+  }
+}
+
+// The run up to the sim saying done: statuses, frames, running results.
+void run_until_done(dynhet::RunRecorder &rec, bool lose_a_frame = false) {
+  ASSERT_TRUE(rec.on_run(run_info()));
+  EXPECT_FALSE(rec.on_run(run_info())); // the repeats change nothing
+  EXPECT_TRUE(rec.on_sim_status(sim(1.0, "production", 100)));
+  EXPECT_TRUE(rec.on_node_status(node(1.1, "running", 0)));
+  for (int f = 0; f < 3; ++f) {
+    send_frame(rec, f, lose_a_frame && f == 1);
+    for (double a : {0.6, 1.8}) EXPECT_TRUE(rec.on_overlap(overlap(a, false, f)));
+  }
+  EXPECT_TRUE(rec.on_sim_status(sim(1.2, "production", 100.5))); // held: < 1 s after the last
+  EXPECT_TRUE(rec.on_sim_status(sim(2.5, "production", 101)));
+  EXPECT_TRUE(rec.on_sim_status(sim(2.6, "done", 101)));
+  EXPECT_TRUE(rec.completion().sim_ended());
+}
+
+TEST(RunRecorder, IgnoresOtherRuns) {
+  const std::string path = temp_file("other");
+  dynhet::RunRecorder rec(path, "test");
+  auto o = overlap(0.6, true, 2);
+  EXPECT_FALSE(rec.on_overlap(o)); // no run yet
+  ASSERT_TRUE(rec.on_run(run_info()));
+  o.run_id = 7;
+  EXPECT_FALSE(rec.on_overlap(o));
+  auto s = sim(1, "done", 1);
+  s.run_id = 7;
+  EXPECT_FALSE(rec.on_sim_status(s));
+  EXPECT_FALSE(rec.completion().sim_ended());
+  rec.finish("test over");
+  std::remove(path.c_str());
+}
+
+TEST(RunRecorder, CompleteRunIsWrittenAndMarkedComplete) {
+  const std::string path = temp_file("complete");
+  dynhet::RunRecorder rec(path, "test");
+  run_until_done(rec);
+  EXPECT_FALSE(rec.completion().settled()); // no final results yet
+  for (double a : {0.6, 1.8}) rec.on_overlap(overlap(a, true, 2));
+  EXPECT_FALSE(rec.completion().settled()); // the node has not said done
+  EXPECT_TRUE(rec.on_node_status(node(2.7, "done", 3)));
+  EXPECT_TRUE(rec.completion().settled());
+  EXPECT_TRUE(rec.finish().empty());
+
+  h5read::File f(path);
+  EXPECT_EQ(Attr(f, "/", "complete").values<int32_t>(), std::vector<int32_t>{1});
+  EXPECT_EQ(Attr(f, "/", "missing").strings().at(0), "");
+  EXPECT_EQ(Attr(f, "/", "run_id").values<int64_t>(), std::vector<int64_t>{kRun});
+  EXPECT_EQ(Attr(f, "/", "frames_lost_overlap").values<int32_t>(), std::vector<int32_t>{0});
+  EXPECT_EQ(Attr(f, "/observables/nodes/overlap", "state").strings().at(0), "done");
+
+  // One record a second plus every change of phase: 100, 101 (2.5 s), done.
+  EXPECT_EQ(h5read::read<double>(f, "/observables/sim/kinetic_energy/time"),
+            (std::vector<double>{100, 101, 101}));
+  EXPECT_EQ(h5read::read<int64_t>(f, "/observables/sim/n_collisions/value"),
+            (std::vector<int64_t>{100000, 101000, 101000}));
+  // Node: running at 1.1 s and done at 2.7 s, in seconds since its first status.
+  const auto t = h5read::read<double>(f, "/observables/nodes/overlap/frames_whole/time");
+  ASSERT_EQ(t.size(), 2u);
+  EXPECT_EQ(t[0], 0.0);
+  EXPECT_NEAR(t[1], 1.6, 1e-12);
+
+  const std::string q = "/observables/overlap/a1.8/q";
+  EXPECT_EQ(h5read::shape(f, q + "/value"), (Shape{4, 2})); // 3 running + the final
+  EXPECT_EQ(h5read::read<int64_t>(f, q + "/step"), (std::vector<int64_t>{0, 1, 2, 2}));
+  EXPECT_EQ(h5read::shape(f, "/observables/overlap/a0.6/tau_alpha/value"), Shape{4});
+  EXPECT_EQ(h5read::read<double>(f, "/observables/overlap/a0.6/lag_time"), (std::vector<double>{0.5, 1}));
+  EXPECT_EQ(Attr(f, "/observables/overlap/a0.6", "subbox_per_side").values<int32_t>(),
+            std::vector<int32_t>{1});
+  EXPECT_EQ(h5read::read<double>(f, "/observables/schedule/frame_time"),
+            (std::vector<double>{100, 100.5, 101}));
+
+  EXPECT_EQ(h5read::shape(f, "/particles/all/position/value"), (Shape{3, 4, 2}));
+  const auto pos = h5read::read<double>(f, "/particles/all/position/value");
+  EXPECT_EQ(pos[8 + 5], 3.25); // frame 1, particle 2, y: 1 + 2 + 0.25
+  EXPECT_EQ(h5read::read<int32_t>(f, "/particles/all/species"), (std::vector<int32_t>{0, 1, 0, 1}));
+  EXPECT_EQ(h5read::read_string(f, "/parameters/scene_toml"), run_info().scene_toml);
+  std::remove(path.c_str());
+}
+
+TEST(RunRecorder, MissingResultsAreNamed) {
+  const std::string path = temp_file("missing");
+  dynhet::RunRecorder rec(path, "test");
+  run_until_done(rec, /*lose_a_frame=*/true);
+  rec.on_overlap(overlap(0.6, true, 2));
+  rec.on_node_status(node(2.7, "done", 3));
+  EXPECT_FALSE(rec.completion().settled()); // a1.8 has no final result
+  const auto missing = rec.finish("timeout");
+  const std::vector<std::string> expect = {"timeout", "overlap a1.8: no final result",
+                                           "frames: 1 of 3 lost by the recorder"};
+  EXPECT_EQ(missing, expect);
+
+  h5read::File f(path);
+  EXPECT_EQ(Attr(f, "/", "complete").values<int32_t>(), std::vector<int32_t>{0});
+  EXPECT_EQ(Attr(f, "/", "missing").strings().at(0),
+            "timeout; overlap a1.8: no final result; frames: 1 of 3 lost by the recorder");
+  EXPECT_EQ(Attr(f, "/", "frames_lost_recorder").values<int32_t>(), std::vector<int32_t>{1});
+  EXPECT_EQ(h5read::shape(f, "/particles/all/position/value"), (Shape{2, 4, 2}));
+  std::remove(path.c_str());
+}
+
+TEST(RunRecorder, FailedSimSettlesButIsIncomplete) {
+  const std::string path = temp_file("failed");
+  dynhet::RunRecorder rec(path, "test");
+  ASSERT_TRUE(rec.on_run(run_info()));
+  auto s = sim(1.0, "failed", 100);
+  s.message = "boom";
+  rec.on_sim_status(s);
+  for (double a : {0.6, 1.8}) rec.on_overlap(overlap(a, true, 0));
+  rec.on_node_status(node(1.5, "failed", 0));
+  EXPECT_TRUE(rec.completion().settled());
+  const auto missing = rec.finish();
+  ASSERT_FALSE(missing.empty());
+  EXPECT_EQ(missing[0], "sim: failed (boom)");
+  EXPECT_EQ(missing[1], "overlap node: failed");
+  std::remove(path.c_str());
+}
+
+} // namespace
