@@ -148,8 +148,9 @@ void Engine::collide(int i, int j) {
   double sx, sy;
   image_shift(i, j, sx, sy);
   Particle &a = part_[i], &b = part_[j];
-  collide_pair(a.x - (b.x + sx), a.y - (b.y + sy), mass_[species_[i]], mass_[species_[j]], eps_,
-               a.vx, a.vy, b.vx, b.vy, growth(i, j));
+  const double impulse = collide_pair(a.x - (b.x + sx), a.y - (b.y + sy), mass_[species_[i]],
+                                      mass_[species_[j]], eps_, a.vx, a.vy, b.vx, b.vy, growth(i, j));
+  count_.virial += sigma(i, j) * impulse;
   ++coll_count_[i];
   ++coll_count_[j];
   ++count_.collisions;

@@ -34,7 +34,17 @@ struct Counters {
   int64_t kicks = 0;
   int64_t cell_crossings = 0;
   int64_t stale = 0; // events found outdated and predicted again
+  // Collision virial sum over collisions of sigma_ij * J_ij, J the normal
+  // momentum transfer: P A = N T + virial / (2 dt) in 2D.
+  double virial = 0;
 };
+
+// Reduced pressure Z = P A / (N T) = 1 + virial / (2 N T dt) from the
+// collision virial accumulated over a time dt at temperature T (2D: T is the
+// kinetic energy per particle).
+inline double reduced_pressure(double virial, double dt, long n, double temperature) {
+  return 1.0 + virial / (2.0 * n * temperature * dt);
+}
 
 class Engine {
 public:
