@@ -185,6 +185,7 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
          if (!(v >= 1 && v <= 10)) return c.bad_value(key, n, "allowed: 1 <= r2/r1 <= 10");
          s.radius_ratio = v;
        }},
+      {"tc_time", non_negative(s.tc_time)},
       {"seed",
        [&](const std::string& key, const toml::node& n) {
          int64_t v;

@@ -95,6 +95,11 @@ void RunRecorder::write_sim(const sim_status_t &m) {
   writer_->append_observable("sim/packing_fraction", step, t, &m.packing_fraction, 1);
   writer_->append_observable("sim/collisions_per_second", step, t, &m.collisions_per_second, 1);
   writer_->append_observable("sim/frames_published", step, t, &m.frames_published, 1);
+  writer_->append_observable("sim/reduced_pressure", step, t, &m.reduced_pressure, 1);
+  writer_->append_observable("sim/reduced_pressure_err", step, t, &m.reduced_pressure_err, 1);
+  writer_->append_observable("sim/collision_frequency", step, t, &m.collision_frequency, 1);
+  writer_->append_observable("sim/collision_frequency_err", step, t, &m.collision_frequency_err, 1);
+  writer_->append_observable("sim/n_tc", step, t, &m.n_tc, 1);
 }
 
 // All chunks the sim sent before saying it ended have been handled by

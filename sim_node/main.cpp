@@ -23,6 +23,7 @@
 #include "dynhet/scene.hpp"
 #include "dynhet/schedule.hpp"
 #include "dynhet/sim_status_t.hpp"
+#include "dynhet/stats.hpp"
 
 namespace {
 
@@ -97,23 +98,41 @@ public:
     msg_.n_kicks = c.kicks;
     const double dsim = e.time() - last_sim_;
     msg_.collisions_per_second = dt > 0 && c.collisions >= last_coll_ ? (c.collisions - last_coll_) / dt : 0;
-    msg_.kinetic_energy = e.kinetic_energy_per_particle();
+    const double ke = e.kinetic_energy_per_particle();
+    if (dsim > 0 && msg_.phase != "compress") {
+      // This interval is one block of the pressure and collision frequency.
+      const long n = e.size();
+      pressure_.add(dynhet::engine::reduced_pressure(c.virial - last_virial_, dsim, n, 0.5 * (ke + msg_.kinetic_energy)));
+      frequency_.add(2.0 * (c.collisions - last_coll_) / (double(n) * dsim));
+    }
+    msg_.reduced_pressure = pressure_.mean();
+    msg_.reduced_pressure_err = pressure_.standard_error();
+    msg_.collision_frequency = frequency_.mean();
+    msg_.collision_frequency_err = frequency_.standard_error();
+    msg_.n_tc = c.tc;
+    msg_.kinetic_energy = ke;
     if (dsim > 0 && remaining_sim_time >= 0) msg_.eta_seconds = remaining_sim_time / (dsim / dt);
     lcm_.publish(dynhet::kChanSimStatus, &msg_);
     print();
     last_ = Clock::now();
     last_sim_ = e.time();
     last_coll_ = c.collisions;
+    last_virial_ = c.virial;
   }
+  // A new phase: rates and block averages start afresh.
   void reset_rates(const dynhet::engine::Engine& e) {
     last_sim_ = e.time();
     last_coll_ = e.counters().collisions;
+    last_virial_ = e.counters().virial;
+    msg_.kinetic_energy = e.kinetic_energy_per_particle();
     msg_.eta_seconds = -1;
+    pressure_.reset();
+    frequency_.reset();
   }
   void print() {
-    std::fprintf(stderr, "%s[%-11s] t=%-10.4g/%-10.4g phi=%.4f  coll/s=%.3g  KE=%.4f  frames %d/%d  ETA %s%s",
+    std::fprintf(stderr, "%s[%-11s] t=%-10.4g/%-10.4g phi=%.4f  coll/s=%.3g  T=%.4f  Z=%.4g  frames %d/%d  ETA %s%s",
                  tty_ ? "\r" : "", msg_.phase.c_str(), msg_.sim_time, msg_.phase_end_time,
-                 msg_.packing_fraction, msg_.collisions_per_second, msg_.kinetic_energy,
+                 msg_.packing_fraction, msg_.collisions_per_second, msg_.kinetic_energy, msg_.reduced_pressure,
                  msg_.frames_published, msg_.frames_total, hms(msg_.eta_seconds).c_str(),
                  tty_ ? "   " : "\n");
     std::fflush(stderr);
@@ -126,6 +145,8 @@ private:
   Clock::time_point last_ = Clock::now();
   double last_sim_ = 0;
   int64_t last_coll_ = 0;
+  double last_virial_ = 0;
+  dynhet::BlockAverage pressure_, frequency_;
 };
 
 } // namespace
@@ -185,6 +206,7 @@ int main(int argc, char** argv) {
     p.radius_ratio = scene.radius_ratio;
     p.seed = scene.seed;
     p.driving = scene.driving;
+    p.tc = scene.tc_time;
     const double gc = scene.contact_value > 0 ? scene.contact_value
                                               : dynhet::henderson_contact_value(scene.packing_fraction);
     p.kick_rate = scene.kick_rate > 0 ? scene.kick_rate : dynhet::enskog_frequency(scene.packing_fraction, gc);
@@ -234,6 +256,7 @@ int main(int argc, char** argv) {
 
     rep.msg().phase = "production";
     rep.msg().phase_end_time = t_end;
+    rep.reset_rates(eng);
     const auto ranges = dynhet::chunk_ranges(static_cast<int>(eng.size()), scene.chunk_particles);
     std::vector<double> xy;
     dynhet::frame_chunk_t chunk{};
@@ -272,10 +295,14 @@ int main(int argc, char** argv) {
     eng.momentum(px, py);
     std::fprintf(stderr,
                  "\nsim_node: done in %.1f s: %lld collisions, %lld kicks, %d frames, KE/N=%.4f, "
-                 "total momentum (%.2g, %.2g), max overlap %.2g\n",
+                 "total momentum (%.2g, %.2g), max overlap %.2g\n"
+                 "sim_node: production: Z = %.5g +- %.2g, collisions per particle per unit time %.5g +- %.2g, "
+                 "TC model acted %lld times\n",
                  seconds_since(t_wall), static_cast<long long>(eng.counters().collisions),
                  static_cast<long long>(eng.counters().kicks), info.n_frames,
-                 eng.kinetic_energy_per_particle(), px, py, std::max(0.0, eng.max_overlap()));
+                 eng.kinetic_energy_per_particle(), px, py, std::max(0.0, eng.max_overlap()),
+                 rep.msg().reduced_pressure, rep.msg().reduced_pressure_err, rep.msg().collision_frequency,
+                 rep.msg().collision_frequency_err, static_cast<long long>(eng.counters().tc));
   } catch (const std::exception& e) {
     fail(e.what());
     return g_signal ? 128 + g_signal : 1;

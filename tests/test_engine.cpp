@@ -193,3 +193,24 @@ TEST(Theory, CollisionFrequencyFollowsEnskog) {
     EXPECT_LT(m.omega_err, 0.005 * w);
   }
 }
+
+TEST(Engine, TcModelMakesCollisionsWithinTcElastic) {
+  // tc longer than the run: after each particle's first collision, every
+  // collision is elastic, so the energy lost is at most what the first
+  // collisions of all particles can take; with tc = 0 it decays much more.
+  Params p = params(500, 0.6, 0.5, false);
+  p.tc = 1e9;
+  Engine e(p);
+  e.prepare();
+  e.run_until(20.0);
+  const auto& c = e.counters();
+  EXPECT_GT(c.tc, c.collisions - e.size()); // all but at most one per particle
+  EXPECT_GT(e.kinetic_energy_per_particle(), 0.3);
+
+  Params q = params(500, 0.6, 0.5, false);
+  Engine f(q);
+  f.prepare();
+  f.run_until(20.0);
+  EXPECT_EQ(f.counters().tc, 0);
+  EXPECT_LT(f.kinetic_energy_per_particle(), 0.05); // homogeneous cooling, Haff's law
+}

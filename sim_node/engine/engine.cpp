@@ -32,6 +32,7 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
   image_x_.assign(n_, 0);
   image_y_.assign(n_, 0);
   coll_count_.assign(n_, 0);
+  last_collision_.assign(n_, -kNever);
   event_.assign(n_, Event{-1, kCross, 0});
   kick_leaf_ = static_cast<int>(n_);
   cal_.reset(static_cast<int>(n_) + 1, kNever);
@@ -148,8 +149,15 @@ void Engine::collide(int i, int j) {
   double sx, sy;
   image_shift(i, j, sx, sy);
   Particle &a = part_[i], &b = part_[j];
+  double eps = eps_;
+  if (p_.tc > 0 && eps < 1.0 &&
+      (now_ - last_collision_[i] < p_.tc || now_ - last_collision_[j] < p_.tc)) {
+    eps = 1.0; // TC model: too soon after the previous collision
+    ++count_.tc;
+  }
+  last_collision_[i] = last_collision_[j] = now_;
   const double impulse = collide_pair(a.x - (b.x + sx), a.y - (b.y + sy), mass_[species_[i]],
-                                      mass_[species_[j]], eps_, a.vx, a.vy, b.vx, b.vy, growth(i, j));
+                                      mass_[species_[j]], eps, a.vx, a.vy, b.vx, b.vy, growth(i, j));
   count_.virial += sigma(i, j) * impulse;
   ++coll_count_[i];
   ++coll_count_[j];
@@ -213,6 +221,7 @@ void Engine::rebase() {
   for (long i = 0; i < n_; ++i) {
     sync(static_cast<int>(i));
     part_[i].t = 0;
+    last_collision_[i] -= now_;
   }
   cal_.shift(now_);
   scale0_ += grow_ * now_;
@@ -350,6 +359,7 @@ void Engine::prepare(const std::function<void(double)>& progress) {
 
   // The run proper starts at t = 0 with kinetic energy 1 per particle.
   now_ = offset_ = 0;
+  last_collision_.assign(n_, -kNever);
   events_since_rebase_ = 0;
   count_ = Counters{};
   eps_ = p_.restitution;

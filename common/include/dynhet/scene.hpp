@@ -33,6 +33,7 @@ struct Scene {
   double restitution = 0.9;
   double radius_ratio = 1.43; // r2 / r1; 1 is monodisperse
   uint64_t seed = 1;
+  double tc_time = 0.0; // TC model: collisions within tc of a particle's previous one are elastic; 0 off
 
   // [driving]
   bool driving = true;

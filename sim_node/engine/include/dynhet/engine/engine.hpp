@@ -27,6 +27,9 @@ struct Params {
   uint64_t seed = 1;
   bool driving = false;
   double kick_rate = 0.0; // kicks per particle per unit time (a pair kick counts for both)
+  // TC model against inelastic collapse: a collision within tc of either
+  // particle's previous collision is elastic. 0: off.
+  double tc = 0.0;
 };
 
 struct Counters {
@@ -34,6 +37,7 @@ struct Counters {
   int64_t kicks = 0;
   int64_t cell_crossings = 0;
   int64_t stale = 0; // events found outdated and predicted again
+  int64_t tc = 0;    // collisions made elastic by the TC model
   // Collision virial sum over collisions of sigma_ij * J_ij, J the normal
   // momentum transfer: P A = N T + virial / (2 dt) in 2D.
   double virial = 0;
@@ -131,6 +135,7 @@ private:
   std::vector<uint8_t> species_;
   std::vector<int32_t> image_x_, image_y_;
   std::vector<uint64_t> coll_count_;
+  std::vector<double> last_collision_; // internal time of each particle's last collision (TC model)
   std::vector<Event> event_;
 
   int nc_ = 0;   // cells per side
