@@ -137,9 +137,9 @@ void Engine::predict(int i) {
   cal_.set(i, now_ + best);
 }
 
+// Every particle's event predicted again (the next kick stays).
 void Engine::clear_events() {
   for (long i = 0; i < n_; ++i) cal_.set(static_cast<int>(i), kNever);
-  cal_.set(kick_leaf_, driving_ ? now_ + rng_.exponential(kick_pair_rate_) : kNever);
   for (long i = 0; i < n_; ++i) predict(static_cast<int>(i));
 }
 
@@ -223,7 +223,7 @@ void Engine::rebase() {
     part_[i].t = 0;
     last_collision_[i] -= now_;
   }
-  cal_.shift(now_);
+  cal_.shift(now_); // the kick leaf too
   scale0_ += grow_ * now_;
   offset_ += now_;
   now_ = 0;
@@ -362,10 +362,69 @@ void Engine::prepare(const std::function<void(double)>& progress) {
   last_collision_.assign(n_, -kNever);
   events_since_rebase_ = 0;
   count_ = Counters{};
+  thermalize(1.0);
+  start_run();
+  cal_.set(kick_leaf_, driving_ ? now_ + rng_.exponential(kick_pair_rate_) : kNever);
+  clear_events();
+}
+
+void Engine::start_run() {
   eps_ = p_.restitution;
   driving_ = p_.driving && p_.kick_rate > 0 && eps_ < 1.0;
   kick_pair_rate_ = 0.5 * p_.kick_rate * n_;
-  thermalize(1.0);
+}
+
+void Engine::synchronize() {
+  rebase();
+  build_cells();
+  clear_events();
+}
+
+State Engine::state() const {
+  State s;
+  s.time = time();
+  s.next_kick_time = offset_ + cal_.time(kick_leaf_);
+  s.x.resize(n_), s.y.resize(n_), s.vx.resize(n_), s.vy.resize(n_), s.last_collision.resize(n_);
+  for (long i = 0; i < n_; ++i) {
+    const double dt = now_ - part_[i].t; // 0 after synchronize()
+    s.x[i] = part_[i].x + part_[i].vx * dt;
+    s.y[i] = part_[i].y + part_[i].vy * dt;
+    s.vx[i] = part_[i].vx;
+    s.vy[i] = part_[i].vy;
+    s.last_collision[i] = offset_ + last_collision_[i];
+  }
+  s.image_x = image_x_;
+  s.image_y = image_y_;
+  s.collision_count = coll_count_;
+  for (int k = 0; k < 4; ++k) s.rng[k] = rng_.state()[k];
+  s.counters = count_;
+  return s;
+}
+
+void Engine::restore(const State& s) {
+  const size_t n = static_cast<size_t>(n_);
+  if (s.x.size() != n || s.y.size() != n || s.vx.size() != n || s.vy.size() != n ||
+      s.last_collision.size() != n || s.image_x.size() != n || s.image_y.size() != n ||
+      s.collision_count.size() != n)
+    throw std::invalid_argument("engine: checkpoint holds " + std::to_string(s.x.size()) +
+                                " particles, the scene " + std::to_string(n_));
+  scale0_ = 1.0;
+  grow_ = 0.0;
+  offset_ = s.time;
+  now_ = 0;
+  events_since_rebase_ = 0;
+  for (long i = 0; i < n_; ++i) {
+    part_[i] = Particle{s.x[i], s.y[i], s.vx[i], s.vy[i], 0.0};
+    last_collision_[i] = s.last_collision[i] - offset_;
+  }
+  image_x_ = s.image_x;
+  image_y_ = s.image_y;
+  coll_count_ = s.collision_count;
+  rng_.set_state(s.rng);
+  count_ = s.counters;
+  start_run();
+  cal_.set(kick_leaf_, s.next_kick_time - offset_);
+  build_cells();
   clear_events();
 }
 

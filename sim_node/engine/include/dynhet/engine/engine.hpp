@@ -50,6 +50,18 @@ inline double reduced_pressure(double virial, double dt, long n, double temperat
   return 1.0 + virial / (2.0 * n * temperature * dt);
 }
 
+// Everything needed to continue a run exactly: written to checkpoints.
+// Taken right after synchronize(), when every particle is at time().
+struct State {
+  double time = 0;
+  double next_kick_time = 0; // absolute; infinite if not driven
+  std::vector<double> x, y, vx, vy, last_collision; // positions in the box; last_collision absolute
+  std::vector<int32_t> image_x, image_y;
+  std::vector<uint64_t> collision_count;
+  uint64_t rng[4] = {0, 0, 0, 0};
+  Counters counters;
+};
+
 class Engine {
 public:
   explicit Engine(const Params& p);
@@ -66,6 +78,17 @@ public:
   // Maxwell-Boltzmann velocities, zero total momentum, kinetic energy per
   // particle exactly `energy` (the paper's time unit: 1 at t = 0).
   void thermalize(double energy = 1.0);
+
+  // Brings every particle to the current time, rebuilds the cells and
+  // predicts every event afresh. A run that passes through the same
+  // synchronised times continues bit for bit like one restored from a
+  // state() taken there; sim_node synchronises at fixed times for that.
+  void synchronize();
+  State state() const; // call right after synchronize()
+  // Continues from a state (after prepare() was not called). Throws
+  // std::invalid_argument if it does not fit these parameters.
+  void restore(const State& s);
+  const Params& params() const { return p_; }
 
   // Processes every event up to time t (absolute), then the system is at t.
   // Stops early, at an event, after max_events; returns true if t was reached.
@@ -115,6 +138,7 @@ private:
   double growth(int i, int j) const { return grow_ * (radius_[species_[i]] + radius_[species_[j]]); }
   double scale() const { return scale0_ + grow_ * now_; }
   void rescale_velocities(double energy);
+  void start_run(); // restitution, driving on; the first kick drawn
   int cell_index(int cx, int cy) const { return cy * nc_ + cx; }
   void cell_insert(int i, int c);
   void cell_remove(int i);
