@@ -86,7 +86,7 @@ for n in $nodes; do start "$n" "$bin/$n"; done
 # The sim in the foreground (its progress line goes to the terminal and
 # sim_node.log).
 set +e
-"$bin/sim_node" "$scene" 2> >(tee "$out/sim_node.log" >&2)
+"$bin/sim_node" "$scene" --checkpoint "$out/checkpoint.h5" 2> >(tee "$out/sim_node.log" >&2)
 sim_rc=$?
 set -e
 [[ $sim_rc -eq 0 ]] || echo "run_scene: sim_node failed (exit $sim_rc)" >&2

@@ -1,6 +1,11 @@
 // sim_node: runs a scene's EDMD simulation and publishes, over LCM, the run
 // info, a status at least once a second, and the frames the scene's
-// observables need (in chunks). Usage: sim_node SCENE.toml [--lcm-url URL]
+// observables need (in chunks).
+// Usage: sim_node SCENE.toml [--lcm-url URL] [--checkpoint FILE.h5]
+//        sim_node --resume FILE.h5 [--checkpoint FILE.h5]
+// With --checkpoint, a checkpoint is written at every multiple of the
+// scene's run.checkpoint_interval and at the end; SIGINT/SIGTERM run on to
+// the next such time, write it and exit (status 128 + signal).
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -14,6 +19,7 @@
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
 
+#include "checkpoint.hpp"
 #include "dynhet/chunking.hpp"
 #include "dynhet/engine/engine.hpp"
 #include "dynhet/frame_chunk_t.hpp"
@@ -155,17 +161,32 @@ int main(int argc, char** argv) {
   CLI::App app{"dynhet sim_node: event-driven MD of a driven granular fluid, frames over LCM"};
   std::string scene_path, url;
   int64_t run_id = 0;
-  app.add_option("scene", scene_path, "scene file (TOML)")->required();
+  std::string checkpoint_path, resume_path;
+  app.add_option("scene", scene_path, "scene file (TOML)");
+  app.add_option("--checkpoint", checkpoint_path, "write checkpoints (HDF5) to this file");
+  app.add_option("--resume", resume_path, "continue the run saved in this checkpoint");
   app.add_option("--lcm-url", url, "LCM URL (default $LCM_DEFAULT_URL or " + std::string(dynhet::kDefaultLcmUrl) + ")");
   app.add_option("--run-id", run_id, "run id (default: random)");
   bool check = false;
   app.add_flag("--check", check, "validate the scene, print what it needs (nodes, frames) and exit");
   CLI11_PARSE(app, argc, argv);
 
+  if (scene_path.empty() == resume_path.empty()) {
+    std::fprintf(stderr, "sim_node: give either a scene file or --resume CHECKPOINT\n");
+    return 2;
+  }
   dynhet::Scene scene;
+  dynhet::Checkpoint resumed;
   try {
-    scene = dynhet::parse_scene_file(scene_path);
-  } catch (const dynhet::SceneError& e) {
+    if (!resume_path.empty()) {
+      resumed = dynhet::read_checkpoint(resume_path);
+      scene = dynhet::parse_scene_text(resumed.scene_toml, resume_path + " (its scene)");
+      run_id = resumed.run_id;
+      scene_path = resume_path;
+    } else {
+      scene = dynhet::parse_scene_file(scene_path);
+    }
+  } catch (const std::exception& e) {
     std::fprintf(stderr, "sim_node: %s\n", e.what());
     return 2;
   }
@@ -191,7 +212,7 @@ int main(int argc, char** argv) {
 
   Reporter rep(lcm, run_id, isatty(STDERR_FILENO));
   auto fail = [&](const std::string& why) {
-    rep.msg().phase = "failed";
+    if (rep.msg().phase != "interrupted") rep.msg().phase = "failed";
     rep.msg().message = why;
     rep.msg().utime = utime_now();
     for (int i = 0; i < 3; ++i) lcm.publish(dynhet::kChanSimStatus, &rep.msg());
@@ -215,21 +236,28 @@ int main(int argc, char** argv) {
                  static_cast<long long>(run_id), eng.size(), scene.packing_fraction, scene.restitution,
                  eng.box_length(), p.driving && scene.restitution < 1 ? "on" : "off", p.kick_rate);
 
-    // Compression to the scene's packing fraction.
     const auto t_wall = Clock::now();
-    rep.msg().phase = "compress";
-    rep.msg().phase_end_time = 0;
-    eng.prepare([&](double) {
-      rep.update(eng, -1);
-      if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
-    });
-    std::fprintf(stderr, "\nsim_node: compressed to phi=%.4f in %.1f s, max overlap %.2g\n",
-                 eng.packing_fraction(), seconds_since(t_wall), std::max(0.0, eng.max_overlap()));
+    if (!resume_path.empty()) {
+      eng.restore(resumed.state);
+      std::fprintf(stderr, "sim_node: resumed at t=%.10g, frame %d, from %s\n", eng.time(),
+                   resumed.next_frame, resume_path.c_str());
+    } else {
+      // Compression to the scene's packing fraction.
+      rep.msg().phase = "compress";
+      rep.msg().phase_end_time = 0;
+      eng.prepare([&](double) {
+        rep.update(eng, -1);
+        if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
+      });
+      std::fprintf(stderr, "\nsim_node: compressed to phi=%.4f in %.1f s, max overlap %.2g\n",
+                   eng.packing_fraction(), seconds_since(t_wall), std::max(0.0, eng.max_overlap()));
+    }
 
     const dynhet::FrameSchedule sched = dynhet::make_schedule(scene.schedule, scene.equilibration_time);
     const double t_end = scene.equilibration_time + scene.production_time;
     dynhet::run_info_t info = make_run_info(scene, eng, sched, run_id);
     rep.msg().frames_total = info.n_frames;
+    rep.msg().frames_published = resumed.next_frame;
     auto last_info = Clock::now();
     auto publish_info = [&] {
       info.utime = utime_now();
@@ -238,21 +266,54 @@ int main(int argc, char** argv) {
     };
     publish_info();
 
+    // Synchronised times k * interval (k counted from t = 0), the same in a
+    // resumed run as in the uninterrupted one.
+    const double interval = scene.checkpoint_interval;
+    int64_t next_slot = static_cast<int64_t>(std::floor(eng.time() / interval + 0.5)) + 1;
+    int next_frame = resumed.next_frame;
+    auto checkpoint = [&] {
+      dynhet::write_checkpoint(checkpoint_path, {scene.text, run_id, next_frame, eng.state()});
+    };
+    bool announced = false;
+
     // Advance to time t in slices, so that status and run info go out and
-    // signals are seen at least once a second.
+    // signals are seen at least once a second; synchronise (and checkpoint)
+    // at every slot on the way.
     auto advance = [&](double t) {
-      while (!eng.run_until(t, 200000)) {
-        rep.update(eng, t_end - eng.time());
-        if (seconds_since(last_info) > 2.0) publish_info();
-        if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
+      for (;;) {
+        const double slot = next_slot * interval;
+        const double target = std::min(t, slot);
+        while (!eng.run_until(target, 200000)) {
+          rep.update(eng, t_end - eng.time());
+          if (seconds_since(last_info) > 2.0) publish_info();
+          if (g_signal && checkpoint_path.empty())
+            throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
+          if (g_signal && !announced) {
+            std::fprintf(stderr, "\nsim_node: signal %d: running on to t=%g to write a checkpoint\n",
+                         g_signal.load(), slot);
+            announced = true;
+          }
+        }
+        if (target == slot) {
+          eng.synchronize();
+          ++next_slot;
+          if (!checkpoint_path.empty()) checkpoint();
+          if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
+                                                 (checkpoint_path.empty() ? "" : "; checkpoint at t=" +
+                                                  std::to_string(eng.time()) + " in " + checkpoint_path +
+                                                  ", continue with sim_node --resume " + checkpoint_path));
+        }
+        if (target == t) break;
       }
       rep.update(eng, t_end - eng.time());
     };
 
-    rep.msg().phase = "equilibrate";
-    rep.msg().phase_end_time = scene.equilibration_time;
-    rep.reset_rates(eng);
-    advance(scene.equilibration_time);
+    if (eng.time() < scene.equilibration_time) {
+      rep.msg().phase = "equilibrate";
+      rep.msg().phase_end_time = scene.equilibration_time;
+      rep.reset_rates(eng);
+      advance(scene.equilibration_time);
+    }
 
     rep.msg().phase = "production";
     rep.msg().phase_end_time = t_end;
@@ -263,7 +324,7 @@ int main(int argc, char** argv) {
     chunk.run_id = run_id;
     chunk.n_particles = static_cast<int32_t>(eng.size());
     chunk.chunk_count = static_cast<int32_t>(ranges.size());
-    for (int f = 0; f < info.n_frames; ++f) {
+    for (int f = next_frame; f < info.n_frames; ++f) {
       advance(sched.frame_time[f]);
       eng.unwrapped_positions(xy);
       chunk.utime = utime_now();
@@ -280,9 +341,13 @@ int main(int argc, char** argv) {
         // Pace multi-chunk frames so receivers' socket buffers keep up.
         if (ranges.size() > 1) std::this_thread::sleep_for(std::chrono::microseconds(300));
       }
-      rep.msg().frames_published = f + 1;
+      rep.msg().frames_published = next_frame = f + 1;
     }
     advance(t_end);
+    if (!checkpoint_path.empty()) {
+      eng.synchronize();
+      checkpoint();
+    }
 
     rep.msg().phase = "done";
     rep.msg().eta_seconds = 0;
@@ -304,6 +369,7 @@ int main(int argc, char** argv) {
                  rep.msg().reduced_pressure, rep.msg().reduced_pressure_err, rep.msg().collision_frequency,
                  rep.msg().collision_frequency_err, static_cast<long long>(eng.counters().tc));
   } catch (const std::exception& e) {
+    if (g_signal && !checkpoint_path.empty()) rep.msg().phase = "interrupted"; // nodes wait for --resume
     fail(e.what());
     return g_signal ? 128 + g_signal : 1;
   }

@@ -383,7 +383,7 @@ void Engine::synchronize() {
 State Engine::state() const {
   State s;
   s.time = time();
-  s.next_kick_time = offset_ + cal_.time(kick_leaf_);
+  s.kick_in = cal_.time(kick_leaf_) - now_; // now_ is 0 after synchronize()
   s.x.resize(n_), s.y.resize(n_), s.vx.resize(n_), s.vy.resize(n_), s.last_collision.resize(n_);
   for (long i = 0; i < n_; ++i) {
     const double dt = now_ - part_[i].t; // 0 after synchronize()
@@ -391,7 +391,7 @@ State Engine::state() const {
     s.y[i] = part_[i].y + part_[i].vy * dt;
     s.vx[i] = part_[i].vx;
     s.vy[i] = part_[i].vy;
-    s.last_collision[i] = offset_ + last_collision_[i];
+    s.last_collision[i] = last_collision_[i] - now_;
   }
   s.image_x = image_x_;
   s.image_y = image_y_;
@@ -415,7 +415,7 @@ void Engine::restore(const State& s) {
   events_since_rebase_ = 0;
   for (long i = 0; i < n_; ++i) {
     part_[i] = Particle{s.x[i], s.y[i], s.vx[i], s.vy[i], 0.0};
-    last_collision_[i] = s.last_collision[i] - offset_;
+    last_collision_[i] = s.last_collision[i];
   }
   image_x_ = s.image_x;
   image_y_ = s.image_y;
@@ -423,7 +423,7 @@ void Engine::restore(const State& s) {
   rng_.set_state(s.rng);
   count_ = s.counters;
   start_run();
-  cal_.set(kick_leaf_, s.next_kick_time - offset_);
+  cal_.set(kick_leaf_, s.kick_in);
   build_cells();
   clear_events();
 }

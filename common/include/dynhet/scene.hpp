@@ -47,6 +47,10 @@ struct Scene {
   // [run]
   double equilibration_time = 100.0;
   double production_time = -1.0; // < 0: exactly what the schedule needs
+  // The engine synchronises every particle at multiples of this time (and
+  // writes a checkpoint there when asked), so that a resumed run goes on
+  // bit for bit like the uninterrupted one.
+  double checkpoint_interval = 50.0;
 
   ScheduleSpec schedule;
 

@@ -51,11 +51,14 @@ inline double reduced_pressure(double virial, double dt, long n, double temperat
 }
 
 // Everything needed to continue a run exactly: written to checkpoints.
-// Taken right after synchronize(), when every particle is at time().
+// Taken right after synchronize(), when every particle is at time(). Times
+// are kept relative to `time` as the engine holds them (adding and
+// subtracting `time` again would round).
 struct State {
   double time = 0;
-  double next_kick_time = 0; // absolute; infinite if not driven
-  std::vector<double> x, y, vx, vy, last_collision; // positions in the box; last_collision absolute
+  double kick_in = 0; // time until the next kick; infinite if not driven
+  std::vector<double> x, y, vx, vy;
+  std::vector<double> last_collision; // minus the time since each particle's last collision
   std::vector<int32_t> image_x, image_y;
   std::vector<uint64_t> collision_count;
   uint64_t rng[4] = {0, 0, 0, 0};

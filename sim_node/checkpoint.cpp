@@ -1,0 +1,139 @@
+#include "checkpoint.hpp"
+
+#include <cstdio>
+#include <stdexcept>
+#include <vector>
+
+#include <hdf5.h>
+#include <hdf5_hl.h>
+
+namespace dynhet {
+namespace {
+
+constexpr const char* kFormat = "dynhet checkpoint 1";
+
+class File {
+public:
+  File(hid_t id, const std::string& path) : id_(id), path_(path) {
+    if (id < 0) throw std::runtime_error(path + ": cannot open as HDF5");
+  }
+  ~File() { H5Fclose(id_); }
+  File(const File&) = delete;
+  File& operator=(const File&) = delete;
+  hid_t id() const { return id_; }
+  void check(herr_t status, const std::string& what) const {
+    if (status < 0) throw std::runtime_error(path_ + ": checkpoint " + what + " failed");
+  }
+
+private:
+  hid_t id_;
+  std::string path_;
+};
+
+template <class T> void put(const File& f, const char* name, hid_t type, const std::vector<T>& v) {
+  const hsize_t n = v.size();
+  f.check(H5LTmake_dataset(f.id(), name, 1, &n, type, v.data()), std::string("writing ") + name);
+}
+
+template <class T> void get(const File& f, const char* name, hid_t type, std::vector<T>& v, size_t n) {
+  hsize_t dims[1] = {0};
+  f.check(H5LTget_dataset_info(f.id(), name, dims, nullptr, nullptr), std::string("reading ") + name);
+  if (dims[0] != n) throw std::runtime_error(std::string("checkpoint: ") + name + " has the wrong length");
+  v.resize(n);
+  f.check(H5LTread_dataset(f.id(), name, type, v.data()), std::string("reading ") + name);
+}
+
+void put_attr(const File& f, const char* name, double v) {
+  f.check(H5LTset_attribute_double(f.id(), "/", name, &v, 1), name);
+}
+void put_attr(const File& f, const char* name, int64_t v) {
+  long long w = v;
+  f.check(H5LTset_attribute_long_long(f.id(), "/", name, &w, 1), name);
+}
+double get_double(const File& f, const char* name) {
+  double v;
+  f.check(H5LTget_attribute_double(f.id(), "/", name, &v), name);
+  return v;
+}
+int64_t get_int(const File& f, const char* name) {
+  long long v;
+  f.check(H5LTget_attribute_long_long(f.id(), "/", name, &v), name);
+  return v;
+}
+
+} // namespace
+
+void write_checkpoint(const std::string& path, const Checkpoint& c) {
+  const std::string tmp = path + ".tmp";
+  {
+    File f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), tmp);
+    f.check(H5LTset_attribute_string(f.id(), "/", "format", kFormat), "format");
+    f.check(H5LTmake_dataset_string(f.id(), "scene_toml", c.scene_toml.c_str()), "scene");
+    const auto& s = c.state;
+    put_attr(f, "run_id", c.run_id);
+    put_attr(f, "next_frame", int64_t{c.next_frame});
+    put_attr(f, "time", s.time);
+    put_attr(f, "kick_in", s.kick_in);
+    put_attr(f, "collisions", s.counters.collisions);
+    put_attr(f, "kicks", s.counters.kicks);
+    put_attr(f, "cell_crossings", s.counters.cell_crossings);
+    put_attr(f, "stale", s.counters.stale);
+    put_attr(f, "tc", s.counters.tc);
+    put_attr(f, "virial", s.counters.virial);
+    put(f, "x", H5T_NATIVE_DOUBLE, s.x);
+    put(f, "y", H5T_NATIVE_DOUBLE, s.y);
+    put(f, "vx", H5T_NATIVE_DOUBLE, s.vx);
+    put(f, "vy", H5T_NATIVE_DOUBLE, s.vy);
+    put(f, "last_collision", H5T_NATIVE_DOUBLE, s.last_collision);
+    put(f, "image_x", H5T_NATIVE_INT32, s.image_x);
+    put(f, "image_y", H5T_NATIVE_INT32, s.image_y);
+    put(f, "collision_count", H5T_NATIVE_UINT64, s.collision_count);
+    put(f, "rng", H5T_NATIVE_UINT64, std::vector<uint64_t>(s.rng, s.rng + 4));
+    f.check(H5Fflush(f.id(), H5F_SCOPE_GLOBAL), "flush");
+  }
+  if (std::rename(tmp.c_str(), path.c_str()) != 0)
+    throw std::runtime_error(path + ": cannot move the checkpoint into place");
+}
+
+Checkpoint read_checkpoint(const std::string& path) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  File f(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), path);
+  char format[64] = {0};
+  if (H5LTget_attribute_string(f.id(), "/", "format", format) < 0 || std::string(format) != kFormat)
+    throw std::runtime_error(path + ": not a dynhet checkpoint");
+  Checkpoint c;
+  H5T_class_t cls;
+  size_t size = 0;
+  hsize_t dims[1];
+  f.check(H5LTget_dataset_info(f.id(), "scene_toml", dims, &cls, &size), "reading the scene");
+  std::vector<char> text(size + 1, '\0');
+  f.check(H5LTread_dataset_string(f.id(), "scene_toml", text.data()), "reading the scene");
+  c.scene_toml = text.data();
+  c.run_id = get_int(f, "run_id");
+  c.next_frame = static_cast<int32_t>(get_int(f, "next_frame"));
+  auto& s = c.state;
+  s.time = get_double(f, "time");
+  s.kick_in = get_double(f, "kick_in");
+  s.counters.collisions = get_int(f, "collisions");
+  s.counters.kicks = get_int(f, "kicks");
+  s.counters.cell_crossings = get_int(f, "cell_crossings");
+  s.counters.stale = get_int(f, "stale");
+  s.counters.tc = get_int(f, "tc");
+  s.counters.virial = get_double(f, "virial");
+  hsize_t n[1] = {0};
+  f.check(H5LTget_dataset_info(f.id(), "x", n, nullptr, nullptr), "reading x");
+  get(f, "x", H5T_NATIVE_DOUBLE, s.x, n[0]);
+  get(f, "y", H5T_NATIVE_DOUBLE, s.y, n[0]);
+  get(f, "vx", H5T_NATIVE_DOUBLE, s.vx, n[0]);
+  get(f, "vy", H5T_NATIVE_DOUBLE, s.vy, n[0]);
+  get(f, "last_collision", H5T_NATIVE_DOUBLE, s.last_collision, n[0]);
+  get(f, "image_x", H5T_NATIVE_INT32, s.image_x, n[0]);
+  get(f, "image_y", H5T_NATIVE_INT32, s.image_y, n[0]);
+  get(f, "collision_count", H5T_NATIVE_UINT64, s.collision_count, n[0]);
+  std::vector<uint64_t> rng;
+  get(f, "rng", H5T_NATIVE_UINT64, rng, 4);
+  for (int k = 0; k < 4; ++k) s.rng[k] = rng[k];
+  return c;
+}
+
+} // namespace dynhet

@@ -1,0 +1,24 @@
+// Checkpoints of a run (HDF5): the engine state at a synchronised time plus
+// what sim_node needs to go on (scene, run id, next frame). Written to a
+// temporary file and renamed, so a checkpoint on disk is always whole.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "dynhet/engine/engine.hpp"
+
+namespace dynhet {
+
+struct Checkpoint {
+  std::string scene_toml;
+  int64_t run_id = 0;
+  int32_t next_frame = 0; // first frame not yet published
+  engine::State state;
+};
+
+void write_checkpoint(const std::string& path, const Checkpoint& c);
+// Throws std::runtime_error naming the file and what is wrong with it.
+Checkpoint read_checkpoint(const std::string& path);
+
+} // namespace dynhet
