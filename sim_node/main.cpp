@@ -327,6 +327,12 @@ int main(int argc, char** argv) {
     for (int f = next_frame; f < info.n_frames; ++f) {
       advance(sched.frame_time[f]);
       eng.unwrapped_positions(xy);
+#ifndef NDEBUG
+      // Debug builds: a full overlap scan at every frame.
+      if (const double ov = eng.max_overlap(); ov > 1e-9)
+        throw std::runtime_error("overlap " + std::to_string(ov) + " of a contact distance at t=" +
+                                 std::to_string(eng.time()));
+#endif
       chunk.utime = utime_now();
       chunk.frame_index = f;
       chunk.time = sched.frame_time[f];

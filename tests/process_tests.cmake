@@ -12,3 +12,11 @@ set_tests_properties(run_scene_refuses_bad_scene PROPERTIES LABELS process TIMEO
 add_test(NAME checkpoint_resume_bit_for_bit
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/checkpoint_resume.sh ${PROJECT_SOURCE_DIR} $<TARGET_FILE_DIR:sim_node>)
 set_tests_properties(checkpoint_resume_bit_for_bit PROPERTIES LABELS process TIMEOUT 300)
+
+# Engine stress test (bench/stress_engine.cpp): a short run in the default
+# suite; the full 10^9 collisions per case under the label `stress`
+# (ctest --test-dir build -L stress), about an hour on 2 cores.
+add_test(NAME stress_engine_short COMMAND stress_engine --collisions 5e6)
+set_tests_properties(stress_engine_short PROPERTIES LABELS engine TIMEOUT 600)
+add_test(NAME stress_engine_1e9 COMMAND stress_engine --collisions 1e9)
+set_tests_properties(stress_engine_1e9 PROPERTIES LABELS stress TIMEOUT 14400)
