@@ -35,17 +35,18 @@ int main(int argc, char** argv) {
   CLI::App app{"dynhet engine benchmark"};
   std::vector<long> ns{10000, 100000};
   std::vector<double> phis{0.60, 0.70, 0.78, 0.805};
-  double coll_per_particle = 50, eps = 1.0;
+  double coll_per_particle = 50, eps = 1.0, sync = 50.0;
   bool driven = false;
   app.add_option("--n", ns, "particle numbers")->delimiter(',');
   app.add_option("--phi", phis, "packing fractions")->delimiter(',');
   app.add_option("--coll", coll_per_particle, "collisions per particle to time");
   app.add_option("--eps", eps, "restitution");
   app.add_flag("--driven", driven, "kicks at the Enskog frequency");
+  app.add_option("--sync", sync, "time between synchronisations (memory re-sorting)");
   CLI11_PARSE(app, argc, argv);
 
-  std::printf("# dynhet engine, one core; eps=%g, %s; timed over %g collisions per particle\n", eps,
-              driven ? "driven" : "undriven", coll_per_particle);
+  std::printf("# dynhet engine, one core; eps=%g, %s; timed over %g collisions per particle, "
+              "synchronised every %g\n", eps, driven ? "driven" : "undriven", coll_per_particle, sync);
   std::printf("%9s %6s %9s %10s %10s %10s %10s %9s %9s %11s\n", "N", "phi", "prep_s", "coll/s",
               "kicks/s", "cross/s", "stale/s", "ns/coll", "B/part", "dE/E");
   for (long n : ns)
@@ -75,7 +76,13 @@ int main(int argc, char** argv) {
       const auto c0 = e.counters();
       const double t_run = coll_per_particle * n / std::max(rate, 1.0);
       t0 = std::chrono::steady_clock::now();
-      e.run_until(e.time() + t_run);
+      // Synchronise (and re-sort particles in memory) every `sync` time
+      // units, as sim_node does at run.checkpoint_interval.
+      for (double t = e.time(), end = e.time() + t_run; t < end;) {
+        t = std::min(end, t + sync);
+        e.run_until(t);
+        e.synchronize();
+      }
       const double wall = seconds(t0);
       const auto c1 = e.counters();
       const double coll = double(c1.collisions - c0.collisions);

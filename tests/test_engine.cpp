@@ -185,7 +185,7 @@ TEST(Theory, PressureOfMonodisperseDisksFollowsHenderson) {
 
 TEST(Theory, CollisionFrequencyFollowsEnskog) {
   for (double phi : {0.1, 0.3}) {
-    const auto m = measure_monodisperse(phi, 2000, 10, 20.0);
+    const auto m = measure_monodisperse(phi, 2000, 20, 40.0);
     const double w = enskog_omega(phi);
     std::printf("phi %.2f: omega = %.4f +- %.4f, Enskog-Henderson %.4f (%.2f%%)\n", phi, m.omega,
                 m.omega_err, w, 100 * (m.omega / w - 1));

@@ -18,8 +18,11 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
     radius_[s] = m.radius[s];
     mass_[s] = m.mass[s];
   }
-  species_.resize(n_);
-  for (long i = 0; i < n_; ++i) species_[i] = static_cast<uint8_t>(species_of(i, n_));
+  species_by_id_.resize(n_);
+  for (long i = 0; i < n_; ++i) species_by_id_[i] = static_cast<uint8_t>(species_of(i, n_));
+  id_.resize(n_);
+  slot_of_.resize(n_);
+  for (long i = 0; i < n_; ++i) id_[i] = slot_of_[i] = static_cast<int32_t>(i);
 
   // Cells at least as wide as the largest contact distance, at least 3 a side.
   nc_ = static_cast<int>(std::floor(box_ / (2.0 * std::max(radius_[0], radius_[1]))));
@@ -28,10 +31,10 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
                                 " holds fewer than 3 cells; use more particles");
   cw_ = box_ / nc_;
 
-  part_.assign(n_, Particle{0, 0, 0, 0, 0});
+  part_.assign(n_, Particle{0, 0, 0, 0, 0, kNever, 0, -1, 0});
+  for (long i = 0; i < n_; ++i) part_[i].species = species_by_id_[i];
   image_x_.assign(n_, 0);
   image_y_.assign(n_, 0);
-  coll_count_.assign(n_, 0);
   last_collision_.assign(n_, -kNever);
   event_.assign(n_, Event{-1, kCross, 0});
   kick_leaf_ = static_cast<int>(n_);
@@ -40,7 +43,7 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
 
 double Engine::packing_fraction() const {
   double a = 0;
-  for (long i = 0; i < n_; ++i) a += M_PI * radius_[species_[i]] * radius_[species_[i]];
+  for (long i = 0; i < n_; ++i) a += M_PI * radius_[part_[i].species] * radius_[part_[i].species];
   return a * scale() * scale() / (box_ * box_);
 }
 
@@ -49,30 +52,56 @@ double Engine::packing_fraction() const {
 void Engine::cell_insert(int i, int c) {
   cell_of_[i] = c;
   prev_[i] = -1;
-  next_[i] = head_[c];
+  part_[i].next = head_[c];
   if (head_[c] >= 0) prev_[head_[c]] = i;
   head_[c] = i;
 }
 
 void Engine::cell_remove(int i) {
   const int c = cell_of_[i];
+  const int next = part_[i].next;
   if (prev_[i] >= 0)
-    next_[prev_[i]] = next_[i];
+    part_[prev_[i]].next = next;
   else
-    head_[c] = next_[i];
-  if (next_[i] >= 0) prev_[next_[i]] = prev_[i];
+    head_[c] = next;
+  if (next >= 0) prev_[next] = prev_[i];
 }
 
 void Engine::build_cells() {
   head_.assign(static_cast<size_t>(nc_) * nc_, -1);
   cell_of_.assign(n_, -1);
-  next_.assign(n_, -1);
+  for (auto& a : part_) a.next = -1;
   prev_.assign(n_, -1);
   for (long i = 0; i < n_; ++i) {
     const int cx = std::min(nc_ - 1, static_cast<int>(part_[i].x / cw_));
     const int cy = std::min(nc_ - 1, static_cast<int>(part_[i].y / cw_));
     cell_insert(static_cast<int>(i), cell_index(cx, cy));
   }
+}
+
+void Engine::reorder() {
+  std::vector<int32_t> cell(n_);
+  for (long s = 0; s < n_; ++s) {
+    const int cx = std::clamp(static_cast<int>(part_[s].x / cw_), 0, nc_ - 1);
+    const int cy = std::clamp(static_cast<int>(part_[s].y / cw_), 0, nc_ - 1);
+    cell[s] = cell_index(cx, cy);
+  }
+  std::vector<int32_t> order(n_);
+  for (long s = 0; s < n_; ++s) order[s] = static_cast<int32_t>(s);
+  std::sort(order.begin(), order.end(), [&](int32_t a, int32_t b) {
+    return cell[a] != cell[b] ? cell[a] < cell[b] : id_[a] < id_[b];
+  });
+  auto permute = [&](auto& v) {
+    auto old = v;
+    for (long s = 0; s < n_; ++s) v[s] = old[order[s]];
+  };
+  permute(part_);
+  permute(image_x_);
+  permute(image_y_);
+  permute(last_collision_);
+  permute(id_);
+  for (long s = 0; s < n_; ++s) slot_of_[id_[s]] = static_cast<int32_t>(s);
+  build_cells();
 }
 
 void Engine::image_shift(int i, int j, double& sx, double& sy) const {
@@ -116,7 +145,7 @@ void Engine::predict(int i) {
     for (int dx = -1; dx <= 1; ++dx) {
       const int nx = (cx + dx + nc_) % nc_;
       const double sx = cx + dx < 0 ? -box_ : (cx + dx >= nc_ ? box_ : 0.0);
-      for (int j = head_[cell_index(nx, ny)]; j >= 0; j = next_[j]) {
+      for (int j = head_[cell_index(nx, ny)]; j >= 0; j = part_[j].next) {
         if (j == i) continue;
         const Particle& b = part_[j];
         const double bdt = now_ - b.t;
@@ -125,21 +154,21 @@ void Engine::predict(int i) {
             pair_collision_time(ddx, ddy, a.vx - b.vx, a.vy - b.vy, sigma(i, j), growth(i, j));
         if (dt == kNever) continue;
         const double t = now_ + dt;
-        if (dt < best) best = dt, ev = Event{j, kCollision, coll_count_[j]};
-        if (t < cal_.time(j)) {
-          event_[j] = Event{i, kCollision, coll_count_[i]};
-          cal_.set(j, t);
+        if (dt < best) best = dt, ev = Event{j, kCollision, b.coll};
+        if (t < b.event_time) {
+          event_[j] = Event{i, kCollision, a.coll};
+          set_event_time(j, t);
         }
       }
     }
   }
   event_[i] = ev;
-  cal_.set(i, now_ + best);
+  set_event_time(i, now_ + best);
 }
 
 // Every particle's event predicted again (the next kick stays).
 void Engine::clear_events() {
-  for (long i = 0; i < n_; ++i) cal_.set(static_cast<int>(i), kNever);
+  for (long i = 0; i < n_; ++i) set_event_time(static_cast<int>(i), kNever);
   for (long i = 0; i < n_; ++i) predict(static_cast<int>(i));
 }
 
@@ -156,11 +185,11 @@ void Engine::collide(int i, int j) {
     ++count_.tc;
   }
   last_collision_[i] = last_collision_[j] = now_;
-  const double impulse = collide_pair(a.x - (b.x + sx), a.y - (b.y + sy), mass_[species_[i]],
-                                      mass_[species_[j]], eps, a.vx, a.vy, b.vx, b.vy, growth(i, j));
+  const double impulse = collide_pair(a.x - (b.x + sx), a.y - (b.y + sy), mass_of(static_cast<int>(i)),
+                                      mass_of(j), eps, a.vx, a.vy, b.vx, b.vy, growth(i, j));
   count_.virial += sigma(i, j) * impulse;
-  ++coll_count_[i];
-  ++coll_count_[j];
+  ++part_[i].coll;
+  ++part_[j].coll;
   ++count_.collisions;
   predict(i);
   predict(j);
@@ -195,21 +224,22 @@ void Engine::cross(int i, int dir) {
 // particles drawn uniformly from the whole system, and with the two species
 // the amplitude is p_Dr^2 = (1 - eps^2) m1 m2 / (m1 + m2) for every pair.
 void Engine::kick() {
-  const int i = static_cast<int>(rng_.below(n_));
-  int j = static_cast<int>(rng_.below(n_ - 1));
-  if (j >= i) ++j;
+  const int a = static_cast<int>(rng_.below(n_));
+  int b = static_cast<int>(rng_.below(n_ - 1));
+  if (b >= a) ++b;
+  const int i = slot_of_[a], j = slot_of_[b]; // drawn by particle id
   double kx, ky;
   rng_.normal_pair(kx, ky);
   const double p = kick_amplitude(eps_, mass_[0], mass_[1]);
   sync(i);
   sync(j);
-  const double mi = mass_[species_[i]], mj = mass_[species_[j]];
+  const double mi = mass_of(static_cast<int>(i)), mj = mass_of(j);
   part_[i].vx += p * kx / mi;
   part_[i].vy += p * ky / mi;
   part_[j].vx -= p * kx / mj;
   part_[j].vy -= p * ky / mj;
-  ++coll_count_[i];
-  ++coll_count_[j];
+  ++part_[i].coll;
+  ++part_[j].coll;
   ++count_.kicks;
   cal_.set(kick_leaf_, now_ + rng_.exponential(kick_pair_rate_));
   predict(i);
@@ -224,6 +254,7 @@ void Engine::rebase() {
     last_collision_[i] -= now_;
   }
   cal_.shift(now_); // the kick leaf too
+  for (auto& a : part_) a.event_time -= now_;
   scale0_ += grow_ * now_;
   offset_ += now_;
   now_ = 0;
@@ -249,7 +280,7 @@ bool Engine::run_until(double t_abs, int64_t max_events) {
     const Event e = event_[leaf];
     if (e.type == kCross) {
       cross(leaf, e.partner);
-    } else if (coll_count_[e.partner] != e.partner_seen) {
+    } else if (part_[e.partner].coll != e.partner_seen) {
       ++count_.stale;
       sync(leaf);
       predict(leaf);
@@ -265,7 +296,7 @@ bool Engine::run_until(double t_abs, int64_t max_events) {
 void Engine::thermalize(double energy) {
   double px = 0, py = 0, mtot = 0;
   for (long i = 0; i < n_; ++i) {
-    const double m = mass_[species_[i]];
+    const double m = mass_of(static_cast<int>(i));
     double gx, gy;
     rng_.normal_pair(gx, gy);
     part_[i].vx = gx / std::sqrt(m);
@@ -286,7 +317,7 @@ void Engine::place_random(double scale) {
   now_ = 0;
   head_.assign(static_cast<size_t>(nc_) * nc_, -1);
   cell_of_.assign(n_, -1);
-  next_.assign(n_, -1);
+  for (auto& a : part_) a.next = -1;
   prev_.assign(n_, -1);
   for (long i = 0; i < n_; ++i) {
     bool placed = false;
@@ -298,7 +329,7 @@ void Engine::place_random(double scale) {
       for (int dy = -1; dy <= 1 && placed; ++dy)
         for (int dx = -1; dx <= 1 && placed; ++dx) {
           const int c = cell_index((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_);
-          for (int j = head_[c]; j >= 0; j = next_[j]) {
+          for (int j = head_[c]; j >= 0; j = part_[j].next) {
             double ddx = x - part_[j].x, ddy = y - part_[j].y;
             ddx -= box_ * std::round(ddx / box_);
             ddy -= box_ * std::round(ddy / box_);
@@ -310,7 +341,8 @@ void Engine::place_random(double scale) {
           }
         }
       if (placed) {
-        part_[i] = Particle{x, y, 0, 0, 0};
+        Particle& p = part_[i];
+        p.x = x, p.y = y, p.vx = p.vy = p.t = 0;
         cell_insert(static_cast<int>(i), cell_index(cx, cy));
       }
     }
@@ -327,6 +359,7 @@ void Engine::prepare(const std::function<void(double)>& progress) {
   const double phi = p_.packing_fraction;
   const double phi_start = std::min(phi, 0.35);
   place_random(std::sqrt(phi_start / phi));
+  reorder();
   if (progress) progress(packing_fraction());
 
   // Grow elastically and without driving, radii scale0_ + grow_ t. The
@@ -349,6 +382,7 @@ void Engine::prepare(const std::function<void(double)>& progress) {
                                std::to_string(packing_fraction()) + " (target " +
                                std::to_string(phi) + "): the packing jams; lower phi");
     rescale_velocities(1.0);
+    reorder();
     clear_events();
     if (progress) progress(packing_fraction());
   }
@@ -365,6 +399,7 @@ void Engine::prepare(const std::function<void(double)>& progress) {
   thermalize(1.0);
   start_run();
   cal_.set(kick_leaf_, driving_ ? now_ + rng_.exponential(kick_pair_rate_) : kNever);
+  reorder();
   clear_events();
 }
 
@@ -376,7 +411,7 @@ void Engine::start_run() {
 
 void Engine::synchronize() {
   rebase();
-  build_cells();
+  reorder();
   clear_events();
 }
 
@@ -385,17 +420,19 @@ State Engine::state() const {
   s.time = time();
   s.kick_in = cal_.time(kick_leaf_) - now_; // now_ is 0 after synchronize()
   s.x.resize(n_), s.y.resize(n_), s.vx.resize(n_), s.vy.resize(n_), s.last_collision.resize(n_);
-  for (long i = 0; i < n_; ++i) {
-    const double dt = now_ - part_[i].t; // 0 after synchronize()
-    s.x[i] = part_[i].x + part_[i].vx * dt;
-    s.y[i] = part_[i].y + part_[i].vy * dt;
-    s.vx[i] = part_[i].vx;
-    s.vy[i] = part_[i].vy;
-    s.last_collision[i] = last_collision_[i] - now_;
+  s.image_x.resize(n_), s.image_y.resize(n_), s.collision_count.resize(n_);
+  for (long k = 0; k < n_; ++k) { // stored by particle id
+    const long i = id_[k];
+    const double dt = now_ - part_[k].t; // 0 after synchronize()
+    s.x[i] = part_[k].x + part_[k].vx * dt;
+    s.y[i] = part_[k].y + part_[k].vy * dt;
+    s.vx[i] = part_[k].vx;
+    s.vy[i] = part_[k].vy;
+    s.last_collision[i] = last_collision_[k] - now_;
+    s.image_x[i] = image_x_[k];
+    s.image_y[i] = image_y_[k];
+    s.collision_count[i] = part_[k].coll;
   }
-  s.image_x = image_x_;
-  s.image_y = image_y_;
-  s.collision_count = coll_count_;
   for (int k = 0; k < 4; ++k) s.rng[k] = rng_.state()[k];
   s.counters = count_;
   return s;
@@ -414,17 +451,17 @@ void Engine::restore(const State& s) {
   now_ = 0;
   events_since_rebase_ = 0;
   for (long i = 0; i < n_; ++i) {
-    part_[i] = Particle{s.x[i], s.y[i], s.vx[i], s.vy[i], 0.0};
+    part_[i] = Particle{s.x[i], s.y[i], s.vx[i], s.vy[i], 0.0, kNever, s.collision_count[i], -1, species_by_id_[i]};
     last_collision_[i] = s.last_collision[i];
   }
   image_x_ = s.image_x;
   image_y_ = s.image_y;
-  coll_count_ = s.collision_count;
+  for (long i = 0; i < n_; ++i) id_[i] = slot_of_[i] = static_cast<int32_t>(i);
   rng_.set_state(s.rng);
   count_ = s.counters;
   start_run();
   cal_.set(kick_leaf_, s.kick_in);
-  build_cells();
+  reorder(); // the same slot order as the run that wrote the state
   clear_events();
 }
 
@@ -434,7 +471,7 @@ double Engine::kinetic_energy_per_particle() const {
   double e = 0;
   for (long i = 0; i < n_; ++i) {
     const auto& a = part_[i];
-    e += 0.5 * mass_[species_[i]] * (a.vx * a.vx + a.vy * a.vy);
+    e += 0.5 * mass_of(static_cast<int>(i)) * (a.vx * a.vx + a.vy * a.vy);
   }
   return e / n_;
 }
@@ -442,18 +479,19 @@ double Engine::kinetic_energy_per_particle() const {
 void Engine::momentum(double& px, double& py) const {
   px = py = 0;
   for (long i = 0; i < n_; ++i) {
-    px += mass_[species_[i]] * part_[i].vx;
-    py += mass_[species_[i]] * part_[i].vy;
+    px += mass_of(static_cast<int>(i)) * part_[i].vx;
+    py += mass_of(static_cast<int>(i)) * part_[i].vy;
   }
 }
 
 void Engine::unwrapped_positions(std::vector<double>& xy) const {
   xy.resize(2 * n_);
-  for (long i = 0; i < n_; ++i) {
-    const auto& a = part_[i];
+  for (long k = 0; k < n_; ++k) {
+    const auto& a = part_[k];
     const double dt = now_ - a.t;
-    xy[2 * i] = a.x + a.vx * dt + image_x_[i] * box_;
-    xy[2 * i + 1] = a.y + a.vy * dt + image_y_[i] * box_;
+    const long i = id_[k];
+    xy[2 * i] = a.x + a.vx * dt + image_x_[k] * box_;
+    xy[2 * i + 1] = a.y + a.vy * dt + image_y_[k] * box_;
   }
 }
 
@@ -467,7 +505,7 @@ double Engine::min_gap_ratio() const {
       for (int dx = -1; dx <= 1; ++dx) {
         const double sx = cx + dx < 0 ? -box_ : (cx + dx >= nc_ ? box_ : 0.0);
         const double sy = cy + dy < 0 ? -box_ : (cy + dy >= nc_ ? box_ : 0.0);
-        for (int j = head_[cell_index((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_)]; j >= 0; j = next_[j]) {
+        for (int j = head_[cell_index((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_)]; j >= 0; j = part_[j].next) {
           if (j <= i) continue;
           const auto& b = part_[j];
           const double ddx = ax - (b.x + b.vx * (now_ - b.t) + sx);

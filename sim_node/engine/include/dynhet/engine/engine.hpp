@@ -103,7 +103,7 @@ public:
   double packing_fraction() const;
   double radius(int species) const { return radius_[species]; }
   double mass(int species) const { return mass_[species]; }
-  const std::vector<uint8_t>& species() const { return species_; }
+  const std::vector<uint8_t>& species() const { return species_by_id_; } // by particle id
   const Counters& counters() const { return count_; }
   double kinetic_energy_per_particle() const;
   void momentum(double& px, double& py) const;
@@ -119,8 +119,13 @@ public:
 
 private:
   enum EventType : int8_t { kCollision, kCross };
-  struct Particle {
+  // What predicting a collision reads of a neighbour, in one cache line.
+  struct alignas(64) Particle {
     double x, y, vx, vy, t; // position (in the box) at local time t, velocity
+    double event_time;      // its next event (a copy of its calendar leaf)
+    uint64_t coll;          // collision counter (also counts kicks): staleness of predictions
+    int32_t next;           // next particle in the same cell, -1 at the end
+    uint8_t species;
   };
   struct Event {
     int32_t partner;       // collision partner, or direction of the cell crossing 0..3
@@ -137,8 +142,13 @@ private:
   void kick();
   void rebase();
   // Contact distance now, and its growth rate (compression only).
-  double sigma(int i, int j) const { return scale() * (radius_[species_[i]] + radius_[species_[j]]); }
-  double growth(int i, int j) const { return grow_ * (radius_[species_[i]] + radius_[species_[j]]); }
+  double sigma(int i, int j) const { return scale() * (radius_[part_[i].species] + radius_[part_[j].species]); }
+  double growth(int i, int j) const { return grow_ * (radius_[part_[i].species] + radius_[part_[j].species]); }
+  double mass_of(int i) const { return mass_[part_[i].species]; }
+  void set_event_time(int i, double t) {
+    part_[i].event_time = t;
+    cal_.set(i, t);
+  }
   double scale() const { return scale0_ + grow_ * now_; }
   void rescale_velocities(double energy);
   void start_run(); // restitution, driving on; the first kick drawn
@@ -148,6 +158,9 @@ private:
   // Shift to add to j's position so that it is the image next to i.
   void image_shift(int i, int j, double& sx, double& sy) const;
   void place_random(double scale);
+  // Renumbers the storage slots in cell order (ties by particle id), so
+  // that neighbours sit close in memory; then rebuilds the cells.
+  void reorder();
 
   Params p_;
   long n_;
@@ -158,16 +171,18 @@ private:
   double scale0_ = 1.0, grow_ = 0.0;
   double eps_;
 
+  // Per-particle arrays are indexed by storage slot; id_[slot] is the
+  // particle's id (its index in frames and checkpoints), slot_of_ the inverse.
   std::vector<Particle> part_;
-  std::vector<uint8_t> species_;
+  std::vector<uint8_t> species_by_id_;
+  std::vector<int32_t> id_, slot_of_;
   std::vector<int32_t> image_x_, image_y_;
-  std::vector<uint64_t> coll_count_;
   std::vector<double> last_collision_; // internal time of each particle's last collision (TC model)
   std::vector<Event> event_;
 
   int nc_ = 0;   // cells per side
   double cw_ = 0; // cell width
-  std::vector<int32_t> cell_of_, head_, next_, prev_;
+  std::vector<int32_t> cell_of_, head_, prev_;
 
   Calendar cal_;
   int kick_leaf_;
