@@ -363,20 +363,24 @@ void Engine::prepare(const std::function<void(double)>& progress) {
   if (progress) progress(packing_fraction());
 
   // Grow elastically and without driving, radii scale0_ + grow_ t. The
-  // rate is slow against the thermal speed (~1) so the packing stays a
-  // fluid and does not jam early.
+  // rate is fast while the packing is far below its target and slow (against
+  // the thermal speed ~1) near it, so the packing stays a fluid and does not
+  // jam early.
   eps_ = 1.0;
   driving_ = false;
   now_ = offset_ = 0;
   thermalize(1.0);
-  grow_ = 0.002;
-  const double t_end = (1.0 - scale0_) / grow_; // absolute time
   clear_events();
-  while (time() < t_end) {
+  while (scale0_ < 1.0) {
+    grow_ = packing_fraction() < phi - 0.1 ? 0.01 : 0.002;
+    const double t_full = (1.0 - scale0_) / grow_; // radii reach their size
     // About a collision per particle, then back to kinetic energy 1 (growth
     // heats the system) and predict everything again.
-    run_until(std::min(t_end, time() + 1.0), 2 * n_);
-    for (long i = 0; i < n_; ++i) sync(static_cast<int>(i));
+    const double t_stop = std::min(t_full, 1.0);
+    const bool reached = run_until(offset_ + t_stop, 2 * n_);
+    rebase(); // now_ = 0: scale0_ is the scale reached
+    if (reached && t_stop == t_full) scale0_ = 1.0;
+    grow_ = 0.0;
     if (count_.collisions > 20000 * n_)
       throw std::runtime_error("engine: compression stalled at phi = " +
                                std::to_string(packing_fraction()) + " (target " +
