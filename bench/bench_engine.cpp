@@ -14,6 +14,7 @@
 
 #include "dynhet/engine/engine.hpp"
 #include "dynhet/model.hpp"
+#include "dynhet/stats.hpp"
 
 namespace {
 
@@ -47,8 +48,8 @@ int main(int argc, char** argv) {
 
   std::printf("# dynhet engine, one core; eps=%g, %s; timed over %g collisions per particle, "
               "synchronised every %g\n", eps, driven ? "driven" : "undriven", coll_per_particle, sync);
-  std::printf("%9s %6s %9s %10s %10s %10s %10s %9s %9s %11s\n", "N", "phi", "prep_s", "coll/s",
-              "kicks/s", "cross/s", "stale/s", "ns/coll", "B/part", "dE/E");
+  std::printf("%9s %6s %9s %10s %10s %10s %10s %9s %9s %11s %8s %8s\n", "N", "phi", "prep_s", "coll/s",
+              "kicks/s", "cross/s", "stale/s", "ns/coll", "B/part", "dE/E", "T_mean", "T_sd");
   for (long n : ns)
     for (double phi : phis) {
       const long rss0 = rss_kib();
@@ -78,18 +79,26 @@ int main(int argc, char** argv) {
       t0 = std::chrono::steady_clock::now();
       // Synchronise (and re-sort particles in memory) every `sync` time
       // units, as sim_node does at run.checkpoint_interval.
+      dynhet::BlockAverage temp; // granular temperature T = KE per particle, sampled
+      double t2 = 0;
       for (double t = e.time(), end = e.time() + t_run; t < end;) {
-        t = std::min(end, t + sync);
-        e.run_until(t);
+        for (double stop = std::min(end, t + sync); t < stop;) {
+          t = std::min(stop, t + 1.0);
+          e.run_until(t);
+          const double T = e.kinetic_energy_per_particle();
+          temp.add(T);
+          t2 += T * T;
+        }
         e.synchronize();
       }
+      const double t_sd = std::sqrt(std::max(0.0, t2 / temp.count() - temp.mean() * temp.mean()));
       const double wall = seconds(t0);
       const auto c1 = e.counters();
       const double coll = double(c1.collisions - c0.collisions);
-      std::printf("%9ld %6.3f %9.2f %10.3g %10.3g %10.3g %10.3g %9.1f %9.0f %11.2e\n", n, phi, prep,
+      std::printf("%9ld %6.3f %9.2f %10.3g %10.3g %10.3g %10.3g %9.1f %9.0f %11.2e %8.4f %8.4f\n", n, phi, prep,
                   coll / wall, (c1.kicks - c0.kicks) / wall, (c1.cell_crossings - c0.cell_crossings) / wall,
                   (c1.stale - c0.stale) / wall, 1e9 * wall / coll, bytes,
-                  eps == 1.0 && !driven ? e.kinetic_energy_per_particle() / e0 - 1 : NAN);
+                  eps == 1.0 && !driven ? e.kinetic_energy_per_particle() / e0 - 1 : NAN, temp.mean(), t_sd);
       std::fflush(stdout);
     }
   return 0;
