@@ -1,0 +1,50 @@
+#include "dynhet/analysis/chi4.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "dynhet/analysis/timescales.hpp"
+
+namespace dynhet::analysis {
+
+namespace {
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+}
+
+Chi4Accumulator::Chi4Accumulator(int n_origins, std::vector<double> lag_time, const SubboxGrid& grid)
+    : n_origins_(n_origins), lag_(std::move(lag_time)), grid_(grid),
+      s1_(static_cast<size_t>(n_origins) * lag_.size(), kNaN), s2_(s1_) {}
+
+void Chi4Accumulator::add(int k, int j, double q_r_sum, double q_r_sum2) {
+  s1_[index(k, j)] = q_r_sum, s2_[index(k, j)] = q_r_sum2;
+}
+
+Chi4Accumulator::Result Chi4Accumulator::result() const {
+  const size_t nj = lag_.size();
+  const double nb = double(grid_.per_side) * grid_.per_side, big_n = grid_.mean_particles;
+  Result r;
+  r.chi4.assign(nj, kNaN), r.chi4_err.assign(nj, kNaN), r.chi4_pooled.assign(nj, kNaN);
+  r.n_origins.assign(nj, 0);
+  for (size_t j = 0; j < nj; ++j) {
+    double sum = 0, sum_sq = 0, t1 = 0, t2 = 0;
+    int n = 0;
+    for (int k = 0; k < n_origins_; ++k) {
+      const double s1 = s1_[index(k, static_cast<int>(j))], s2 = s2_[index(k, static_cast<int>(j))];
+      if (std::isnan(s1)) continue;
+      const double mean = s1 / nb;
+      const double c = big_n * (s2 / nb - mean * mean); // N[<Q_r^2> - <Q_r>^2] of origin k
+      sum += c, sum_sq += c * c, t1 += s1, t2 += s2, ++n;
+    }
+    r.n_origins[j] = n;
+    if (n == 0) continue;
+    r.chi4[j] = sum / n; // eq. (14): the average over origins
+    if (n > 1) r.chi4_err[j] = std::sqrt(std::max(0.0, (sum_sq / n - r.chi4[j] * r.chi4[j]) / (n - 1)));
+    const double boxes = n * nb;
+    if (boxes > 1) r.chi4_pooled[j] = big_n * (t2 - t1 * t1 / boxes) / (boxes - 1);
+  }
+  const Peak p = find_peak(lag_, nb > 1 ? r.chi4 : r.chi4_pooled); // chi4^P at tau4
+  r.chi4_peak = p.y, r.tau4 = p.t;
+  return r;
+}
+
+} // namespace dynhet::analysis

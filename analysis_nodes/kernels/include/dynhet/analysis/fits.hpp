@@ -1,0 +1,124 @@
+// Fits of the paper's empirical forms (secs. 3.1-3.4). Least squares, by
+// Levenberg-Marquardt where the form is nonlinear, with the starting point
+// from a linearised form. Errors are one standard deviation from the
+// covariance of the fit; where no data errors are given they are scaled by
+// chi2/dof, so they measure the scatter about the fit.
+#pragma once
+
+#include <functional>
+#include <vector>
+
+#include <Eigen/Dense>
+
+namespace dynhet::analysis {
+
+// ---- general tools --------------------------------------------------------
+
+// Weighted straight line y = slope x + intercept (weights w = 1/sigma^2; empty: all 1).
+struct LinearFit {
+  double slope, intercept, slope_err, intercept_err, chi2;
+  int n;
+};
+LinearFit linear_fit(const std::vector<double>& x, const std::vector<double>& y,
+                     const std::vector<double>& w = {});
+
+// Minimises |r(p)|^2 for residuals r already divided by their errors.
+struct LmResult {
+  Eigen::VectorXd p;
+  Eigen::MatrixXd cov; // (J^T J)^-1 at the minimum, unscaled
+  double chi2;
+  int dof;
+  bool converged;
+};
+using Residuals = std::function<Eigen::VectorXd(const Eigen::VectorXd&)>;
+LmResult levenberg_marquardt(const Residuals& r, Eigen::VectorXd p0, int max_iter = 200);
+
+// ---- overlap, sec. 3.1 ----------------------------------------------------
+
+// Eq. (8): Q(t) = 1 / ((t/tau0)^beta + 1) over every lag with a finite Q
+// (q_err empty: unweighted).
+struct OverlapFit {
+  double beta, tau0, beta_err, tau0_err, chi2;
+  int n;
+};
+OverlapFit fit_overlap(const std::vector<double>& t, const std::vector<double>& q,
+                       const std::vector<double>& q_err = {});
+
+// ---- displacements, sec. 3.2 ----------------------------------------------
+
+// Long-time MSD, Delta(t) = 4 D t + b, over the lags t_min <= t <= t_max.
+struct DiffusionFit {
+  double d, d_err, offset, t_min, t_max;
+  int n;
+};
+DiffusionFit fit_diffusion(const std::vector<double>& t, const std::vector<double>& msd, double t_min,
+                           double t_max, const std::vector<double>& msd_err = {});
+// First lag from which the local exponent d ln Delta / d ln t stays within
+// tol of 1 up to the last lag: where the MSD is diffusive. NaN if never.
+double diffusive_onset(const std::vector<double>& t, const std::vector<double>& msd, double tol = 0.05);
+
+// Gaussian P_g(dx,t) = exp(-dx^2/(4Dt)) / sqrt(4 pi D t) with D free, fitted
+// to ln P over the non-empty bins, each weighted by its count (Poisson).
+struct GaussianFit {
+  double d, d_err;
+  int n;
+};
+GaussianFit fit_gaussian_displacement(const std::vector<double>& x, const std::vector<double>& p,
+                                      const std::vector<long>& count, double t);
+
+// Exponential tail P_e(dx,t) = A exp(-|dx|/x0) over the non-empty bins with
+// |dx| >= x_min (both tails), a straight line in ln P weighted by counts.
+struct ExpTailFit {
+  double x0, x0_err, amplitude, x_min;
+  int n;
+};
+ExpTailFit fit_exponential_tail(const std::vector<double>& x, const std::vector<double>& p,
+                                const std::vector<long>& count, double x_min);
+
+// ---- cluster sizes, sec. 3.3 ----------------------------------------------
+
+// A distribution of positive integers (cluster sizes N_c) in log bins:
+// bin b holds the sizes lo[b]..hi[b]; p[b] = count[b] / (total (hi-lo+1)),
+// the fraction of clusters per size, P(N_c); centre = sqrt(lo hi).
+struct SizeHistogram {
+  std::vector<long> lo, hi, count;
+  std::vector<double> centre, p;
+  long total = 0;
+};
+
+// P(N_c) = C N_c^-kappa, eq. (11) below N*, over the bins inside
+// [n_lo, n_hi] with at least min_count clusters; the model is averaged
+// over each bin's sizes, so wide bins give no bias.
+struct PowerLawFit {
+  double kappa, kappa_err, amplitude;
+  int n;
+};
+PowerLawFit fit_power_law(const SizeHistogram& h, long n_lo, long n_hi, long min_count = 5);
+
+// Log-normal, eqs. (12)-(13): P(N_c) = P0 exp(-[ln(N_c/N_sigma)]^2 / (2 sigma^2)),
+// N_sigma = N0 exp(-sigma^2), over the bins with at least min_count clusters.
+struct LogNormalFit {
+  double n0, sigma, n_sigma, p0, n0_err, sigma_err;
+  int n;
+};
+LogNormalFit fit_log_normal(const SizeHistogram& h, long min_count = 5);
+
+// ---- four-point structure factor, sec. 3.4 --------------------------------
+
+// Eq. (18) (a_fitted false): S4 = chi0 / (1 + (q xi)^2); eq. (20) (true):
+// S4 = chi0 / (1 + (q xi)^2 + A^2 (q xi)^4). Fitted over the shells with
+// 0 < q and q xi <= qxi_max, xi from the OZ fit itself (iterated until the
+// range is stable); at least 3 (OZ) or 4 (A^2) shells are used. Without
+// errors the residuals are relative, (S4 - model)/S4.
+struct OzFit {
+  double chi0, xi, a, chi0_err, xi_err, a_err;
+  double q_fit_max; // largest q in the fit
+  int n;
+  bool range_ok; // false if the q xi <= qxi_max range held too few shells
+};
+OzFit fit_oz(const std::vector<double>& q, const std::vector<double>& s4,
+             const std::vector<double>& s4_err = {}, double qxi_max = 1.0);
+OzFit fit_oz_a2(const std::vector<double>& q, const std::vector<double>& s4,
+                const std::vector<double>& s4_err = {}, double qxi_max = 1.0);
+
+} // namespace dynhet::analysis

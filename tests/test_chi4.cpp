@@ -1,0 +1,148 @@
+// chi4(t), eq. (14), against a direct two-loop computation and a known
+// answer; chi4^P and tau4; tau_alpha per waiting time.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "dynhet/analysis/chi4.hpp"
+#include "dynhet/analysis/displacement.hpp"
+#include "dynhet/analysis/timescales.hpp"
+
+using namespace dynhet::analysis;
+
+namespace {
+
+// Positions in [0, box) and their displacements: slow (|dr| = 0.1) with
+// probability p_slow, else fast (|dr| = 2), independently.
+void bernoulli_frames(long n, double box, double p_slow, std::mt19937_64& gen, std::vector<double>& p0,
+                      std::vector<double>& pt) {
+  std::uniform_real_distribution<double> u(0, 1);
+  p0.resize(2 * n), pt.resize(2 * n);
+  for (long i = 0; i < n; ++i) {
+    p0[2 * i] = box * u(gen), p0[2 * i + 1] = box * u(gen);
+    const double step = u(gen) < p_slow ? 0.1 : 2.0;
+    pt[2 * i] = p0[2 * i] + step, pt[2 * i + 1] = p0[2 * i + 1];
+  }
+}
+
+} // namespace
+
+TEST(Chi4, MatchesTwoLoopComputation) {
+  std::mt19937_64 gen(17);
+  std::normal_distribution<double> g(0, 0.6);
+  std::uniform_real_distribution<double> u(0, 1);
+  const long n = 2500;
+  const double box = 50.0;
+  std::vector<double> p0(2 * n), pt(2 * n);
+  for (long i = 0; i < 2 * n; ++i) p0[i] = box * (3 * u(gen) - 1), pt[i] = p0[i] + g(gen);
+  const std::vector<std::uint8_t> species(n, 0);
+  DisplacementSpec spec;
+  for (int target : {25, 100, 400}) spec.grids.push_back(make_subbox_grid(n, box, target));
+  spec.cutoffs = {0.4, 0.8};
+  const OriginIndex origin(p0.data(), n, spec);
+  DisplacementResult r;
+  displacement_pass(p0.data(), pt.data(), species.data(), n, origin, spec, r);
+  for (size_t gi = 0; gi < spec.grids.size(); ++gi) {
+    const SubboxGrid& grid = spec.grids[gi];
+    const int m = grid.per_side;
+    const double w = box / m;
+    for (int c = 0; c < 2; ++c) {
+      // Loop over the sub-boxes, and inside over all particles.
+      double s1 = 0, s2 = 0;
+      for (int bx = 0; bx < m; ++bx)
+        for (int by = 0; by < m; ++by) {
+          long slow = 0;
+          for (long i = 0; i < n; ++i) {
+            const double x = std::fmod(std::fmod(p0[2 * i], box) + box, box);
+            const double y = std::fmod(std::fmod(p0[2 * i + 1], box) + box, box);
+            if (x < bx * w || x >= (bx + 1) * w || y < by * w || y >= (by + 1) * w) continue;
+            slow += std::hypot(pt[2 * i] - p0[2 * i], pt[2 * i + 1] - p0[2 * i + 1]) < spec.cutoffs[c];
+          }
+          const double q = slow / grid.mean_particles;
+          s1 += q, s2 += q * q;
+        }
+      const double nb = m * m, chi4 = grid.mean_particles * (s2 / nb - (s1 / nb) * (s1 / nb));
+      // Both sum the same integers in different orders: equal to rounding.
+      EXPECT_NEAR(r.chi4[gi * 2 + c], chi4, 1e-12 * chi4) << "grid " << m << " cutoff " << c;
+      EXPECT_NEAR(r.q_r_sum[gi * 2 + c], s1, 1e-12 * s1);
+    }
+  }
+}
+
+TEST(Chi4, IndependentMobilityGivesQTimesOneMinusOneOverBoxes) {
+  // Particles slow independently with probability p: the slow count of a
+  // sub-box is multinomial, so E[chi4] = p (1 - 1/n_boxes) (whatever N);
+  // the origin average must agree within 4 standard errors.
+  std::mt19937_64 gen(23);
+  const long n = 4096;
+  const double box = 64.0, p = 0.3;
+  const int origins = 60;
+  const SubboxGrid grid = make_subbox_grid(n, box, 64); // 8 x 8
+  DisplacementSpec spec;
+  spec.grids = {grid};
+  spec.cutoffs = {0.6};
+  Chi4Accumulator acc(origins, {1.0}, grid);
+  const std::vector<std::uint8_t> species(n, 0);
+  std::vector<double> p0, pt;
+  for (int k = 0; k < origins; ++k) {
+    bernoulli_frames(n, box, p, gen, p0, pt);
+    const OriginIndex origin(p0.data(), n, spec);
+    DisplacementResult r;
+    displacement_pass(p0.data(), pt.data(), species.data(), n, origin, spec, r);
+    acc.add(k, 0, r.q_r_sum[0], r.q_r_sum2[0]);
+  }
+  const auto res = acc.result();
+  EXPECT_EQ(res.n_origins[0], origins);
+  EXPECT_NEAR(res.chi4[0], p * (1 - 1.0 / 64), 4 * res.chi4_err[0]);
+  // Pooled over all boxes of all origins, n_r is Binomial(n, p/n_boxes):
+  // N var(Q_r) = p (1 - p/n_boxes); its error is about that of chi4.
+  EXPECT_NEAR(res.chi4_pooled[0], p * (1 - p / 64), 4 * res.chi4_err[0]);
+}
+
+TEST(Chi4, WholeBoxUsesTheVarianceOverOrigins) {
+  // One sub-box: the within-origin variance is zero, the pooled one is the
+  // variance of Q over origins times N_tot, here set by hand.
+  const SubboxGrid whole = make_subbox_grid(100, 10.0, 100);
+  ASSERT_EQ(whole.per_side, 1);
+  Chi4Accumulator acc(3, {1.0, 2.0, 4.0}, whole);
+  const double q[3] = {0.5, 0.6, 0.7};
+  for (int k = 0; k < 3; ++k)
+    for (int j = 0; j < 3; ++j) acc.add(k, j, q[k] * (j + 1) / 3, std::pow(q[k] * (j + 1) / 3, 2));
+  const auto r = acc.result();
+  for (int j = 0; j < 3; ++j) {
+    EXPECT_NEAR(r.chi4[j], 0.0, 1e-12);
+    const double f = (j + 1) / 3.0; // sample variance of {0.5, 0.6, 0.7} f is 0.01 f^2
+    EXPECT_NEAR(r.chi4_pooled[j], 100 * 0.01 * f * f, 1e-12);
+  }
+  EXPECT_FALSE(std::isnan(r.chi4_peak));
+  EXPECT_DOUBLE_EQ(r.tau4, 4.0); // grows to the last lag: the peak is at the end
+}
+
+TEST(Chi4, PeakOfAParabolaInLnTIsExact) {
+  std::vector<double> t, y;
+  for (int j = 0; j <= 24; ++j) t.push_back(0.1 * std::pow(10.0, j / 8.0));
+  const double ln_tau4 = std::log(3.3);
+  for (double x : t) y.push_back(12.0 - 2.0 * std::pow(std::log(x) - ln_tau4, 2));
+  const Peak p = find_peak(t, y);
+  EXPECT_TRUE(p.interior);
+  EXPECT_NEAR(p.t, 3.3, 1e-10);
+  EXPECT_NEAR(p.y, 12.0, 1e-10);
+}
+
+TEST(Chi4, TauAlphaPerWaitingTime) {
+  // Origin k decays as exp(-t/tau_k): its own tau_alpha is tau_k, to the
+  // accuracy of linear interpolation in ln t over 1/40 decade (< 1e-3 relative).
+  std::vector<double> lags;
+  for (int j = 0; j <= 100; ++j) lags.push_back(0.1 * std::pow(10.0, j / 40.0));
+  const std::vector<double> taus{2.0, 2.5, 1.5, 4.0};
+  OverlapAccumulator acc(4, lags);
+  for (int k = 0; k < 4; ++k)
+    for (size_t j = 0; j < lags.size(); ++j) {
+      const double v = std::exp(-lags[j] / taus[k]);
+      acc.add(k, static_cast<int>(j), &v, 1);
+    }
+  const auto tau = tau_alpha_per_origin(acc, lags, 4);
+  for (int k = 0; k < 4; ++k) EXPECT_NEAR(tau[k], taus[k], 1e-3 * taus[k]);
+  EXPECT_EQ(nearest_lag(lags, 2.0), 52); // 0.1 * 10^(52/40) = 1.995
+}

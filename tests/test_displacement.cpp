@@ -1,0 +1,174 @@
+// The one-pass displacement kernel against brute force: Q_r on every grid,
+// MSD of all and small particles, the x-displacement histogram, and the
+// fastest/slowest subsets.
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "dynhet/analysis/displacement.hpp"
+
+using namespace dynhet::analysis;
+
+namespace {
+
+struct System {
+  long n;
+  double box;
+  std::vector<double> p0, pt;
+  std::vector<std::uint8_t> species;
+};
+
+// Random positions in any periodic image, Gaussian displacements of width sd.
+System random_system(long n, double box, double sd, unsigned seed) {
+  std::mt19937_64 gen(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::normal_distribution<double> g(0, sd);
+  System s{n, box, std::vector<double>(2 * n), std::vector<double>(2 * n), std::vector<std::uint8_t>(n)};
+  for (long i = 0; i < 2 * n; ++i) {
+    s.p0[i] = box * u(gen) + box * std::floor(3 * u(gen) - 1);
+    s.pt[i] = s.p0[i] + g(gen);
+  }
+  for (long i = 0; i < n; ++i) s.species[i] = i < n - n / 2 ? 0 : 1; // the project's layout
+  return s;
+}
+
+DisplacementSpec spec_for(const System& s, const std::vector<int>& targets) {
+  DisplacementSpec spec;
+  for (int t : targets) spec.grids.push_back(make_subbox_grid(s.n, s.box, t));
+  spec.cutoffs = {0.3, 0.6, 1.0};
+  spec.hist_lo = -2.0, spec.hist_width = 0.1, spec.hist_bins = 40;
+  return spec;
+}
+
+} // namespace
+
+TEST(Displacement, SubboxOverlapEqualsOverlapKernelOnEveryGrid) {
+  const System s = random_system(3000, 48.0, 0.5, 7);
+  // Grids of 12 x 12, 5 x 5, 3 x 3 boxes and the whole system.
+  const DisplacementSpec spec = spec_for(s, {20, 120, 333, 3000});
+  const OriginIndex origin(s.p0.data(), s.n, spec);
+  DisplacementResult r;
+  displacement_pass(s.p0.data(), s.pt.data(), s.species.data(), s.n, origin, spec, r);
+  const int nc = 3;
+  for (size_t g = 0; g < spec.grids.size(); ++g) {
+    std::vector<double> ref;
+    overlap_subboxes(s.p0.data(), s.pt.data(), s.n, spec.grids[g], spec.cutoffs, ref);
+    const int nb = spec.grids[g].per_side * spec.grids[g].per_side;
+    for (int c = 0; c < nc; ++c)
+      for (int b = 0; b < nb; ++b) EXPECT_DOUBLE_EQ(r.q_r[g * nc + c][b], ref[c * nb + b]) << g << " " << c;
+  }
+}
+
+TEST(Displacement, MsdHistogramAndQMatchBruteForce) {
+  const System s = random_system(5000, 60.0, 0.6, 11);
+  const DisplacementSpec spec = spec_for(s, {50});
+  const OriginIndex origin(s.p0.data(), s.n, spec);
+  DisplacementResult r;
+  std::vector<double> d2(s.n);
+  displacement_pass(s.p0.data(), s.pt.data(), s.species.data(), s.n, origin, spec, r, d2.data());
+  double all = 0, small = 0;
+  long n_small = 0, out = 0;
+  std::vector<long> hist[2] = {std::vector<long>(40, 0), std::vector<long>(40, 0)};
+  std::vector<long> slow(3, 0);
+  for (long i = 0; i < s.n; ++i) {
+    const double dx = s.pt[2 * i] - s.p0[2 * i], dy = s.pt[2 * i + 1] - s.p0[2 * i + 1];
+    EXPECT_EQ(d2[i], dx * dx + dy * dy);
+    all += dx * dx + dy * dy;
+    if (s.species[i] == 0) small += dx * dx + dy * dy, ++n_small;
+    const double b = std::floor((dx + 2.0) / 0.1);
+    if (b < 0 || b >= 40)
+      ++out;
+    else
+      ++hist[s.species[i]][static_cast<int>(b)];
+    for (int c = 0; c < 3; ++c) slow[c] += std::sqrt(dx * dx + dy * dy) < spec.cutoffs[c];
+  }
+  // Same sums in the same order: equal to rounding.
+  EXPECT_NEAR(r.msd_all, all / s.n, 1e-12 * r.msd_all);
+  EXPECT_NEAR(r.msd_small, small / n_small, 1e-12 * r.msd_small);
+  EXPECT_EQ(r.n_small, n_small);
+  EXPECT_EQ(r.hist_out, out);
+  EXPECT_EQ(r.hist[0], hist[0]);
+  EXPECT_EQ(r.hist[1], hist[1]);
+  for (int c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(r.q[c], double(slow[c]) / s.n);
+  // The density integrates to the fraction inside the histogram.
+  std::vector<long> both(40);
+  for (int b = 0; b < 40; ++b) both[b] = hist[0][b] + hist[1][b];
+  const DisplacementDensity d = displacement_density(spec, both, s.n);
+  double integral = 0;
+  for (double p : d.p) integral += p * spec.hist_width;
+  EXPECT_NEAR(integral, 1.0 - double(out) / s.n, 1e-12);
+}
+
+TEST(Displacement, ManyGridsTakeTheGeneralPathWithTheSameAnswer) {
+  // Sides m = 19, 17, 13, 11, 5, 4, 3 divide no other: seven indexed grids,
+  // more than the unrolled cases; the whole box (m = 1) is summed. Each
+  // grid alone must give the same chi4.
+  const System s = random_system(4000, 50.0, 0.5, 3);
+  const DisplacementSpec spec = spec_for(s, {11, 14, 24, 33, 160, 250, 444, 4000});
+  const OriginIndex origin(s.p0.data(), s.n, spec);
+  ASSERT_EQ(origin.indexed_grids(), 7);
+  DisplacementResult all;
+  displacement_pass(s.p0.data(), s.pt.data(), s.species.data(), s.n, origin, spec, all);
+  for (size_t g = 0; g < spec.grids.size(); ++g) {
+    DisplacementSpec one = spec;
+    one.grids = {spec.grids[g]};
+    const OriginIndex o1(s.p0.data(), s.n, one);
+    DisplacementResult r1;
+    displacement_pass(s.p0.data(), s.pt.data(), s.species.data(), s.n, o1, one, r1);
+    for (int c = 0; c < 3; ++c) EXPECT_DOUBLE_EQ(all.chi4[g * 3 + c], r1.chi4[c]);
+  }
+}
+
+TEST(Displacement, NestedGridsShareOneIndex) {
+  // m = 16, 8, 4, 2, 1: only the finest is indexed, the others are sums of
+  // its boxes, and still equal the overlap kernel box by box.
+  const System s = random_system(4096, 64.0, 0.5, 13);
+  DisplacementSpec spec = spec_for(s, {16, 64, 256, 1024, 4096});
+  spec.cutoffs = {0.2, 0.4, 0.6, 0.8, 1.0, 1.2}; // more than four cutoffs: the general rank loop
+  const OriginIndex origin(s.p0.data(), s.n, spec);
+  ASSERT_EQ(origin.indexed_grids(), 1);
+  DisplacementResult r;
+  displacement_pass(s.p0.data(), s.pt.data(), s.species.data(), s.n, origin, spec, r);
+  for (size_t g = 0; g < spec.grids.size(); ++g) {
+    std::vector<double> ref;
+    overlap_subboxes(s.p0.data(), s.pt.data(), s.n, spec.grids[g], spec.cutoffs, ref);
+    const int nb = spec.grids[g].per_side * spec.grids[g].per_side;
+    for (int c = 0; c < 6; ++c)
+      for (int b = 0; b < nb; ++b) EXPECT_DOUBLE_EQ(r.q_r[g * 6 + c][b], ref[c * nb + b]) << g << " " << c;
+  }
+}
+
+TEST(Displacement, NestedGridsFromTargets) {
+  // N = 10^5: ideal sides 63.2, 31.6, 15.8, 7.9, 3.95 and the whole box.
+  const auto g = nested_subbox_grids(100000, 800.0, {400, 25, 100, 1600, 6400, 100000});
+  const int want[] = {16, 64, 32, 8, 4, 1};
+  for (int k = 0; k < 6; ++k) EXPECT_EQ(g[k].per_side, want[k]);
+  EXPECT_DOUBLE_EQ(g[1].mean_particles, 100000.0 / 4096);
+  DisplacementSpec spec;
+  spec.grids = g;
+  spec.cutoffs = {0.6};
+  const std::vector<double> pos(200000, 1.0);
+  EXPECT_EQ(OriginIndex(pos.data(), 100000, spec).indexed_grids(), 1);
+}
+
+TEST(Displacement, ExtremeSubsetsMatchASortedList) {
+  const System s = random_system(2001, 40.0, 1.0, 5);
+  std::vector<double> d2(s.n);
+  for (long i = 0; i < s.n; ++i)
+    d2[i] = std::pow(s.pt[2 * i] - s.p0[2 * i], 2) + std::pow(s.pt[2 * i + 1] - s.p0[2 * i + 1], 2);
+  for (int which : {-1, 0}) {
+    std::vector<double> v;
+    for (long i = 0; i < s.n; ++i)
+      if (which < 0 || s.species[i] == which) v.push_back(d2[i]);
+    std::sort(v.begin(), v.end());
+    const double f = which < 0 ? 0.1 : 0.2; // 10% of all, 20% of small ones
+    const long k = std::lround(f * v.size());
+    const ExtremeMsd e = msd_extremes(d2.data(), s.species.data(), s.n, f, which);
+    EXPECT_EQ(e.count, k);
+    EXPECT_NEAR(e.slow, std::accumulate(v.begin(), v.begin() + k, 0.0) / k, 1e-12);
+    EXPECT_NEAR(e.fast, std::accumulate(v.end() - k, v.end(), 0.0) / k, 1e-12);
+  }
+}

@@ -1,0 +1,119 @@
+// Fits recovering known parameters: Q(t) (eq. 8), OZ forms (eqs. 18, 20),
+// D from the MSD, Gaussian and exponential-tail fits of P(dx, t).
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "dynhet/analysis/fits.hpp"
+
+using namespace dynhet::analysis;
+
+namespace {
+std::vector<double> log_lags(double t0, double t1, int per_decade) {
+  std::vector<double> t;
+  const int n = static_cast<int>(std::round(std::log10(t1 / t0) * per_decade));
+  for (int j = 0; j <= n; ++j) t.push_back(t0 * std::pow(10.0, double(j) / per_decade));
+  return t;
+}
+} // namespace
+
+TEST(Fits, StraightLine) {
+  const LinearFit f = linear_fit({1, 2, 3, 4}, {3, 5, 7, 9});
+  EXPECT_NEAR(f.slope, 2.0, 1e-12);
+  EXPECT_NEAR(f.intercept, 1.0, 1e-12);
+  EXPECT_NEAR(f.chi2, 0.0, 1e-20);
+}
+
+TEST(Fits, OverlapFormRecoversBetaAndTau0) {
+  const std::vector<double> t = log_lags(0.05, 200.0, 8);
+  std::vector<double> q;
+  for (double x : t) q.push_back(1 / (std::pow(x / 2.7, 1.3) + 1));
+  const OverlapFit f = fit_overlap(t, q);
+  EXPECT_NEAR(f.beta, 1.3, 1e-6);
+  EXPECT_NEAR(f.tau0, 2.7, 1e-6);
+}
+
+TEST(Fits, OverlapFormWithNoiseWithinItsErrors) {
+  // Gaussian noise of sd 0.005 on every lag, passed as the errors: the fit
+  // must land within 4 of its own standard deviations.
+  std::mt19937_64 gen(3);
+  std::normal_distribution<double> g(0, 0.005);
+  const std::vector<double> t = log_lags(0.05, 200.0, 8);
+  std::vector<double> q, e(t.size(), 0.005);
+  for (double x : t) q.push_back(1 / (std::pow(x / 5.0, 0.8) + 1) + g(gen));
+  const OverlapFit f = fit_overlap(t, q, e);
+  EXPECT_NEAR(f.beta, 0.8, 4 * f.beta_err);
+  EXPECT_NEAR(f.tau0, 5.0, 4 * f.tau0_err);
+  EXPECT_LT(f.beta_err, 0.02);
+}
+
+TEST(Fits, OrnsteinZernikeOnExactData) {
+  std::vector<double> q, s, s2;
+  for (int k = 1; k <= 40; ++k) {
+    q.push_back(0.025 * k);
+    s.push_back(30.0 / (1 + std::pow(q.back() * 6.0, 2)));
+    const double x2 = std::pow(q.back() * 6.0, 2);
+    s2.push_back(30.0 / (1 + x2 + 0.09 * x2 * x2)); // A = 0.3
+  }
+  const OzFit f = fit_oz(q, s);
+  EXPECT_NEAR(f.xi, 6.0, 1e-6);
+  EXPECT_NEAR(f.chi0, 30.0, 1e-5);
+  EXPECT_TRUE(f.range_ok);
+  EXPECT_LE(f.q_fit_max * f.xi, 1.0 + 1e-9);
+  EXPECT_EQ(f.n, 6); // q = 0.025 k with q xi <= 1: k = 1 .. 6
+  const OzFit g = fit_oz_a2(q, s2);
+  EXPECT_NEAR(g.xi, 6.0, 1e-5);
+  EXPECT_NEAR(g.a, 0.3, 1e-4);
+  EXPECT_NEAR(g.chi0, 30.0, 1e-5);
+}
+
+TEST(Fits, DiffusionCoefficientFromTheLongTimeMsd) {
+  // Ornstein-Uhlenbeck MSD: 4 D (t - tau (1 - e^{-t/tau})): ballistic, then 4 D t - 4 D tau.
+  const double d = 0.05, tau = 0.3;
+  const std::vector<double> t = log_lags(0.01, 1000.0, 8);
+  std::vector<double> msd;
+  for (double x : t) msd.push_back(4 * d * (x - tau * (1 - std::exp(-x / tau))));
+  const double onset = diffusive_onset(t, msd, 0.05);
+  // Brute force: local slopes of the exact curve from the onset on are within 0.05 of 1.
+  EXPECT_GT(onset, 1.0);
+  EXPECT_LT(onset, 10.0);
+  const DiffusionFit f = fit_diffusion(t, msd, onset, 1000.0);
+  // Beyond the onset the curve is 4 D t - 4 D tau up to e^{-t/tau} < e^{-3}.
+  EXPECT_NEAR(f.d, d, 1e-3 * d);
+  EXPECT_NEAR(f.offset, -4 * d * tau, 0.05 * 4 * d * tau);
+}
+
+TEST(Fits, GaussianAndExponentialTailsOfDisplacements) {
+  std::mt19937_64 gen(5);
+  const double t = 2.0, d = 0.1, x0 = 0.4;
+  const double lo = -4, w = 0.05;
+  const int bins = 160, n = 400000;
+  auto histogram = [&](auto&& draw) {
+    std::vector<long> c(bins, 0);
+    for (int k = 0; k < n; ++k) {
+      const int b = static_cast<int>(std::floor((draw() - lo) / w));
+      if (b >= 0 && b < bins) ++c[b];
+    }
+    return c;
+  };
+  std::vector<double> x;
+  for (int b = 0; b < bins; ++b) x.push_back(lo + (b + 0.5) * w);
+  auto density = [&](const std::vector<long>& c) {
+    std::vector<double> p;
+    for (long v : c) p.push_back(v / (double(n) * w));
+    return p;
+  };
+  // Gaussian samples of variance 2 D t: the fit gives D within 4 sigma.
+  std::normal_distribution<double> gauss(0, std::sqrt(2 * d * t));
+  const std::vector<long> cg = histogram([&] { return gauss(gen); });
+  const GaussianFit fg = fit_gaussian_displacement(x, density(cg), cg, t);
+  EXPECT_NEAR(fg.d, d, 4 * fg.d_err + 1e-3 * d); // + bin-width bias (w/sigma)^2/24 < 1e-3
+  // Laplace samples exp(-|x|/x0): the tail fit beyond 2 x0 gives x0 within 4 sigma.
+  std::exponential_distribution<double> ex(1 / x0);
+  std::uniform_int_distribution<int> sign(0, 1);
+  const std::vector<long> cl = histogram([&] { return (sign(gen) ? 1 : -1) * ex(gen); });
+  const ExpTailFit fe = fit_exponential_tail(x, density(cl), cl, 2 * x0);
+  EXPECT_NEAR(fe.x0, x0, 4 * fe.x0_err);
+  EXPECT_LT(fe.x0_err, 0.01 * x0);
+}
