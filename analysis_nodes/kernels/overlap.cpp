@@ -60,7 +60,7 @@ void OverlapAccumulator::add(int k, int j, const double* q_r, int nb) {
   double s = 0, s2 = 0;
   for (int r = 0; r < nb; ++r) s += q_r[r], s2 += q_r[r] * q_r[r];
   const double mean = s / nb;
-  q_[index(k, j)] = mean;              // eq. (5): Q(t;t0) = <Q_r(t;t0)>
+  q_[index(k, j)] = mean;              // eq. (6): Q(t;t0) = <Q_r(t;t0)>
   var_[index(k, j)] = s2 / nb - mean * mean; // <Q_r^2> - <Q_r>^2
 }
 

@@ -16,7 +16,7 @@ struct SubboxGrid {
 };
 SubboxGrid make_subbox_grid(long n_total, double box, int target_particles);
 
-// Paper eq. (4): Q_r(t;t0) = (1/N) sum_{i in B_r at t0} theta(a - |r_i(t0+t) - r_i(t0)|)
+// Paper eq. (5): Q_r(t;t0) = (1/N) sum_{i in B_r at t0} theta(a - |r_i(t0+t) - r_i(t0)|)
 // for every sub-box r (row-major, m*m values) and every cutoff a in one pass
 // over the particles. Positions are unwrapped, x0 y0 x1 y1 ...; a particle
 // belongs to the sub-box holding its position at t0 folded into the box.
@@ -30,7 +30,7 @@ void overlap_subboxes(const double* pos0, const double* pos_t, long n, const Sub
 double crossing_time(const std::vector<double>& t, const std::vector<double>& q, double level);
 
 // Q(t;t0) = <Q_r(t;t0)> per (origin, lag), for one cutoff, and the averages
-// over origins: Q(t) (eq. 6), its standard error, and tau_alpha with a
+// over origins: Q(t) (eq. 7), its standard error, and tau_alpha with a
 // jackknife error over origins.
 class OverlapAccumulator {
 public:
