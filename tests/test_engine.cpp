@@ -43,8 +43,8 @@ Params params(long n, double phi, double eps, bool driving) {
 } // namespace
 
 TEST(Engine, CompressionReachesPhiWithoutOverlap) {
-  for (double phi : {0.5, 0.78}) {
-    Engine e(params(600, phi, 1.0, false));
+  for (auto [n, phi] : {std::pair{600L, 0.5}, {600L, 0.78}, {3000L, 0.76}, {2000L, 0.82}}) {
+    Engine e(params(n, phi, 1.0, false));
     e.prepare();
     EXPECT_NEAR(e.packing_fraction(), phi, 1e-12);
     EXPECT_GE(brute_min_gap(e), 1.0 - 1e-9) << "phi " << phi;

@@ -370,9 +370,10 @@ void Engine::prepare(const std::function<void(double)>& progress) {
   driving_ = false;
   now_ = offset_ = 0;
   thermalize(1.0);
-  clear_events();
+  auto rate = [&] { return packing_fraction() < phi - 0.1 ? 0.01 : 0.002; };
+  grow_ = rate();
+  clear_events(); // predictions know the growth rate of this round
   while (scale0_ < 1.0) {
-    grow_ = packing_fraction() < phi - 0.1 ? 0.01 : 0.002;
     const double t_full = (1.0 - scale0_) / grow_; // radii reach their size
     // About a collision per particle, then back to kinetic energy 1 (growth
     // heats the system) and predict everything again.
@@ -380,7 +381,7 @@ void Engine::prepare(const std::function<void(double)>& progress) {
     const bool reached = run_until(offset_ + t_stop, 2 * n_);
     rebase(); // now_ = 0: scale0_ is the scale reached
     if (reached && t_stop == t_full) scale0_ = 1.0;
-    grow_ = 0.0;
+    grow_ = scale0_ < 1.0 ? rate() : 0.0;
     if (count_.collisions > 20000 * n_)
       throw std::runtime_error("engine: compression stalled at phi = " +
                                std::to_string(packing_fraction()) + " (target " +
@@ -394,6 +395,9 @@ void Engine::prepare(const std::function<void(double)>& progress) {
   for (long i = 0; i < n_; ++i) sync(static_cast<int>(i)), part_[i].t = 0;
   grow_ = 0;
   scale0_ = 1.0;
+  if (const double ov = max_overlap(); ov > 1e-9)
+    throw std::runtime_error("engine: compression left an overlap of " + std::to_string(ov) +
+                             " of a contact distance (a bug)");
 
   // The run proper starts at t = 0 with kinetic energy 1 per particle.
   now_ = offset_ = 0;
