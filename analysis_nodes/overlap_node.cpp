@@ -1,12 +1,17 @@
 // overlap_node: the overlap Q(t), its error bars and tau_alpha, computed
 // live from the frames on DYNHET_FRAME and published on DYNHET_OVERLAP (one
-// message per cutoff a) after every frame that adds a pair. It holds only
-// the origin frames that some later frame still needs.
+// message per cutoff a) after every frame that adds a pair; if the run asks
+// for chi4, also chi4(t) for every listed sub-box size on DYNHET_CHI4, from
+// the same displacements. It holds only the origin frames that some later
+// frame still needs (16 N bytes each, plus 4 N per origin for chi4's
+// sub-box index).
 //
 // Usage: overlap_node [--lcm-url URL] [--publish-url URL]
 // With --lcm-url file://LOG?speed=0 it re-runs the analysis from an
 // lcm-logger log at full speed and publishes on --publish-url.
+#include <algorithm>
 #include <chrono>
+#include <limits>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -16,7 +21,10 @@
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
 
+#include "dynhet/analysis/chi4.hpp"
+#include "dynhet/analysis/displacement.hpp"
 #include "dynhet/analysis/overlap.hpp"
+#include "dynhet/chi4_t.hpp"
 #include "dynhet/chunking.hpp"
 #include "dynhet/frame_chunk_t.hpp"
 #include "dynhet/lcm_url.hpp"
@@ -55,6 +63,7 @@ public:
     status_.state = "running";
     grid_ = an::make_subbox_grid(m->n_particles, m->box_length, m->overlap_subbox_particles);
     for (int c = 0; c < m->n_cutoffs; ++c) acc_.emplace_back(m->n_origins, m->lag_time);
+    if (std::find(m->observables.begin(), m->observables.end(), "chi4") != m->observables.end()) start_chi4(*m);
     // Which origins and which (origin, lag) pairs each frame serves.
     origin_at_.assign(m->n_frames, -1);
     pairs_at_.assign(m->n_frames, {});
@@ -110,6 +119,7 @@ private:
   void on_frame(const dynhet::Frame& f) {
     const int k0 = origin_at_[f.index];
     if (k0 >= 0) origins_[k0] = f.position;
+    if (k0 >= 0 && chi4_) chi4_index_[k0] = std::make_unique<an::OriginIndex>(f.position.data(), info_->n_particles, spec_);
     bool added = false;
     for (const auto& [k, j] : pairs_at_[f.index]) {
       auto it = origins_.find(k);
@@ -118,19 +128,75 @@ private:
                            info_->cutoff_a, qr_);
       const int nb = grid_.per_side * grid_.per_side;
       for (size_t c = 0; c < acc_.size(); ++c) acc_[c].add(k, j, qr_.data() + c * nb, nb);
+      if (chi4_) add_chi4(k, j, it->second, f);
       ++pairs_done_;
       added = true;
     }
     // Drop origins no later frame needs.
     for (auto it = origins_.begin(); it != origins_.end();)
-      it = last_use_[it->first] <= f.index ? origins_.erase(it) : std::next(it);
+      if (last_use_[it->first] <= f.index) {
+        chi4_index_.erase(it->first);
+        it = origins_.erase(it);
+      } else {
+        ++it;
+      }
     last_frame_ = f.index;
     last_time_ = f.time;
     if (added) publish_results(false);
     tick();
   }
 
+  // chi4 for every listed sub-box size (nested grids: one pass, see
+  // displacement.hpp) and every cutoff.
+  void start_chi4(const dynhet::run_info_t& m) {
+    chi4_ = true;
+    spec_.grids = an::nested_subbox_grids(m.n_particles, m.box_length, m.chi4_subbox_particles);
+    spec_.cutoffs = m.cutoff_a;
+    std::sort(spec_.cutoffs.begin(), spec_.cutoffs.end()); // the pass wants them ascending
+    species_.assign(m.species.begin(), m.species.end());
+    for (const auto& g : spec_.grids)
+      for (size_t c = 0; c < spec_.cutoffs.size(); ++c) chi4_acc_.emplace_back(m.n_origins, m.lag_time, g);
+  }
+  void add_chi4(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) {
+    an::displacement_pass(pos0.data(), f.position.data(), species_.data(), info_->n_particles,
+                          *chi4_index_.at(k), spec_, pass_);
+    for (size_t i = 0; i < chi4_acc_.size(); ++i) chi4_acc_[i].add(k, j, pass_.q_r_sum[i], pass_.q_r_sum2[i]);
+  }
+  void publish_chi4(bool final) {
+    const size_t nc = spec_.cutoffs.size(), ng = spec_.grids.size(), nj = info_->lag_time.size();
+    for (size_t c = 0; c < nc; ++c) {
+      dynhet::chi4_t m{};
+      m.utime = utime_now();
+      m.run_id = info_->run_id;
+      m.sim_time = last_time_;
+      m.frame_index = last_frame_;
+      m.is_final = final;
+      m.cutoff_a = spec_.cutoffs[c];
+      m.n_grids = static_cast<int32_t>(ng);
+      m.n_lags = static_cast<int32_t>(nj);
+      m.lag_time = info_->lag_time;
+      for (size_t g = 0; g < ng; ++g) {
+        const auto r = chi4_acc_[g * nc + c].result();
+        // The whole box has one sub-box: its chi4 is N var(Q) over origins.
+        const bool whole = spec_.grids[g].per_side == 1;
+        m.subbox_particles.push_back(spec_.grids[g].mean_particles);
+        m.subbox_per_side.push_back(spec_.grids[g].per_side);
+        const auto& v = whole ? r.chi4_pooled : r.chi4;
+        m.chi4.insert(m.chi4.end(), v.begin(), v.end());
+        if (whole)
+          m.chi4_err.insert(m.chi4_err.end(), nj, std::numeric_limits<double>::quiet_NaN());
+        else
+          m.chi4_err.insert(m.chi4_err.end(), r.chi4_err.begin(), r.chi4_err.end());
+        m.chi4_peak.push_back(r.chi4_peak);
+        m.tau4.push_back(r.tau4);
+      }
+      m.n_values = static_cast<int32_t>(m.chi4.size());
+      out_.publish(dynhet::kChanChi4, &m);
+    }
+  }
+
   void publish_results(bool final) {
+    if (chi4_) publish_chi4(final);
     for (size_t c = 0; c < acc_.size(); ++c) {
       const auto r = acc_[c].result();
       dynhet::overlap_t m{};
@@ -179,6 +245,13 @@ private:
   std::vector<std::vector<std::pair<int, int>>> pairs_at_;
   std::map<int, std::vector<double>> origins_; // origin k -> positions at t0
   std::vector<double> qr_;
+  // chi4 (only if the run asks for it)
+  bool chi4_ = false;
+  an::DisplacementSpec spec_;
+  std::vector<uint8_t> species_;
+  std::vector<an::Chi4Accumulator> chi4_acc_; // [grid * n_cutoffs + cutoff], cutoffs ascending
+  std::map<int, std::unique_ptr<an::OriginIndex>> chi4_index_;
+  an::DisplacementResult pass_;
   dynhet::FrameAssembler assembler_;
   dynhet::node_status_t status_{};
   Clock::time_point last_status_ = Clock::now();

@@ -94,8 +94,21 @@ std::string known_keys(const Table& t) {
 } // namespace
 
 const std::vector<std::string>& known_observables() {
-  static const std::vector<std::string> v{"overlap"};
+  static const std::vector<std::string> v{"overlap", "chi4"};
   return v;
+}
+
+std::string node_of(const std::string& observable) {
+  return observable == "chi4" ? "overlap" : observable;
+}
+
+std::vector<std::string> nodes_for(const std::vector<std::string>& observables) {
+  std::vector<std::string> nodes;
+  for (const auto& o : observables) {
+    const std::string n = node_of(o) + "_node";
+    if (std::find(nodes.begin(), nodes.end(), n) == nodes.end()) nodes.push_back(n);
+  }
+  return nodes;
 }
 
 bool Scene::wants(const std::string& o) const {
@@ -246,6 +259,20 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
   };
   schema["overlap"] = {
       {"subbox_particles", int_in(s.overlap_subbox_particles, 1, int64_t(1) << 31)},
+  };
+  schema["chi4"] = {
+      {"subbox_particles",
+       [&](const std::string& key, const toml::node& n) {
+         const auto* arr = n.as_array();
+         if (!arr || arr->empty()) return c.bad_type(key, n, "a non-empty array of integers");
+         s.chi4_subbox_particles.clear();
+         for (const auto& e : *arr) {
+           int64_t v;
+           if (!c.get_int(key, e, v)) return;
+           if (v < 1) return c.bad_value(key, e, "every size must be >= 1 particle per sub-box");
+           s.chi4_subbox_particles.push_back(static_cast<int>(std::min<int64_t>(v, 1 << 30)));
+         }
+       }},
   };
   schema["transport"] = {
       {"chunk_particles", int_in(s.chunk_particles, 1, 65000)}, // 16 B each: < 1 MiB

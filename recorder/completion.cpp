@@ -3,11 +3,13 @@
 #include <algorithm>
 #include <cstdio>
 
+#include "dynhet/scene.hpp"
+
 namespace dynhet {
 
 namespace {
 // Observables whose result messages the recorder knows how to write.
-bool recordable(const std::string &observable) { return observable == "overlap"; }
+bool recordable(const std::string &observable) { return observable == "overlap" || observable == "chi4"; }
 } // namespace
 
 std::string cutoff_label(double cutoff_a) {
@@ -18,9 +20,9 @@ std::string cutoff_label(double cutoff_a) {
 
 Completion::Completion(const std::vector<std::string> &observables, const std::vector<double> &cutoffs)
     : observables_(observables) {
-  const bool overlap = std::find(observables.begin(), observables.end(), "overlap") != observables.end();
-  if (overlap)
-    for (double a : cutoffs) cutoffs_.push_back(cutoff_label(a));
+  for (const std::string &obs : observables)
+    if (recordable(obs))
+      for (double a : cutoffs) expected_finals_.push_back(obs + " " + cutoff_label(a));
 }
 
 void Completion::sim_phase(const std::string &phase, const std::string &message) {
@@ -37,14 +39,13 @@ void Completion::frames(int lost, int expected) {
 }
 
 std::string Completion::state_of(const std::string &node) const {
-  auto it = node_state_.find(node);
+  auto it = node_state_.find(node_of(node)); // the node serving this observable
   return it == node_state_.end() ? "never heard from" : it->second;
 }
 
 bool Completion::finals_complete(const std::string &observable) const {
-  if (observable != "overlap") return true;
-  for (const std::string &c : cutoffs_)
-    if (!finals_.count(c)) return false;
+  for (const std::string &f : expected_finals_)
+    if (f.rfind(observable + " ", 0) == 0 && !finals_.count(f)) return false;
   return true;
 }
 
@@ -67,8 +68,8 @@ std::vector<std::string> Completion::missing() const {
     const std::string state = state_of(obs);
     if (state != "done") out.push_back(obs + " node: " + state);
   }
-  for (const std::string &c : cutoffs_)
-    if (!finals_.count(c)) out.push_back("overlap " + c + ": no final result");
+  for (const std::string &f : expected_finals_)
+    if (!finals_.count(f)) out.push_back(f + ": no final result");
   if (frames_lost_ > 0)
     out.push_back("frames: " + std::to_string(frames_lost_) + " of " + std::to_string(frames_expected_) +
                   " lost by the recorder");

@@ -17,12 +17,16 @@ std::string cutoff_label(double cutoff_a);
 class Completion {
 public:
   Completion() = default;
-  // The observables the run names and, for the overlap, its cutoffs.
+  // The observables the run names and the cutoffs (one final result of
+  // each observable per cutoff).
   Completion(const std::vector<std::string> &observables, const std::vector<double> &cutoffs);
 
   void sim_phase(const std::string &phase, const std::string &message);
   void node_state(const std::string &node, const std::string &state);
-  void final_overlap(double cutoff_a) { finals_.insert(cutoff_label(cutoff_a)); }
+  // A final result of `observable` ("overlap", "chi4") for one cutoff.
+  void final_result(const std::string &observable, double cutoff_a) {
+    finals_.insert(observable + " " + cutoff_label(cutoff_a));
+  }
   void frames(int lost, int expected);
 
   // The sim has said done or failed.
@@ -37,7 +41,7 @@ public:
 
 private:
   std::vector<std::string> observables_;
-  std::vector<std::string> cutoffs_; // labels
+  std::vector<std::string> expected_finals_; // "overlap a0.6", ...
   std::string phase_ = "unknown", sim_message_;
   std::map<std::string, std::string> node_state_;
   std::set<std::string> finals_;

@@ -22,6 +22,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "dynhet/lcm_url.hpp"
+#include "dynhet/scene.hpp"
 #include "run_recorder.hpp"
 
 namespace {
@@ -78,6 +79,9 @@ private:
   void on_overlap(const lcm::ReceiveBuffer *, const std::string &, const dynhet::overlap_t *m) {
     if (rec_.on_overlap(*m)) last_progress_ = Clock::now();
   }
+  void on_chi4(const lcm::ReceiveBuffer *, const std::string &, const dynhet::chi4_t *m) {
+    if (rec_.on_chi4(*m)) last_progress_ = Clock::now();
+  }
   void on_frame(const lcm::ReceiveBuffer *, const std::string &, const dynhet::frame_chunk_t *m) {
     rec_.on_frame_chunk(*m);
   }
@@ -99,6 +103,7 @@ void Session::subscribe() {
   }
   lcm_.subscribe(dynhet::kChanNodeStatus, &Session::on_node, this)->setQueueCapacity(1000);
   lcm_.subscribe(dynhet::kChanOverlap, &Session::on_overlap, this)->setQueueCapacity(10000);
+  lcm_.subscribe(dynhet::kChanChi4, &Session::on_chi4, this)->setQueueCapacity(10000);
   // The launch scripts wait for this line before starting the sim.
   std::fprintf(stderr, "recorder: ready, waiting for run info%s%s\n", log_ ? " in " : "",
                log_ ? opt_.from_log.c_str() : "");
@@ -215,7 +220,7 @@ int list_nodes(const std::string &log_path) {
     dynhet::run_info_t run;
     if (e->channel != dynhet::kChanRun || !decode(*e, run)) continue;
     std::string line;
-    for (const std::string &obs : run.observables) line += (line.empty() ? "" : " ") + obs + "_node";
+    for (const std::string &n : dynhet::nodes_for(run.observables)) line += (line.empty() ? "" : " ") + n;
     std::printf("%s\n", line.c_str());
     return 0;
   }

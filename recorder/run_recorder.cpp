@@ -140,8 +140,37 @@ void RunRecorder::write_node(const node_status_t &m) {
 bool RunRecorder::on_overlap(const overlap_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
   guarded("overlap", [&] { write_overlap(m); });
-  if (m.is_final) completion_.final_overlap(m.cutoff_a);
+  if (m.is_final) completion_.final_result("overlap", m.cutoff_a);
   return true;
+}
+
+bool RunRecorder::on_chi4(const chi4_t &m) {
+  if (!info_ || m.run_id != info_->run_id) return false;
+  guarded("chi4", [&] { write_chi4(m); });
+  if (m.is_final) completion_.final_result("chi4", m.cutoff_a);
+  return true;
+}
+
+// chi4/a<cutoff>/{chi4, chi4_err}: value (records, grids, lags) flattened to
+// (records, grids * lags); chi4_peak, tau4: (records, grids).
+void RunRecorder::write_chi4(const chi4_t &m) {
+  const std::string label = cutoff_label(m.cutoff_a);
+  const std::string base = "chi4/" + label + "/";
+  if (!chi4_started_[label]) {
+    writer_->write_fixed(base + "lag_time", m.lag_time);
+    writer_->write_fixed(base + "subbox_particles", m.subbox_particles);
+    writer_->write_fixed(base + "subbox_per_side", m.subbox_per_side);
+    writer_->set_attribute("observables/" + base, "cutoff_a", m.cutoff_a);
+    writer_->set_attribute("observables/" + base, "layout", "value[record][grid * n_lags + lag]");
+    chi4_started_[label] = true;
+  }
+  if (m.n_values <= 0) return;
+  const int64_t step = m.frame_index;
+  const double t = m.sim_time;
+  writer_->append_observable(base + "chi4", step, t, m.chi4);
+  writer_->append_observable(base + "chi4_err", step, t, m.chi4_err);
+  writer_->append_observable(base + "chi4_peak", step, t, m.chi4_peak);
+  writer_->append_observable(base + "tau4", step, t, m.tau4);
 }
 
 void RunRecorder::write_overlap(const overlap_t &m) {

@@ -77,6 +77,8 @@ dynhet::run_info_t make_run_info(const dynhet::Scene& sc, const dynhet::engine::
   m.observables = sc.observables;
   m.n_observables = static_cast<int32_t>(m.observables.size());
   m.overlap_subbox_particles = sc.overlap_subbox_particles;
+  m.chi4_subbox_particles = sc.chi4_subbox_particles;
+  m.n_chi4_sizes = static_cast<int32_t>(m.chi4_subbox_particles.size());
   m.keep_frames = sc.keep_frames;
   m.chunk_particles = sc.chunk_particles;
   m.scene_toml = sc.text;
@@ -195,7 +197,7 @@ int main(int argc, char** argv) {
     const auto sched = dynhet::make_schedule(scene.schedule, scene.equilibration_time);
     std::printf("scene %s: valid\n", scene_path.c_str());
     std::printf("nodes:");
-    for (const auto& o : scene.observables) std::printf(" %s_node", o.c_str());
+    for (const auto& n : dynhet::nodes_for(scene.observables)) std::printf(" %s", n.c_str());
     std::printf("\nframes: %zu\nparticles: %lld\nsim_time: %g\n", sched.frame_time.size(),
                 static_cast<long long>(scene.n_particles), scene.equilibration_time + scene.production_time);
     return 0;

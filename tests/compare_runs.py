@@ -16,6 +16,9 @@ def final_results(path):
         for name, g in f["observables/overlap"].items():
             for obs in ("q", "q_err", "qr_var", "tau_alpha", "tau_alpha_err"):
                 out[f"{name}/{obs}"] = np.atleast_1d(g[obs]["value"][-1])
+        for name, g in f.get("observables/chi4", {}).items():
+            for obs in ("chi4", "chi4_err", "chi4_peak", "tau4"):
+                out[f"chi4/{name}/{obs}"] = np.atleast_1d(g[obs]["value"][-1])
         lost = int(f["observables/nodes/overlap/frames_lost/value"][-1])
         return out, lost
 

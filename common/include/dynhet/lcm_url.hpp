@@ -21,5 +21,6 @@ inline constexpr const char* kChanFrame = "DYNHET_FRAME";
 inline constexpr const char* kChanSimStatus = "DYNHET_SIM_STATUS";
 inline constexpr const char* kChanNodeStatus = "DYNHET_NODE_STATUS";
 inline constexpr const char* kChanOverlap = "DYNHET_OVERLAP";
+inline constexpr const char* kChanChi4 = "DYNHET_CHI4";
 
 } // namespace dynhet

@@ -50,7 +50,7 @@ struct Scene {
   // The engine synchronises every particle at multiples of this time (and
   // writes a checkpoint there when asked), so that a resumed run goes on
   // bit for bit like the uninterrupted one.
-  double checkpoint_interval = 50.0;
+  double checkpoint_interval = 10.0;
 
   ScheduleSpec schedule;
 
@@ -61,6 +61,9 @@ struct Scene {
 
   // [overlap]
   int overlap_subbox_particles = 100; // target N = <N_r> per sub-box
+
+  // [chi4]: target N = <N_r> of each sub-box grid; >= n_particles is the whole box
+  std::vector<int> chi4_subbox_particles{25, 100, 400, 1600, 6400, 1 << 30};
 
   // [transport]
   int chunk_particles = 8192; // 16 bytes each: 128 KiB of positions
@@ -75,5 +78,12 @@ Scene parse_scene_file(const std::string& path);
 
 // Observables this build knows how to compute.
 const std::vector<std::string>& known_observables();
+
+// The node that computes an observable: Q(t) and chi4(t) come from the same
+// pass over the displacements of the same (origin, lag) pairs, so one node,
+// "overlap", serves both (half the work and one copy of the frames).
+std::string node_of(const std::string& observable);
+// The executables a list of observables needs ("overlap_node", ...), each once.
+std::vector<std::string> nodes_for(const std::vector<std::string>& observables);
 
 } // namespace dynhet

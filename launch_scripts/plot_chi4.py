@@ -1,0 +1,52 @@
+#!/usr/bin/python3
+"""Plot chi4(t) of a dynhet run (HDF5, H5MD layout): one panel per cutoff a,
+one curve per sub-box size N, the peak chi4^P at tau4 marked.
+
+Usage: plot_chi4.py RUN.h5 OUT.png
+"""
+import math
+import sys
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def main(path, png):
+    with h5py.File(path, "r") as f:
+        if "observables/chi4" not in f:
+            print(f"plot_chi4: {path} has no chi4 results", file=sys.stderr)
+            return 1
+        groups = sorted(f["observables/chi4"].items())
+        fig, axes = plt.subplots(1, len(groups), figsize=(6.0 * len(groups), 4.4), squeeze=False)
+        for ax, (name, g) in zip(axes[0], groups):
+            t = g["lag_time"][()]
+            sizes = g["subbox_particles"][()]
+            chi = g["chi4"]["value"][-1].reshape(len(sizes), len(t))
+            err = g["chi4_err"]["value"][-1].reshape(len(sizes), len(t))
+            peak, tau4 = g["chi4_peak"]["value"][-1], g["tau4"]["value"][-1]
+            for i, n in enumerate(sizes):
+                line = ax.errorbar(t, chi[i], yerr=np.nan_to_num(err[i]), marker="o", ms=2.5, capsize=2,
+                                   label=f"N = {n:.0f}")
+                if math.isfinite(tau4[i]):
+                    ax.plot([tau4[i]], [peak[i]], "*", ms=10, color=line[0].get_color())
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            ax.set_xlabel("t")
+            ax.set_ylabel(r"$\chi_4(t)$")
+            ax.set_title(f"a = {g.attrs.get('cutoff_a', name)} (star: peak at $\\tau_4$)", fontsize=10)
+            ax.legend(fontsize=7)
+        fig.tight_layout()
+        fig.savefig(png, dpi=120)
+    print(f"plot_chi4: wrote {png}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3:
+        print(__doc__, file=sys.stderr)
+        sys.exit(2)
+    sys.exit(main(sys.argv[1], sys.argv[2]))
