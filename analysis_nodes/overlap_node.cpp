@@ -35,12 +35,9 @@
 
 namespace {
 
+using dynhet::utime_now;
+
 using Clock = std::chrono::steady_clock;
-int64_t utime_now() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
-}
 
 namespace an = dynhet::analysis;
 

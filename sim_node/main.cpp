@@ -33,17 +33,14 @@
 
 namespace {
 
+using dynhet::utime_now;
+
 std::atomic<int> g_signal{0};
 void on_signal(int s) { g_signal = s; }
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
-}
-int64_t utime_now() {
-  return std::chrono::duration_cast<std::chrono::microseconds>(
-             std::chrono::system_clock::now().time_since_epoch())
-      .count();
 }
 
 std::string hms(double s) {

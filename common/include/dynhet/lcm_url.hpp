@@ -2,6 +2,8 @@
 // project's default. ttl=0 keeps every packet on this host.
 #pragma once
 
+#include <chrono>
+#include <cstdint>
 #include <cstdlib>
 #include <string>
 
@@ -13,6 +15,13 @@ inline std::string resolve_lcm_url(const std::string& flag) {
   if (!flag.empty()) return flag;
   if (const char* env = std::getenv("LCM_DEFAULT_URL"); env && *env) return env;
   return kDefaultLcmUrl;
+}
+
+// LCM's utime: microseconds since the epoch.
+inline int64_t utime_now() {
+  return std::chrono::duration_cast<std::chrono::microseconds>(
+             std::chrono::system_clock::now().time_since_epoch())
+      .count();
 }
 
 // Channel names.
