@@ -23,6 +23,8 @@
 
 #include "dynhet/analysis/chi4.hpp"
 #include "dynhet/analysis/displacement.hpp"
+#include "dynhet/analysis/fits.hpp"
+#include "dynhet/analysis/timescales.hpp"
 #include "dynhet/analysis/overlap.hpp"
 #include "dynhet/chi4_t.hpp"
 #include "dynhet/chunking.hpp"
@@ -143,6 +145,27 @@ private:
     tick();
   }
 
+  // Q(t) = 1/((t/tau0)^beta + 1), weighted by the errors if every lag has one.
+  void fit_q(const an::OverlapAccumulator::Result& r, dynhet::overlap_t& m) const {
+    m.beta = m.beta_err = m.tau0 = m.tau0_err = std::numeric_limits<double>::quiet_NaN();
+    std::vector<double> t, q, e;
+    bool weighted = true;
+    for (size_t j = 0; j < r.q.size(); ++j) {
+      if (std::isnan(r.q[j])) continue;
+      t.push_back(info_->lag_time[j]);
+      q.push_back(r.q[j]);
+      e.push_back(r.q_err[j]);
+      weighted = weighted && std::isfinite(r.q_err[j]) && r.q_err[j] > 0;
+    }
+    if (t.size() < 4) return;
+    try {
+      const auto f = an::fit_overlap(t, q, weighted ? e : std::vector<double>{});
+      m.beta = f.beta, m.beta_err = f.beta_err, m.tau0 = f.tau0, m.tau0_err = f.tau0_err;
+    } catch (const std::exception&) {
+      // not converged yet: NaN
+    }
+  }
+
   // chi4 for every listed sub-box size (nested grids: one pass, see
   // displacement.hpp) and every cutoff.
   void start_chi4(const dynhet::run_info_t& m) {
@@ -213,6 +236,10 @@ private:
       m.qr_var = r.qr_var;
       m.tau_alpha = r.tau_alpha;
       m.tau_alpha_err = r.tau_alpha_err;
+      fit_q(r, m);
+      for (int k = 0; k < info_->n_origins; ++k) m.t0.push_back(info_->frame_time[info_->origin_frame[k]]);
+      m.tau_alpha_t0 = an::tau_alpha_per_origin(acc_[c], info_->lag_time, info_->n_origins);
+      m.n_t0 = static_cast<int32_t>(m.t0.size());
       out_.publish(dynhet::kChanOverlap, &m);
       if (final)
         std::fprintf(stderr, "overlap_node: a=%g tau_alpha=%.5g +- %.2g (%d pairs)\n", m.cutoff_a,

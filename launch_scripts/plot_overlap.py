@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Plot the overlap Q(t) of a dynhet run (HDF5, H5MD layout) with its error
-bars, the 1/e line and tau_alpha, one curve per cutoff a.
+bars, the 1/e line, tau_alpha and the fit 1/((t/tau0)^beta + 1), one curve
+per cutoff a; beside it tau_alpha against the waiting time t0 (aging check).
 
 Usage: plot_overlap.py RUN.h5 OUT.png
 """
@@ -25,7 +26,7 @@ def main(path, png):
         if "observables/overlap" not in f:
             print(f"plot_overlap: {path} has no overlap results", file=sys.stderr)
             return 1
-        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.4), gridspec_kw={"width_ratios": [3, 2]})
         for name, g in sorted(f["observables/overlap"].items()):
             t = g["lag_time"][()]
             q, err = last(g, "q"), last(g, "q_err")
@@ -35,8 +36,18 @@ def main(path, png):
             if math.isfinite(tau):
                 label += rf", $\tau_\alpha$ = {tau:.4g}" + (f" ± {tau_err:.2g}" if math.isfinite(tau_err) else "")
             line = ax.errorbar(t, q, yerr=np.nan_to_num(err), marker="o", ms=3, capsize=2, label=label)
+            color = line[0].get_color()
             if math.isfinite(tau):
-                ax.axvline(tau, color=line[0].get_color(), ls=":", lw=1)
+                ax.axvline(tau, color=color, ls=":", lw=1)
+            if "beta" in g and math.isfinite(last(g, "beta")):
+                beta, tau0 = last(g, "beta"), last(g, "tau0")
+                tt = np.geomspace(t[0], t[-1], 200)
+                ax.plot(tt, 1 / ((tt / tau0) ** beta + 1), "--", color=color, lw=1,
+                        label=rf"fit $\beta$ = {beta:.3g}, $\tau_0$ = {tau0:.3g}")
+            if "tau_alpha_t0" in g:
+                ax2.plot(g["t0"][()], last(g, "tau_alpha_t0"), "o-", ms=3, color=color, label=label.split(",")[0])
+                if math.isfinite(tau):
+                    ax2.axhline(tau, color=color, ls=":", lw=1)
         ax.axhline(math.exp(-1), color="gray", ls="--", lw=1, label="1/e")
         ax.set_xscale("log")
         ax.set_xlabel("t")
@@ -49,6 +60,10 @@ def main(path, png):
             title += " (" + ", ".join(bits) + ")"
         ax.set_title(title, fontsize=10)
         ax.legend(fontsize=8)
+        ax2.set_xlabel("waiting time $t_0$")
+        ax2.set_ylabel(r"$\tau_\alpha(t_0)$")
+        ax2.set_title("aging check: flat if stationary", fontsize=10)
+        ax2.legend(fontsize=8)
         fig.tight_layout()
         fig.savefig(png, dpi=120)
     print(f"plot_overlap: wrote {png}", file=sys.stderr)

@@ -192,6 +192,15 @@ void RunRecorder::write_overlap(const overlap_t &m) {
   writer_->append_observable(base + "qr_var", step, t, m.qr_var);
   writer_->append_observable(base + "tau_alpha", step, t, &m.tau_alpha, 1);
   writer_->append_observable(base + "tau_alpha_err", step, t, &m.tau_alpha_err, 1);
+  writer_->append_observable(base + "beta", step, t, &m.beta, 1);
+  writer_->append_observable(base + "beta_err", step, t, &m.beta_err, 1);
+  writer_->append_observable(base + "tau0", step, t, &m.tau0, 1);
+  writer_->append_observable(base + "tau0_err", step, t, &m.tau0_err, 1);
+  if (m.n_t0 > 0) {
+    if (!overlap_t0_written_[label]) writer_->write_fixed(base + "t0", m.t0);
+    overlap_t0_written_[label] = true;
+    writer_->append_observable(base + "tau_alpha_t0", step, t, m.tau_alpha_t0);
+  }
 }
 
 bool RunRecorder::on_frame_chunk(const frame_chunk_t &m) {

@@ -93,6 +93,7 @@ private:
   std::map<std::string, Node> nodes_;
   std::map<std::string, bool> overlap_started_; // by cutoff label
   std::map<std::string, bool> chi4_started_;    // by cutoff label
+  std::map<std::string, bool> overlap_t0_written_;
   std::optional<int64_t> node_clock_zero_;      // utime of the first node status
   int write_errors_ = 0;
 

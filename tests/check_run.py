@@ -111,6 +111,19 @@ def main(path, scene_path):
         check(math.isfinite(tau) and abs(tau - tau_bf) <= 1e-9 * tau_bf,
               f"{name}: tau_alpha {tau:.6g} (brute force {tau_bf:.6g})")
         check(np.all(np.diff(q_bf) <= 0.05), f"{name}: Q(t) decays")
+        tau_t0 = g["tau_alpha_t0"]["value"][-1]
+        tau_t0_bf = np.array([crossing_time(lag, q_k[k], math.exp(-1)) for k in range(len(origin_frame))])
+        same = np.allclose(tau_t0, tau_t0_bf, rtol=1e-9, atol=0, equal_nan=True)
+        check(same, f"{name}: tau_alpha(t0) per origin equals brute force")
+        beta, tau0 = float(g["beta"]["value"][-1]), float(g["tau0"]["value"][-1])
+        # The fit (unweighted here: early lags have zero error) is a least-squares
+        # minimum: nudging either parameter by 0.1% does not lower the residual.
+        def sse(b_, t_):
+            return np.sum((q_bf - 1 / ((lag / t_) ** b_ + 1)) ** 2)
+        best = sse(beta, tau0)
+        nudged = min(sse(beta * f1, tau0 * f2) for f1 in (0.999, 1, 1.001) for f2 in (0.999, 1, 1.001)
+                     if (f1, f2) != (1, 1))
+        check(best <= nudged * (1 + 1e-9), f"{name}: fit beta={beta:.4g} tau0={tau0:.4g} is a least-squares minimum")
     if "observables/chi4" in f:
         check_chi4(f, unwrapped, L, origin_frame, pair_frame)
     if failures:

@@ -14,7 +14,7 @@ def final_results(path):
     with h5py.File(path, "r") as f:
         out = {}
         for name, g in f["observables/overlap"].items():
-            for obs in ("q", "q_err", "qr_var", "tau_alpha", "tau_alpha_err"):
+            for obs in ("q", "q_err", "qr_var", "tau_alpha", "tau_alpha_err", "beta", "tau0", "tau_alpha_t0"):
                 out[f"{name}/{obs}"] = np.atleast_1d(g[obs]["value"][-1])
         for name, g in f.get("observables/chi4", {}).items():
             for obs in ("chi4", "chi4_err", "chi4_peak", "tau4"):
