@@ -52,11 +52,19 @@ public:
 
   bool finished() const { return finished_; }
   bool has_run() const { return info_ != nullptr; }
+  // The sim publishes its status every second; silence longer than
+  // `timeout` (not after a checkpointed interruption) means it died.
+  void check_sim_alive(double timeout) {
+    if (!info_ || finished_ || sim_interrupted_) return;
+    const double silent = std::chrono::duration<double>(Clock::now() - last_sim_news_).count();
+    if (silent > timeout) finish(1, "the sim has been silent for " + std::to_string(static_cast<int>(silent)) + " s");
+  }
   int exit_code() const { return exit_code_; }
 
   void on_run(const lcm::ReceiveBuffer*, const std::string&, const dynhet::run_info_t* m) {
     if (info_ || (run_filter_ && m->run_id != run_filter_)) return;
     info_ = std::make_unique<dynhet::run_info_t>(*m);
+    last_sim_news_ = Clock::now();
     status_.run_id = m->run_id;
     status_.frames_expected = m->n_frames;
     status_.state = "running";
@@ -83,6 +91,7 @@ public:
 
   void on_chunk(const lcm::ReceiveBuffer*, const std::string&, const dynhet::frame_chunk_t* m) {
     if (!info_ || m->run_id != info_->run_id || m->n_values != 2 * m->count) return;
+    last_sim_news_ = Clock::now();
     const dynhet::ChunkHeader h{m->frame_index, m->time,           m->n_particles, m->chunk_index,
                                 m->chunk_count, m->first_particle, m->count};
     auto frame = assembler_.add(h, m->position.data());
@@ -91,6 +100,8 @@ public:
 
   void on_sim_status(const lcm::ReceiveBuffer*, const std::string&, const dynhet::sim_status_t* m) {
     if (!info_ || m->run_id != info_->run_id || finished_) return;
+    last_sim_news_ = Clock::now();
+    sim_interrupted_ = m->phase == "interrupted"; // checkpointed: wait for --resume
     if (m->phase == "done") finish(0, "");
     if (m->phase == "failed") finish(1, "sim failed: " + m->message);
   }
@@ -279,6 +290,8 @@ private:
   dynhet::FrameAssembler assembler_;
   dynhet::node_status_t status_{};
   Clock::time_point last_status_ = Clock::now();
+  Clock::time_point last_sim_news_ = Clock::now();
+  bool sim_interrupted_ = false;
   int pairs_done_ = 0, last_frame_ = -1;
   double last_time_ = 0;
   bool finished_ = false;
@@ -296,6 +309,8 @@ int main(int argc, char** argv) {
   app.add_option("--publish-url", publish_url, "LCM URL to publish on (default: the input bus)");
   app.add_option("--run-id", run_id, "only this run (default: the first one seen)");
   app.add_option("--wait-run", wait_run, "give up after this many seconds without run info");
+  double sim_timeout = 60;
+  app.add_option("--sim-timeout", sim_timeout, "give up if the sim is silent this long (s) during a run");
   CLI11_PARSE(app, argc, argv);
 
   const std::string in_url = dynhet::resolve_lcm_url(url);
@@ -322,6 +337,7 @@ int main(int argc, char** argv) {
       break;
     }
     node.tick();
+    if (!replay) node.check_sim_alive(sim_timeout);
     if (!node.has_run() && std::chrono::duration<double>(Clock::now() - start).count() > wait_run) {
       std::fprintf(stderr, "overlap_node: no run info on %s within %g s\n", in_url.c_str(), wait_run);
       return 4;

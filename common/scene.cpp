@@ -5,6 +5,8 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <iomanip>
+#include <limits>
 #include <sstream>
 
 #include <toml++/toml.h>
@@ -29,6 +31,10 @@ const char* type_name(const toml::node& n) {
 std::string show(const toml::node& n) {
   std::ostringstream s;
   if (n.is_table()) return "{...}";
+  if (auto d = n.value_exact<double>()) {
+    s << std::setprecision(12) << *d; // 0.9, not 0.90000000000000002
+    return s.str();
+  }
   n.visit([&](auto&& v) { s << v; });
   return s.str();
 }
@@ -175,7 +181,7 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
 
   std::map<std::string, Table> schema;
   schema["system"] = {
-      {"n_particles", int_in(s.n_particles, 2, int64_t(1) << 31)},
+      {"n_particles", int_in(s.n_particles, 2, std::numeric_limits<int32_t>::max())},
       {"packing_fraction",
        [&](const std::string& key, const toml::node& n) {
          double v;
@@ -234,6 +240,8 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
            auto v = e.value_exact<std::string>();
            if (!v) return c.bad_type(key, e, "a string");
            const auto& known = known_observables();
+           if (std::find(s.observables.begin(), s.observables.end(), *v) != s.observables.end())
+             return c.bad_value(key, e, "each observable may be named once");
            if (std::find(known.begin(), known.end(), *v) == known.end()) {
              std::string list;
              for (const auto& k : known) list += (list.empty() ? "" : ", ") + k;
@@ -251,6 +259,8 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
            double v;
            if (!c.get_double(key, e, v)) return;
            if (v <= 0) return c.bad_value(key, e, "every cutoff a must be > 0");
+           if (std::find(s.cutoff_a.begin(), s.cutoff_a.end(), v) != s.cutoff_a.end())
+             return c.bad_value(key, e, "each cutoff may be listed once");
            s.cutoff_a.push_back(v);
          }
        }},
@@ -258,7 +268,7 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
        [&](const std::string& key, const toml::node& n) { c.get_bool(key, n, s.keep_frames); }},
   };
   schema["overlap"] = {
-      {"subbox_particles", int_in(s.overlap_subbox_particles, 1, int64_t(1) << 31)},
+      {"subbox_particles", int_in(s.overlap_subbox_particles, 1, std::numeric_limits<int32_t>::max())},
   };
   schema["chi4"] = {
       {"subbox_particles",
@@ -310,6 +320,12 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
     c.fail("schedule.lag_min", "value " + std::to_string(sch.lag_min) +
                                    " must be smaller than schedule.lag_max = " +
                                    std::to_string(sch.lag_max));
+  // Every (origin, lag) pair is a frame to publish and a pass to make.
+  const double n_lags = std::floor(std::log10(sch.lag_max / sch.lag_min) * sch.lags_per_decade) + 2;
+  if (sch.lag_min < sch.lag_max && sch.origins * n_lags > 2e7)
+    c.fail("schedule", "origins x lags = " + std::to_string(sch.origins) + " x " +
+                           std::to_string(static_cast<long>(n_lags)) +
+                           " pairs is more than 2e7; use fewer origins or lags per decade");
   const double needed = (sch.origins - 1) * sch.origin_spacing + sch.lag_max;
   if (s.production_time < 0) {
     s.production_time = needed;

@@ -89,7 +89,16 @@ set +e
 "$bin/sim_node" "$scene" --checkpoint "$out/checkpoint.h5" 2> >(tee "$out/sim_node.log" >&2)
 sim_rc=$?
 set -e
-[[ $sim_rc -eq 0 ]] || echo "run_scene: sim_node failed (exit $sim_rc)" >&2
+if [[ $sim_rc -ne 0 ]]; then
+  echo "run_scene: sim_node failed (exit $sim_rc); giving the others 15 s to finish" >&2
+  for _ in $(seq 150); do
+    alive=0
+    for p in "${pids[@]}"; do kill -0 "$p" 2>/dev/null && alive=1; done
+    ((alive)) || break
+    sleep 0.1
+  done
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+fi
 
 status=$sim_rc
 for i in "${!pids[@]}"; do

@@ -218,6 +218,7 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "\nsim_node: %s\n", why.c_str());
   };
 
+  bool checkpoint_written = !resume_path.empty();
   try {
     dynhet::engine::Params p;
     p.n_particles = scene.n_particles;
@@ -272,6 +273,7 @@ int main(int argc, char** argv) {
     int next_frame = resumed.next_frame;
     auto checkpoint = [&] {
       dynhet::write_checkpoint(checkpoint_path, {scene.text, run_id, next_frame, eng.state()});
+      checkpoint_written = true;
     };
     bool announced = false;
 
@@ -374,7 +376,7 @@ int main(int argc, char** argv) {
                  rep.msg().reduced_pressure, rep.msg().reduced_pressure_err, rep.msg().collision_frequency,
                  rep.msg().collision_frequency_err, static_cast<long long>(eng.counters().tc));
   } catch (const std::exception& e) {
-    if (g_signal && !checkpoint_path.empty()) rep.msg().phase = "interrupted"; // nodes wait for --resume
+    if (g_signal && checkpoint_written) rep.msg().phase = "interrupted"; // nodes wait for --resume
     fail(e.what());
     return g_signal ? 128 + g_signal : 1;
   }

@@ -72,6 +72,14 @@ TEST(Scene, ImpossibleValuesAreRefused) {
   expect_error("[observables]\ncutoff_a = [0.6, -1]\n", {"observables.cutoff_a", "-1"});
   expect_error("[driving]\nkick_rate = \"fast\"\n", {"driving.kick_rate", "enskog"});
   expect_error("[transport]\nchunk_particles = 100000\n", {"transport.chunk_particles", "65000"});
+  expect_error("[observables]\ncutoff_a = [0.6, 0.6]\n", {"observables.cutoff_a", "once"});
+  expect_error("[observables]\ncompute = [\"overlap\", \"overlap\"]\n", {"observables.compute", "once"});
+  expect_error("[system]\nn_particles = 2147483648\n", {"system.n_particles", "2147483647"});
+  expect_error("[overlap]\nsubbox_particles = 2147483648\n", {"overlap.subbox_particles"});
+  expect_error("[schedule]\norigins = 1000000\nlags_per_decade = 1000\nlag_min = 1e-9\nlag_max = 1e9\n",
+               {"schedule", "more than 2e7"});
+  // Values are shown as written, not as the nearest double's long expansion.
+  expect_error("[system]\npacking_fraction = 0.9\n", {"value 0.9 is"});
 }
 
 TEST(Scene, AllProblemsAreReportedTogether) {
