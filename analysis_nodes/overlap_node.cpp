@@ -27,6 +27,7 @@
 #include "dynhet/analysis/timescales.hpp"
 #include "dynhet/analysis/overlap.hpp"
 #include "dynhet/chi4_t.hpp"
+#include "dynhet/msd_t.hpp"
 #include "dynhet/chunking.hpp"
 #include "dynhet/frame_chunk_t.hpp"
 #include "dynhet/lcm_url.hpp"
@@ -34,6 +35,7 @@
 #include "dynhet/overlap_t.hpp"
 #include "dynhet/run_info_t.hpp"
 #include "dynhet/sim_status_t.hpp"
+#include "dynhet/stats.hpp"
 
 namespace {
 
@@ -70,7 +72,10 @@ public:
     status_.state = "running";
     grid_ = an::make_subbox_grid(m->n_particles, m->box_length, m->overlap_subbox_particles);
     for (int c = 0; c < m->n_cutoffs; ++c) acc_.emplace_back(m->n_origins, m->lag_time);
-    if (std::find(m->observables.begin(), m->observables.end(), "chi4") != m->observables.end()) start_chi4(*m);
+    auto wants = [&](const char* o) { return std::find(m->observables.begin(), m->observables.end(), o) != m->observables.end(); };
+    want_chi4_ = wants("chi4");
+    want_msd_ = wants("msd");
+    if (want_chi4_ || want_msd_) start_pass(*m);
     // Which origins and which (origin, lag) pairs each frame serves.
     origin_at_.assign(m->n_frames, -1);
     pairs_at_.assign(m->n_frames, {});
@@ -129,7 +134,7 @@ private:
   void on_frame(const dynhet::Frame& f) {
     const int k0 = origin_at_[f.index];
     if (k0 >= 0) origins_[k0] = f.position;
-    if (k0 >= 0 && chi4_) chi4_index_[k0] = std::make_unique<an::OriginIndex>(f.position.data(), info_->n_particles, spec_);
+    if (k0 >= 0 && pass_on_) chi4_index_[k0] = std::make_unique<an::OriginIndex>(f.position.data(), info_->n_particles, spec_);
     bool added = false;
     for (const auto& [k, j] : pairs_at_[f.index]) {
       auto it = origins_.find(k);
@@ -138,7 +143,7 @@ private:
                            info_->cutoff_a, qr_);
       const int nb = grid_.per_side * grid_.per_side;
       for (size_t c = 0; c < acc_.size(); ++c) acc_[c].add(k, j, qr_.data() + c * nb, nb);
-      if (chi4_) add_chi4(k, j, it->second, f);
+      if (pass_on_) add_pass(k, j, it->second, f);
       ++pairs_done_;
       added = true;
     }
@@ -179,8 +184,11 @@ private:
 
   // chi4 for every listed sub-box size (nested grids: one pass, see
   // displacement.hpp) and every cutoff.
-  void start_chi4(const dynhet::run_info_t& m) {
-    chi4_ = true;
+  void start_pass(const dynhet::run_info_t& m) {
+    pass_on_ = true;
+    const size_t pairs = static_cast<size_t>(m.n_origins) * m.lag_time.size();
+    msd_all_.assign(pairs, std::numeric_limits<double>::quiet_NaN());
+    msd_small_ = msd_all_;
     spec_.grids = an::nested_subbox_grids(m.n_particles, m.box_length, m.chi4_subbox_particles);
     spec_.cutoffs = m.cutoff_a;
     std::sort(spec_.cutoffs.begin(), spec_.cutoffs.end()); // the pass wants them ascending
@@ -188,10 +196,47 @@ private:
     for (const auto& g : spec_.grids)
       for (size_t c = 0; c < spec_.cutoffs.size(); ++c) chi4_acc_.emplace_back(m.n_origins, m.lag_time, g);
   }
-  void add_chi4(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) {
+  void add_pass(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) {
     an::displacement_pass(pos0.data(), f.position.data(), species_.data(), info_->n_particles,
                           *chi4_index_.at(k), spec_, pass_);
     for (size_t i = 0; i < chi4_acc_.size(); ++i) chi4_acc_[i].add(k, j, pass_.q_r_sum[i], pass_.q_r_sum2[i]);
+    msd_all_[static_cast<size_t>(k) * info_->lag_time.size() + j] = pass_.msd_all;
+    msd_small_[static_cast<size_t>(k) * info_->lag_time.size() + j] = pass_.msd_small;
+  }
+  // Mean over the origins measured at each lag, and its standard error.
+  void origin_mean(const std::vector<double>& v, std::vector<double>& mean, std::vector<double>& err) const {
+    const size_t nj = info_->lag_time.size();
+    mean.assign(nj, std::numeric_limits<double>::quiet_NaN());
+    err = mean;
+    for (size_t j = 0; j < nj; ++j) {
+      dynhet::BlockAverage b;
+      for (int k = 0; k < info_->n_origins; ++k)
+        if (const double x = v[k * nj + j]; !std::isnan(x)) b.add(x);
+      if (b.count()) mean[j] = b.mean(), err[j] = b.standard_error();
+    }
+  }
+  void publish_msd(bool final) {
+    dynhet::msd_t m{};
+    m.utime = utime_now();
+    m.run_id = info_->run_id;
+    m.sim_time = last_time_;
+    m.frame_index = last_frame_;
+    m.is_final = final;
+    m.lag_time = info_->lag_time;
+    m.n_lags = static_cast<int32_t>(m.lag_time.size());
+    origin_mean(msd_all_, m.msd_all, m.msd_all_err);
+    origin_mean(msd_small_, m.msd_small, m.msd_small_err);
+    // D from Delta = 4 D t + b where the MSD has become diffusive (local
+    // log slope within 0.05 of 1 up to the end), else over the last decade.
+    m.fit_t_max = m.lag_time.back();
+    m.fit_t_min = an::diffusive_onset(m.lag_time, m.msd_all);
+    if (!std::isfinite(m.fit_t_min)) m.fit_t_min = m.fit_t_max / 10;
+    m.diffusion = m.diffusion_err = std::numeric_limits<double>::quiet_NaN();
+    if (std::isfinite(m.fit_t_min) && m.fit_t_min < m.fit_t_max) {
+      const auto d = an::fit_diffusion(m.lag_time, m.msd_all, m.fit_t_min, m.fit_t_max);
+      if (d.n >= 3) m.diffusion = d.d, m.diffusion_err = d.d_err;
+    }
+    out_.publish(dynhet::kChanMsd, &m);
   }
   void publish_chi4(bool final) {
     const size_t nc = spec_.cutoffs.size(), ng = spec_.grids.size(), nj = info_->lag_time.size();
@@ -227,7 +272,8 @@ private:
   }
 
   void publish_results(bool final) {
-    if (chi4_) publish_chi4(final);
+    if (want_chi4_) publish_chi4(final);
+    if (want_msd_) publish_msd(final);
     for (size_t c = 0; c < acc_.size(); ++c) {
       const auto r = acc_[c].result();
       dynhet::overlap_t m{};
@@ -280,8 +326,9 @@ private:
   std::vector<std::vector<std::pair<int, int>>> pairs_at_;
   std::map<int, std::vector<double>> origins_; // origin k -> positions at t0
   std::vector<double> qr_;
-  // chi4 (only if the run asks for it)
-  bool chi4_ = false;
+  // The displacement pass, for chi4 and the MSD (only if the run asks)
+  bool pass_on_ = false, want_chi4_ = false, want_msd_ = false;
+  std::vector<double> msd_all_, msd_small_; // per (origin, lag)
   an::DisplacementSpec spec_;
   std::vector<uint8_t> species_;
   std::vector<an::Chi4Accumulator> chi4_acc_; // [grid * n_cutoffs + cutoff], cutoffs ascending

@@ -100,12 +100,12 @@ std::string known_keys(const Table& t) {
 } // namespace
 
 const std::vector<std::string>& known_observables() {
-  static const std::vector<std::string> v{"overlap", "chi4"};
+  static const std::vector<std::string> v{"overlap", "chi4", "msd"};
   return v;
 }
 
 std::string node_of(const std::string& observable) {
-  return observable == "chi4" ? "overlap" : observable;
+  return observable == "chi4" || observable == "msd" ? "overlap" : observable;
 }
 
 std::vector<std::string> nodes_for(const std::vector<std::string>& observables) {

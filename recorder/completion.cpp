@@ -9,7 +9,9 @@ namespace dynhet {
 
 namespace {
 // Observables whose result messages the recorder knows how to write.
-bool recordable(const std::string &observable) { return observable == "overlap" || observable == "chi4"; }
+bool recordable(const std::string &observable) {
+  return observable == "overlap" || observable == "chi4" || observable == "msd";
+}
 } // namespace
 
 std::string cutoff_label(double cutoff_a) {
@@ -22,7 +24,11 @@ Completion::Completion(const std::vector<std::string> &observables, const std::v
     : observables_(observables) {
   for (const std::string &obs : observables)
     if (recordable(obs))
-      for (double a : cutoffs) expected_finals_.push_back(obs + " " + cutoff_label(a));
+      for (double a : cutoffs) {
+        const std::string f = final_label(obs, a);
+        if (std::find(expected_finals_.begin(), expected_finals_.end(), f) == expected_finals_.end())
+          expected_finals_.push_back(f);
+      }
 }
 
 void Completion::sim_phase(const std::string &phase, const std::string &message) {
@@ -45,7 +51,7 @@ std::string Completion::state_of(const std::string &node) const {
 
 bool Completion::finals_complete(const std::string &observable) const {
   for (const std::string &f : expected_finals_)
-    if (f.rfind(observable + " ", 0) == 0 && !finals_.count(f)) return false;
+    if ((f == observable || f.rfind(observable + " ", 0) == 0) && !finals_.count(f)) return false;
   return true;
 }
 

@@ -144,6 +144,33 @@ bool RunRecorder::on_overlap(const overlap_t &m) {
   return true;
 }
 
+bool RunRecorder::on_msd(const msd_t &m) {
+  if (!info_ || m.run_id != info_->run_id) return false;
+  guarded("msd", [&] { write_msd(m); });
+  if (m.is_final) completion_.final_result("msd", 0.0);
+  return true;
+}
+
+// msd/{msd_all, msd_all_err, msd_small, msd_small_err}: (records, lags);
+// diffusion, diffusion_err, fit_t_min, fit_t_max: one number per record.
+void RunRecorder::write_msd(const msd_t &m) {
+  if (!msd_started_) {
+    writer_->write_fixed("msd/lag_time", m.lag_time);
+    msd_started_ = true;
+  }
+  if (m.n_lags <= 0) return;
+  const int64_t step = m.frame_index;
+  const double t = m.sim_time;
+  writer_->append_observable("msd/msd_all", step, t, m.msd_all);
+  writer_->append_observable("msd/msd_all_err", step, t, m.msd_all_err);
+  writer_->append_observable("msd/msd_small", step, t, m.msd_small);
+  writer_->append_observable("msd/msd_small_err", step, t, m.msd_small_err);
+  writer_->append_observable("msd/diffusion", step, t, &m.diffusion, 1);
+  writer_->append_observable("msd/diffusion_err", step, t, &m.diffusion_err, 1);
+  writer_->append_observable("msd/fit_t_min", step, t, &m.fit_t_min, 1);
+  writer_->append_observable("msd/fit_t_max", step, t, &m.fit_t_max, 1);
+}
+
 bool RunRecorder::on_chi4(const chi4_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
   guarded("chi4", [&] { write_chi4(m); });

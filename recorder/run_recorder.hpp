@@ -25,6 +25,7 @@
 #include "dynhet/h5md.hpp"
 #include "dynhet/node_status_t.hpp"
 #include "dynhet/chi4_t.hpp"
+#include "dynhet/msd_t.hpp"
 #include "dynhet/overlap_t.hpp"
 #include "dynhet/run_info_t.hpp"
 #include "dynhet/sim_status_t.hpp"
@@ -65,6 +66,7 @@ public:
   bool on_node_status(const node_status_t &m);
   bool on_overlap(const overlap_t &m);
   bool on_chi4(const chi4_t &m);
+  bool on_msd(const msd_t &m);
   bool on_frame_chunk(const frame_chunk_t &m);
 
   bool has_run() const { return info_ != nullptr; }
@@ -94,6 +96,7 @@ private:
   std::map<std::string, bool> overlap_started_; // by cutoff label
   std::map<std::string, bool> chi4_started_;    // by cutoff label
   std::map<std::string, bool> overlap_t0_written_;
+  bool msd_started_ = false;
   std::optional<int64_t> node_clock_zero_;      // utime of the first node status
   int write_errors_ = 0;
 
@@ -102,6 +105,7 @@ private:
   void write_node(const node_status_t &m);
   void write_overlap(const overlap_t &m);
   void write_chi4(const chi4_t &m);
+  void write_msd(const msd_t &m);
   void write_summary(const std::vector<std::string> &missing);
   void sim_ended(const sim_status_t &m);
   template <class F> void guarded(const char *what, F &&write);

@@ -35,6 +35,27 @@ def crossing_time(t, q, level):
     return math.nan
 
 
+def check_msd(f, unwrapped, origin_frame, pair_frame, lag):
+    """Delta(t) = <|r(t0+t) - r(t0)|^2> over particles (all, small), then over origins; D by brute force."""
+    species = f["particles/all/species"][()]
+    g = f["observables/msd"]
+    d2 = np.array([[np.sum((unwrapped[pf] - unwrapped[of]) ** 2, axis=1) for pf in pair_frame[k]]
+                   for k, of in enumerate(origin_frame)])  # origin, lag, particle
+    for name, sel in (("msd_all", slice(None)), ("msd_small", species == 0)):
+        bf = d2[:, :, sel].mean(axis=2).mean(axis=0)
+        rec = g[name]["value"][-1]
+        err = np.max(np.abs(rec - bf) / bf)
+        check(err < 1e-12, f"msd: {name} equals brute force (max rel diff {err:.2g})")
+    D, t_min, t_max = (float(g[k]["value"][-1]) for k in ("diffusion", "fit_t_min", "fit_t_max"))
+    if math.isfinite(D):
+        bf = d2.mean(axis=2).mean(axis=0)
+        sel = (lag >= t_min) & (lag <= t_max)
+        slope = np.polyfit(lag[sel], bf[sel], 1)[0]
+        check(abs(D - slope / 4) <= 1e-9 * abs(D), f"msd: D = {D:.5g} is the slope/4 over [{t_min:.3g}, {t_max:.3g}]")
+    else:
+        check(False, "msd: no diffusion coefficient")
+
+
 def check_chi4(f, unwrapped, L, origin_frame, pair_frame):
     """chi4(t) = mean over origins of N [<Q_r^2> - <Q_r>^2] (paper eq. 14), by brute force;
     for the whole box N_tot times the variance of Q over origins."""
@@ -126,6 +147,8 @@ def main(path, scene_path):
         check(best <= nudged * (1 + 1e-9), f"{name}: fit beta={beta:.4g} tau0={tau0:.4g} is a least-squares minimum")
     if "observables/chi4" in f:
         check_chi4(f, unwrapped, L, origin_frame, pair_frame)
+    if "observables/msd" in f:
+        check_msd(f, unwrapped, origin_frame, pair_frame, lag)
     if failures:
         print(f"{len(failures)} check(s) failed")
         return 1

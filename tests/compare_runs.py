@@ -19,6 +19,9 @@ def final_results(path):
         for name, g in f.get("observables/chi4", {}).items():
             for obs in ("chi4", "chi4_err", "chi4_peak", "tau4"):
                 out[f"chi4/{name}/{obs}"] = np.atleast_1d(g[obs]["value"][-1])
+        if "observables/msd" in f:
+            for obs in ("msd_all", "msd_small", "diffusion"):
+                out[f"msd/{obs}"] = np.atleast_1d(f["observables/msd"][obs]["value"][-1])
         lost = int(f["observables/nodes/overlap/frames_lost/value"][-1])
         return out, lost
 

@@ -31,5 +31,6 @@ inline constexpr const char* kChanSimStatus = "DYNHET_SIM_STATUS";
 inline constexpr const char* kChanNodeStatus = "DYNHET_NODE_STATUS";
 inline constexpr const char* kChanOverlap = "DYNHET_OVERLAP";
 inline constexpr const char* kChanChi4 = "DYNHET_CHI4";
+inline constexpr const char* kChanMsd = "DYNHET_MSD";
 
 } // namespace dynhet

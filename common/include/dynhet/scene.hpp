@@ -79,9 +79,9 @@ Scene parse_scene_file(const std::string& path);
 // Observables this build knows how to compute.
 const std::vector<std::string>& known_observables();
 
-// The node that computes an observable: Q(t) and chi4(t) come from the same
-// pass over the displacements of the same (origin, lag) pairs, so one node,
-// "overlap", serves both (half the work and one copy of the frames).
+// The node that computes an observable: Q(t), chi4(t) and the MSD come from
+// the same pass over the displacements of the same (origin, lag) pairs, so
+// one node, "overlap", serves all three (one pass, one copy of the frames).
 std::string node_of(const std::string& observable);
 // The executables a list of observables needs ("overlap_node", ...), each once.
 std::vector<std::string> nodes_for(const std::vector<std::string>& observables);

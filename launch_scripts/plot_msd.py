@@ -1,0 +1,49 @@
+#!/usr/bin/python3
+"""Plot the mean square displacement Delta(t) of a dynhet run (HDF5, H5MD
+layout), all particles and small ones, with 4 D t + b over its fit range.
+
+Usage: plot_msd.py RUN.h5 OUT.png
+"""
+import math
+import sys
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+
+def main(path, png):
+    with h5py.File(path, "r") as f:
+        if "observables/msd" not in f:
+            print(f"plot_msd: {path} has no MSD results", file=sys.stderr)
+            return 1
+        g = f["observables/msd"]
+        t = g["lag_time"][()]
+        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        for name, label in (("msd_all", "all"), ("msd_small", "small")):
+            ax.errorbar(t, g[name]["value"][-1], yerr=np.nan_to_num(g[name + "_err"]["value"][-1]), marker="o",
+                        ms=3, capsize=2, label=label)
+        D = float(g["diffusion"]["value"][-1])
+        t0, t1 = float(g["fit_t_min"]["value"][-1]), float(g["fit_t_max"]["value"][-1])
+        if math.isfinite(D):
+            tt = np.geomspace(t0, t1, 50)
+            ax.plot(tt, 4 * D * tt, "k--", lw=1, label=f"4Dt, D = {D:.4g} (fit {t0:.3g}..{t1:.3g})")
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("t")
+        ax.set_ylabel(r"$\Delta(t)$")
+        ax.legend(fontsize=8)
+        fig.tight_layout()
+        fig.savefig(png, dpi=120)
+    print(f"plot_msd: wrote {png}", file=sys.stderr)
+    return 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) != 3:
+        print(__doc__, file=sys.stderr)
+        sys.exit(2)
+    sys.exit(main(sys.argv[1], sys.argv[2]))
