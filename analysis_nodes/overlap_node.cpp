@@ -227,10 +227,11 @@ private:
     origin_mean(msd_all_, m.msd_all, m.msd_all_err);
     origin_mean(msd_small_, m.msd_small, m.msd_small_err);
     // D from Delta = 4 D t + b where the MSD has become diffusive (local
-    // log slope within 0.05 of 1 up to the end), else over the last decade.
+    // log slope within 0.05 of 1 up to the end) or over the last decade of
+    // lags, whichever range is longer.
     m.fit_t_max = m.lag_time.back();
-    m.fit_t_min = an::diffusive_onset(m.lag_time, m.msd_all);
-    if (!std::isfinite(m.fit_t_min)) m.fit_t_min = m.fit_t_max / 10;
+    m.fit_t_min = m.fit_t_max / 10;
+    if (const double onset = an::diffusive_onset(m.lag_time, m.msd_all); onset < m.fit_t_min) m.fit_t_min = onset;
     m.diffusion = m.diffusion_err = std::numeric_limits<double>::quiet_NaN();
     if (std::isfinite(m.fit_t_min) && m.fit_t_min < m.fit_t_max) {
       const auto d = an::fit_diffusion(m.lag_time, m.msd_all, m.fit_t_min, m.fit_t_max);
