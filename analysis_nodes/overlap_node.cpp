@@ -161,6 +161,15 @@ private:
     tick();
   }
 
+  // The fields every result message shares: when, which run, which frame.
+  template <class Msg> void stamp(Msg& m, bool final) const {
+    m.utime = utime_now();
+    m.run_id = info_->run_id;
+    m.sim_time = last_time_;
+    m.frame_index = last_frame_;
+    m.is_final = final;
+  }
+
   // Q(t) = 1/((t/tau0)^beta + 1), weighted by the errors if every lag has one.
   void fit_q(const an::OverlapAccumulator::Result& r, dynhet::overlap_t& m) const {
     m.beta = m.beta_err = m.tau0 = m.tau0_err = std::numeric_limits<double>::quiet_NaN();
@@ -217,11 +226,7 @@ private:
   }
   void publish_msd(bool final) {
     dynhet::msd_t m{};
-    m.utime = utime_now();
-    m.run_id = info_->run_id;
-    m.sim_time = last_time_;
-    m.frame_index = last_frame_;
-    m.is_final = final;
+    stamp(m, final);
     m.lag_time = info_->lag_time;
     m.n_lags = static_cast<int32_t>(m.lag_time.size());
     origin_mean(msd_all_, m.msd_all, m.msd_all_err);
@@ -243,11 +248,7 @@ private:
     const size_t nc = spec_.cutoffs.size(), ng = spec_.grids.size(), nj = info_->lag_time.size();
     for (size_t c = 0; c < nc; ++c) {
       dynhet::chi4_t m{};
-      m.utime = utime_now();
-      m.run_id = info_->run_id;
-      m.sim_time = last_time_;
-      m.frame_index = last_frame_;
-      m.is_final = final;
+      stamp(m, final);
       m.cutoff_a = spec_.cutoffs[c];
       m.n_grids = static_cast<int32_t>(ng);
       m.n_lags = static_cast<int32_t>(nj);
@@ -278,11 +279,7 @@ private:
     for (size_t c = 0; c < acc_.size(); ++c) {
       const auto r = acc_[c].result();
       dynhet::overlap_t m{};
-      m.utime = utime_now();
-      m.run_id = info_->run_id;
-      m.sim_time = last_time_;
-      m.frame_index = last_frame_;
-      m.is_final = final;
+      stamp(m, final);
       m.cutoff_a = info_->cutoff_a[c];
       m.subbox_per_side = grid_.per_side;
       m.subbox_particles = grid_.mean_particles;
