@@ -38,13 +38,7 @@ int main(int argc, char** argv) {
   std::printf("%6s %8s %8s %9s %9s %8s %10s %10s %8s\n", "phi", "t_run", "cpu_s", "Z", "Z_err", "Z_rel%",
               "tau_alpha", "tau_err", "tau_rel%");
   for (double phi : phis) {
-    dynhet::engine::Params p;
-    p.n_particles = n;
-    p.packing_fraction = phi;
-    p.restitution = eps;
-    p.driving = true;
-    p.kick_rate = dynhet::enskog_frequency(phi, dynhet::henderson_contact_value(phi));
-    dynhet::engine::Engine e(p);
+    dynhet::engine::Engine e(dynhet::engine::paper_params(n, phi, eps, true));
     e.prepare();
     const double t_eq = 50.0;
     e.run_until(t_eq);

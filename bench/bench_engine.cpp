@@ -53,12 +53,7 @@ int main(int argc, char** argv) {
   for (long n : ns)
     for (double phi : phis) {
       const long rss0 = rss_kib();
-      dynhet::engine::Params p;
-      p.n_particles = n;
-      p.packing_fraction = phi;
-      p.restitution = eps;
-      p.driving = driven;
-      p.kick_rate = dynhet::enskog_frequency(phi, dynhet::henderson_contact_value(phi));
+      dynhet::engine::Params p = dynhet::engine::paper_params(n, phi, eps, driven);
       p.seed = 1;
       dynhet::engine::Engine e(p);
       auto t0 = std::chrono::steady_clock::now();

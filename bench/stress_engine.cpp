@@ -23,12 +23,7 @@ struct Case {
 };
 
 bool run_case(const Case& c, long n, double collisions, double check_every) {
-  dynhet::engine::Params p;
-  p.n_particles = n;
-  p.packing_fraction = c.phi;
-  p.restitution = c.eps;
-  p.driving = true;
-  p.kick_rate = dynhet::enskog_frequency(c.phi, dynhet::henderson_contact_value(c.phi));
+  dynhet::engine::Params p = dynhet::engine::paper_params(n, c.phi, c.eps, true);
   p.tc = c.tc;
   p.seed = 11;
   dynhet::engine::Engine e(p);

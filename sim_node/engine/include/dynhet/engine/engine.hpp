@@ -16,6 +16,7 @@
 
 #include "dynhet/engine/calendar.hpp"
 #include "dynhet/engine/rng.hpp"
+#include "dynhet/model.hpp"
 
 namespace dynhet::engine {
 
@@ -31,6 +32,18 @@ struct Params {
   // particle's previous collision is elastic. 0: off.
   double tc = 0.0;
 };
+
+// The paper's system: radius ratio 1.43, kicks (if driven) at the Enskog
+// frequency with Henderson's contact value.
+inline Params paper_params(long n, double phi, double eps, bool driven) {
+  Params p;
+  p.n_particles = n;
+  p.packing_fraction = phi;
+  p.restitution = eps;
+  p.driving = driven;
+  p.kick_rate = enskog_frequency(phi, henderson_contact_value(phi));
+  return p;
+}
 
 struct Counters {
   int64_t collisions = 0;
