@@ -23,7 +23,7 @@ public:
 
   void sim_phase(const std::string &phase, const std::string &message);
   void node_state(const std::string &node, const std::string &state);
-  // A final result of `observable` ("overlap", "chi4") for one cutoff, or
+  // A final result of `observable` ("overlap", "chi4", "clusters") for one cutoff, or
   // of one that does not depend on the cutoff ("msd"; cutoff ignored).
   void final_result(const std::string &observable, double cutoff_a) { finals_.insert(final_label(observable, cutoff_a)); }
   static std::string final_label(const std::string &observable, double cutoff_a) {

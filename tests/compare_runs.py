@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Replays must reproduce the live Q(t) bit for bit (if the live run lost
+"""Replays must reproduce the live results (Q(t), chi4, MSD, clusters) bit for bit (if the live run lost
 no frame) and must be identical to each other.
 
 Usage: compare_runs.py LIVE.h5 REPLAY1.h5 REPLAY2.h5
@@ -22,6 +22,10 @@ def final_results(path):
         if "observables/msd" in f:
             for obs in ("msd_all", "msd_small", "diffusion"):
                 out[f"msd/{obs}"] = np.atleast_1d(f["observables/msd"][obs]["value"][-1])
+        for name, g in f.get("observables/clusters", {}).items():
+            for obs in ("neighbour_cutoff", "tau_alpha", "lag", "mean_size_slow", "mean_size_fast", "p_slow",
+                        "p_fast", "rg_slow", "rg_fast", "slow_d_f", "slow_kappa", "fast_n0", "fast_sigma"):
+                out[f"clusters/{name}/{obs}"] = np.atleast_1d(g[obs]["value"][-1])
         lost = int(f["observables/nodes/overlap/frames_lost/value"][-1])
         return out, lost
 
