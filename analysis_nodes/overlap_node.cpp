@@ -2,14 +2,16 @@
 // live from the frames on DYNHET_FRAME and published on DYNHET_OVERLAP (one
 // message per cutoff a) after every frame that adds a pair; if the run asks
 // for chi4, also chi4(t) for every listed sub-box size on DYNHET_CHI4, from
-// the same displacements. It holds only the origin frames that some later
-// frame still needs (16 N bytes each, plus 4 N per origin for chi4's
-// sub-box index).
+// the same displacements, and the MSD (with the instantaneous fastest and
+// slowest subsets) on DYNHET_MSD and P(dx, t) on DYNHET_DISPLACEMENT. It
+// holds only the origin frames that some later frame still needs (16 N
+// bytes each, plus 4 N per origin for chi4's sub-box index).
 //
 // Usage: overlap_node [--lcm-url URL] [--publish-url URL]
 // With --lcm-url file://LOG?speed=0 it re-runs the analysis from an
 // lcm-logger log at full speed and publishes on --publish-url.
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -23,9 +25,12 @@
 #include "dynhet/analysis/overlap.hpp"
 #include "dynhet/analysis/timescales.hpp"
 #include "dynhet/chi4_t.hpp"
+#include "dynhet/displacement_t.hpp"
 #include "dynhet/msd_t.hpp"
 #include "dynhet/overlap_t.hpp"
+#include "dynhet/scene.hpp"
 #include "dynhet/stats.hpp"
+#include "displacement_results.hpp"
 #include "frame_node.hpp"
 
 namespace {
@@ -43,7 +48,17 @@ private:
     for (int c = 0; c < m->n_cutoffs; ++c) acc_.emplace_back(m->n_origins, m->lag_time);
     want_chi4_ = wants("chi4");
     want_msd_ = wants("msd");
-    if (want_chi4_ || want_msd_) start_pass(*m);
+    const bool want_displacement = wants("displacement");
+    if (want_msd_ || want_displacement) {
+      try {
+        const dynhet::Scene scene = dynhet::parse_scene_text(m->scene_toml, "run info scene");
+        msd_spec_ = scene.msd;
+        if (want_displacement) displacement_ = std::make_unique<dynhet::DisplacementResults>(*m, scene.displacement);
+      } catch (const std::exception& e) {
+        return fail(std::string("cannot read the scene's [msd] and [displacement] tables: ") + e.what());
+      }
+    }
+    if (want_chi4_ || want_msd_ || want_displacement) start_pass(*m);
     std::fprintf(stderr, "overlap_node: %dx%d sub-boxes of N=%.1f\n", grid_.per_side, grid_.per_side,
                  grid_.mean_particles);
   }
@@ -87,6 +102,9 @@ private:
     const size_t pairs = static_cast<size_t>(m.n_origins) * m.lag_time.size();
     msd_all_.assign(pairs, std::numeric_limits<double>::quiet_NaN());
     msd_small_ = msd_all_;
+    for (auto& v : msd_extreme_) v = msd_all_;
+    if (displacement_) displacement_->configure(spec_);
+    if (want_msd_) d2_.resize(m.n_particles);
     spec_.grids = an::nested_subbox_grids(m.n_particles, m.box_length, m.chi4_subbox_particles);
     spec_.cutoffs = m.cutoff_a;
     std::sort(spec_.cutoffs.begin(), spec_.cutoffs.end()); // the pass wants them ascending
@@ -95,11 +113,21 @@ private:
       for (size_t c = 0; c < spec_.cutoffs.size(); ++c) chi4_acc_.emplace_back(m.n_origins, m.lag_time, g);
   }
   void add_pass(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) {
-    an::displacement_pass(pos0.data(), f.position.data(), species_.data(), info().n_particles,
-                          *chi4_index_.at(k), spec_, pass_);
+    const long n = info().n_particles;
+    an::displacement_pass(pos0.data(), f.position.data(), species_.data(), n, *chi4_index_.at(k), spec_, pass_,
+                          want_msd_ ? d2_.data() : nullptr);
     for (size_t i = 0; i < chi4_acc_.size(); ++i) chi4_acc_[i].add(k, j, pass_.q_r_sum[i], pass_.q_r_sum2[i]);
-    msd_all_[static_cast<size_t>(k) * info().lag_time.size() + j] = pass_.msd_all;
-    msd_small_[static_cast<size_t>(k) * info().lag_time.size() + j] = pass_.msd_small;
+    const size_t kj = static_cast<size_t>(k) * info().lag_time.size() + j;
+    msd_all_[kj] = pass_.msd_all;
+    msd_small_[kj] = pass_.msd_small;
+    if (want_msd_) {
+      // The instantaneous fastest and slowest subsets of this pair.
+      const an::ExtremeMsd all = an::msd_extremes(d2_.data(), species_.data(), n, msd_spec_.fraction_all, -1, select_);
+      const an::ExtremeMsd small = an::msd_extremes(d2_.data(), species_.data(), n, msd_spec_.fraction_small, 0, select_);
+      msd_extreme_[0][kj] = all.fast, msd_extreme_[1][kj] = all.slow;
+      msd_extreme_[2][kj] = small.fast, msd_extreme_[3][kj] = small.slow;
+    }
+    if (displacement_) displacement_->add(k, j, pass_, pass_.n_small);
   }
   // Mean over the origins measured at each lag, and its standard error.
   void origin_mean(const std::vector<double>& v, std::vector<double>& mean, std::vector<double>& err) const {
@@ -126,6 +154,12 @@ private:
     m.fit_t_max = m.lag_time.back();
     m.fit_t_min = m.fit_t_max / 10;
     if (const double onset = an::diffusive_onset(m.lag_time, m.msd_all); onset < m.fit_t_min) m.fit_t_min = onset;
+    m.fraction_all = msd_spec_.fraction_all;
+    m.fraction_small = msd_spec_.fraction_small;
+    origin_mean(msd_extreme_[0], m.msd_fast_all, m.msd_fast_all_err);
+    origin_mean(msd_extreme_[1], m.msd_slow_all, m.msd_slow_all_err);
+    origin_mean(msd_extreme_[2], m.msd_fast_small, m.msd_fast_small_err);
+    origin_mean(msd_extreme_[3], m.msd_slow_small, m.msd_slow_small_err);
     m.diffusion = m.diffusion_err = std::numeric_limits<double>::quiet_NaN();
     if (std::isfinite(m.fit_t_min) && m.fit_t_min < m.fit_t_max) {
       const auto d = an::fit_diffusion(m.lag_time, m.msd_all, m.fit_t_min, m.fit_t_max);
@@ -162,9 +196,22 @@ private:
     }
   }
 
+  // P(dx, t) at the lags nearest the scene's targets, tau_alpha that of
+  // the first cutoff listed. At most once a second before the final
+  // message: each costs (1 + blocks) fits per target and set, and a record.
+  void publish_displacement(bool final) {
+    const auto now = std::chrono::steady_clock::now();
+    if (!final && now - last_displacement_ < std::chrono::seconds(1)) return;
+    last_displacement_ = now;
+    dynhet::displacement_t m = displacement_->message(acc_[0].result().tau_alpha, info().cutoff_a[0]);
+    stamp(m, final);
+    out_.publish(dynhet::kChanDisplacement, &m);
+  }
+
   void publish_results(bool final) {
     if (want_chi4_) publish_chi4(final);
     if (want_msd_) publish_msd(final);
+    if (displacement_) publish_displacement(final);
     for (size_t c = 0; c < acc_.size(); ++c) {
       const auto r = acc_[c].result();
       dynhet::overlap_t m{};
@@ -197,6 +244,11 @@ private:
   // The displacement pass, for chi4 and the MSD (only if the run asks)
   bool pass_on_ = false, want_chi4_ = false, want_msd_ = false;
   std::vector<double> msd_all_, msd_small_; // per (origin, lag)
+  std::vector<double> msd_extreme_[4];       // per (origin, lag): fast all, slow all, fast small, slow small
+  std::vector<double> d2_, select_;          // |dr|^2 of the pair; the selection's buffer
+  dynhet::Scene::Msd msd_spec_;
+  std::unique_ptr<dynhet::DisplacementResults> displacement_;
+  std::chrono::steady_clock::time_point last_displacement_{};
   an::DisplacementSpec spec_;
   std::vector<uint8_t> species_;
   std::vector<an::Chi4Accumulator> chi4_acc_; // [grid * n_cutoffs + cutoff], cutoffs ascending

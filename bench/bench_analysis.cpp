@@ -23,6 +23,7 @@
 
 #include "dynhet/analysis/clusters.hpp"
 #include "dynhet/analysis/displacement.hpp"
+#include "dynhet/analysis/displacement_distribution.hpp"
 #include "dynhet/analysis/s4.hpp"
 
 namespace an = dynhet::analysis;
@@ -136,6 +137,8 @@ Timing summary(std::vector<double> t) {
   return {t.front(), t[t.size() / 2]};
 }
 
+void bench_extremes(const Frames& f, const std::vector<double>& d2, const an::DisplacementResult& r, int reps);
+
 void bench_pass(const Frames& f, int reps) {
   std::printf("\n# one pass per (origin, lag): Q_r and chi4 on every grid for every cutoff, MSD all/small, "
               "P(dx) histogram\n");
@@ -173,13 +176,55 @@ void bench_pass(const Frames& f, int reps) {
                 c.origin->indexed_grids(), c.spec.cutoffs.size(), 1e3 * c.index_s, 1e9 * t.min / f.n,
                 1e9 * t.median / f.n, 1e9 * t2.min / f.n, c.q);
   }
-  const Timing t_ext = time_calls(reps, [&] {
-    an::msd_extremes(d2.data(), f.species.data(), f.n, 0.1, -1);
-    an::msd_extremes(d2.data(), f.species.data(), f.n, 0.2, 0);
+  bench_extremes(f, d2, r, reps);
+}
+
+// What the MSD's fastest/slowest subsets and P(dx, t) add per (origin,
+// lag) pair on top of the pass, as the overlap node does them.
+void bench_extremes(const Frames& f, const std::vector<double>& d2, const an::DisplacementResult& r, int reps) {
+  std::printf("\n# added per (origin, lag): fastest/slowest 10%% of all and 20%% of small (exact, nth_element), "
+              "P(dx) tally\n");
+  std::printf("%8s %-52s %9s %9s %12s\n", "N", "what", "ns/p_min", "ns/p_med", "max_rel_err");
+  // Reference: a full sort of each set.
+  auto sorted_means = [&](int which, double fraction) {
+    std::vector<double> v;
+    for (long i = 0; i < f.n; ++i)
+      if (which < 0 || f.species[i] == which) v.push_back(d2[i]);
+    std::sort(v.begin(), v.end());
+    const long k = std::max(1L, std::lround(fraction * v.size()));
+    return an::ExtremeMsd{std::accumulate(v.end() - k, v.end(), 0.0) / k,
+                          std::accumulate(v.begin(), v.begin() + k, 0.0) / k, k};
+  };
+  const an::ExtremeMsd ref[2] = {sorted_means(-1, 0.1), sorted_means(0, 0.2)};
+  an::ExtremeMsd got[2];
+  auto rel = [](double a, double b) { return std::abs(a - b) / std::abs(b); };
+  auto row = [&](const char* what, const Timing& t, bool check) {
+    double e = 0;
+    for (int s = 0; s < 2 && check; ++s) e = std::max({e, rel(got[s].fast, ref[s].fast), rel(got[s].slow, ref[s].slow)});
+    std::printf("%8ld %-52s %9.2f %9.2f %12.1e\n", f.n, what, 1e9 * t.min / f.n, 1e9 * t.median / f.n, e);
+  };
+  const Timing fresh = time_calls(reps, [&] {
+    got[0] = an::msd_extremes(d2.data(), f.species.data(), f.n, 0.1, -1);
+    got[1] = an::msd_extremes(d2.data(), f.species.data(), f.n, 0.2, 0);
   });
-  std::printf(
-      "# fastest/slowest 10%% of all and 20%% of small (nth_element): %.2f ns/particle (min; median %.2f)\n",
-      1e9 * t_ext.min / f.n, 1e9 * t_ext.median / f.n);
+  row("extremes, new buffer per call", fresh, true);
+  std::vector<double> buffer;
+  const Timing reused = time_calls(reps, [&] {
+    got[0] = an::msd_extremes(d2.data(), f.species.data(), f.n, 0.1, -1, buffer);
+    got[1] = an::msd_extremes(d2.data(), f.species.data(), f.n, 0.2, 0, buffer);
+  });
+  row("extremes, reused buffer (overlap node)", reused, true);
+  // P(dx): the pass histograms every pair anyway; the node adds them to a
+  // tally per (block, lag, set): 2 x bins additions per pair.
+  const int bins = static_cast<int>(r.hist[0].size());
+  an::DisplacementTally tally(20, 1, 2, bins);
+  std::vector<long> all(bins);
+  const Timing t_tally = time_calls(reps, [&] {
+    for (int b = 0; b < bins; ++b) all[b] = r.hist[0][b] + r.hist[1][b];
+    tally.add(0, 0, 0, all.data(), f.n);
+    tally.add(0, 0, 1, r.hist[0].data(), r.n_small);
+  });
+  row("P(dx) tally of one pair (400 bins, 2 sets)", t_tally, false);
 }
 
 // Largest relative difference of S4 over the shells with 0 < q <= q_max

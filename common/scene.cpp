@@ -100,12 +100,12 @@ std::string known_keys(const Table& t) {
 } // namespace
 
 const std::vector<std::string>& known_observables() {
-  static const std::vector<std::string> v{"overlap", "chi4", "msd", "clusters"};
+  static const std::vector<std::string> v{"overlap", "chi4", "msd", "displacement", "clusters"};
   return v;
 }
 
 std::string node_of(const std::string& observable) {
-  return observable == "chi4" || observable == "msd" ? "overlap" : observable;
+  return observable == "chi4" || observable == "msd" || observable == "displacement" ? "overlap" : observable;
 }
 
 std::vector<std::string> nodes_for(const std::vector<std::string>& observables) {
@@ -330,6 +330,43 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
       {"fractal_min_size", int_in(cl.fractal_min_size, 1, 1000000000)},
       {"error_blocks", int_in(cl.error_blocks, 2, 1000)},
   };
+  // A fraction of a set of particles for the fastest and slowest subsets.
+  auto subset_fraction = [&](double& out) {
+    return [&c, &out](const std::string& key, const toml::node& n) {
+      double v;
+      if (!c.get_double(key, n, v)) return;
+      if (!(v > 0 && v <= 0.5)) return c.bad_value(key, n, "allowed: 0 < fraction <= 0.5");
+      out = v;
+    };
+  };
+  schema["msd"] = {
+      {"fraction_all", subset_fraction(s.msd.fraction_all)},
+      {"fraction_small", subset_fraction(s.msd.fraction_small)},
+  };
+  auto& dp = s.displacement;
+  auto positive_list = [&](std::vector<double>& out) {
+    return [&c, &out](const std::string& key, const toml::node& n) {
+      const auto* arr = n.as_array();
+      if (!arr) return c.bad_type(key, n, "an array of numbers > 0 (may be empty)");
+      std::vector<double> v;
+      for (const auto& e : *arr) {
+        double x;
+        if (!c.get_double(key, e, x)) return;
+        if (x <= 0) return c.bad_value(key, e, "every entry must be > 0");
+        v.push_back(x);
+      }
+      out = v;
+    };
+  };
+  schema["displacement"] = {
+      {"lags_tau_alpha", positive_list(dp.lags_tau_alpha)},
+      {"lags", positive_list(dp.lags)},
+      {"x_max", positive(dp.x_max)},
+      {"bin_width", positive(dp.bin_width)},
+      {"tail_sigmas", non_negative(dp.tail_sigmas)},
+      {"min_bin_count", int_in(dp.min_bin_count, 1, 1000000000)},
+      {"error_blocks", int_in(dp.error_blocks, 2, 1000)},
+  };
   schema["transport"] = {
       {"chunk_particles", int_in(s.chunk_particles, 1, 65000)}, // 16 B each: < 1 MiB
   };
@@ -404,6 +441,23 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
   if (const auto& p = cl.power_law_sizes; !(p[0] >= 1 && p[0] < p[1]))
     c.fail("clusters.power_law_sizes", "[" + std::to_string(p[0]) + ", " + std::to_string(p[1]) +
                                            "] is not allowed; allowed: [lo, hi] with 1 <= lo < hi");
+  // P(dx, t): a message of 2 sets x targets x bins x 24 bytes must stay well
+  // under what survives UDP whole (~200 KB).
+  const size_t targets = dp.lags_tau_alpha.size() + dp.lags.size();
+  const double bins = 2 * dp.x_max / dp.bin_width;
+  if (s.wants("displacement") && targets == 0)
+    c.fail("displacement.lags_tau_alpha", "and displacement.lags are both empty; name at least one lag");
+  if (targets > 16)
+    c.fail("displacement.lags_tau_alpha", "with displacement.lags names " + std::to_string(targets) +
+                                              " lags; at most 16");
+  if (!(bins >= 10 && bins <= 4000))
+    c.fail("displacement.bin_width", "value " + std::to_string(dp.bin_width) + " makes " +
+                                         std::to_string(static_cast<long>(bins)) +
+                                         " bins over [-x_max, x_max); allowed: 10 to 4000 bins");
+  else if (targets * dp.bins() > 4096)
+    c.fail("displacement.bin_width", "value " + std::to_string(dp.bin_width) + ": " + std::to_string(targets) +
+                                         " lags x " + std::to_string(dp.bins()) +
+                                         " bins is more than 4096 (the message would not survive UDP)");
   if (s.observables.empty())
     c.fail("observables.compute", "is empty; name at least one of the known observables");
   c.throw_if_failed();

@@ -1,6 +1,8 @@
 #!/usr/bin/python3
 """Plot the mean square displacement Delta(t) of a dynhet run (HDF5, H5MD
-layout), all particles and small ones, with 4 D t + b over its fit range.
+layout), all particles (solid) and small ones (dashed), with 4 D t + b over
+its fit range, and the MSD of the instantaneous fastest (red) and slowest
+(blue) fractions of each set (paper fig. MSD).
 
 Usage: plot_msd.py RUN.h5 OUT.png
 """
@@ -23,9 +25,16 @@ def main(path, png):
         g = f["observables/msd"]
         t = g["lag_time"][()]
         fig, ax = plt.subplots(figsize=(6.4, 4.4))
-        for name, label in (("msd_all", "all"), ("msd_small", "small")):
-            ax.errorbar(t, g[name]["value"][-1], yerr=np.nan_to_num(g[name + "_err"]["value"][-1]), marker="o",
-                        ms=3, capsize=2, label=label)
+        fractions = {k: float(g.attrs.get(f"fraction_{k}", math.nan)) for k in ("all", "small")}
+        for name, ls in (("all", "-"), ("small", "--")):
+            curves = [(f"msd_{name}", "green", name)]
+            if f"msd_fast_{name}" in g:
+                curves += [(f"msd_{kind}_{name}", colour, f"{kind}est {fractions[name]:.0%} of {name}")
+                           for kind, colour in (("fast", "red"), ("slow", "blue"))]
+            for key, colour, label in curves:
+                ax.errorbar(t, g[key]["value"][-1], yerr=np.nan_to_num(g[key + "_err"]["value"][-1]), ls=ls,
+                            color=colour, marker="o" if name == "all" else "s", ms=2.5, capsize=2, lw=1,
+                            label=label)
         D = float(g["diffusion"]["value"][-1])
         t0, t1 = float(g["fit_t_min"]["value"][-1]), float(g["fit_t_max"]["value"][-1])
         if math.isfinite(D):

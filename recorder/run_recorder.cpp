@@ -151,11 +151,13 @@ bool RunRecorder::on_msd(const msd_t &m) {
   return true;
 }
 
-// msd/{msd_all, msd_all_err, msd_small, msd_small_err}: (records, lags);
-// diffusion, diffusion_err, fit_t_min, fit_t_max: one number per record.
+// msd/{msd_all, msd_small, msd_{fast,slow}_{all,small}} and their _err:
+// (records, lags), the subsets' fractions as attributes; diffusion, diffusion_err, fit_t_min, fit_t_max: one number per record.
 void RunRecorder::write_msd(const msd_t &m) {
   if (!msd_started_) {
     writer_->write_fixed("msd/lag_time", m.lag_time);
+    writer_->set_attribute("observables/msd", "fraction_all", m.fraction_all);
+    writer_->set_attribute("observables/msd", "fraction_small", m.fraction_small);
     msd_started_ = true;
   }
   if (m.n_lags <= 0) return;
@@ -169,6 +171,57 @@ void RunRecorder::write_msd(const msd_t &m) {
   writer_->append_observable("msd/diffusion_err", step, t, &m.diffusion_err, 1);
   writer_->append_observable("msd/fit_t_min", step, t, &m.fit_t_min, 1);
   writer_->append_observable("msd/fit_t_max", step, t, &m.fit_t_max, 1);
+  writer_->append_observable("msd/msd_fast_all", step, t, m.msd_fast_all);
+  writer_->append_observable("msd/msd_fast_all_err", step, t, m.msd_fast_all_err);
+  writer_->append_observable("msd/msd_slow_all", step, t, m.msd_slow_all);
+  writer_->append_observable("msd/msd_slow_all_err", step, t, m.msd_slow_all_err);
+  writer_->append_observable("msd/msd_fast_small", step, t, m.msd_fast_small);
+  writer_->append_observable("msd/msd_fast_small_err", step, t, m.msd_fast_small_err);
+  writer_->append_observable("msd/msd_slow_small", step, t, m.msd_slow_small);
+  writer_->append_observable("msd/msd_slow_small_err", step, t, m.msd_slow_small_err);
+}
+
+bool RunRecorder::on_displacement(const displacement_t &m) {
+  if (!info_ || m.run_id != info_->run_id) return false;
+  guarded("displacement", [&] { write_displacement(m); });
+  if (m.is_final) completion_.final_result("displacement", 0.0);
+  return true;
+}
+
+// displacement/: x (bin centres) once, with the settings as attributes; per
+// record the targets and their lags (records, targets), per series (set s,
+// target l) at [s * n_targets + l] the fits (records, series), and per bin
+// p, p_err, count (records, series * bins).
+void RunRecorder::write_displacement(const displacement_t &m) {
+  const std::string base = "displacement/";
+  if (!displacement_started_) {
+    writer_->write_fixed(base + "x", m.x);
+    const std::string g = "observables/displacement";
+    writer_->set_attribute(g, "bin_width", m.bin_width);
+    writer_->set_attribute(g, "n_sets", m.n_sets);
+    writer_->set_attribute(g, "sets", "all,small");
+    writer_->set_attribute(g, "n_blocks", m.n_blocks);
+    writer_->set_attribute(g, "tail_sigmas", m.tail_sigmas);
+    writer_->set_attribute(g, "min_bin_count", m.min_bin_count);
+    writer_->set_attribute(g, "cutoff_a", m.cutoff_a);
+    writer_->set_attribute(g, "layout", "series s * n_targets + l; bins (s * n_targets + l) * n_bins + b");
+    displacement_started_ = true;
+  }
+  if (m.n_values <= 0) return;
+  const int64_t step = m.frame_index;
+  const double t = m.sim_time;
+  auto scalar = [&](const char *name, const auto &v) { writer_->append_observable(base + name, step, t, &v, 1); };
+  auto array = [&](const char *name, const auto &v) { writer_->append_observable(base + name, step, t, v); };
+  scalar("tau_alpha", m.tau_alpha);
+  array("target_time", m.target_time), array("target_tau_alpha", m.target_tau_alpha);
+  array("lag_index", m.lag_index), array("lag_time", m.lag_time);
+  array("n_pairs", m.n_pairs), array("samples", m.samples), array("fraction_outside", m.fraction_outside);
+  array("p", m.p), array("p_err", m.p_err), array("count", m.count);
+  array("gauss_d", m.gauss_d), array("gauss_d_err", m.gauss_d_err), array("gauss_bins", m.gauss_bins);
+  array("tail_x0", m.tail_x0), array("tail_x0_err", m.tail_x0_err), array("tail_amplitude", m.tail_amplitude);
+  array("tail_x_min", m.tail_x_min), array("tail_x_max", m.tail_x_max), array("tail_bins", m.tail_bins);
+  scalar("gauss_d_small_tau_alpha", m.gauss_d_small_tau_alpha);
+  scalar("tail_x0_small_tau_alpha", m.tail_x0_small_tau_alpha);
 }
 
 bool RunRecorder::on_clusters(const clusters_t &m) {

@@ -11,6 +11,8 @@
 //   nodes/<node>/<field>   {step = frames handled, time = wall s since the first node status}
 //   overlap/a<cutoff>/<field> {step = frame index, time = sim time}, lag_time
 //   clusters/a<cutoff>/<field> likewise, with lag_time, r and the size bins
+//   msd/<field>, displacement/<field> likewise (one each per run), with
+//   lag_time (msd) and x, the bin centres (displacement)
 #pragma once
 
 #include <cstdint>
@@ -27,6 +29,7 @@
 #include "dynhet/node_status_t.hpp"
 #include "dynhet/chi4_t.hpp"
 #include "dynhet/clusters_t.hpp"
+#include "dynhet/displacement_t.hpp"
 #include "dynhet/msd_t.hpp"
 #include "dynhet/overlap_t.hpp"
 #include "dynhet/run_info_t.hpp"
@@ -70,6 +73,7 @@ public:
   bool on_chi4(const chi4_t &m);
   bool on_msd(const msd_t &m);
   bool on_clusters(const clusters_t &m);
+  bool on_displacement(const displacement_t &m);
   bool on_frame_chunk(const frame_chunk_t &m);
 
   bool has_run() const { return info_ != nullptr; }
@@ -100,7 +104,7 @@ private:
   std::map<std::string, bool> chi4_started_;    // by cutoff label
   std::map<std::string, bool> clusters_started_, clusters_r_written_, clusters_bins_written_;
   std::map<std::string, bool> overlap_t0_written_;
-  bool msd_started_ = false;
+  bool msd_started_ = false, displacement_started_ = false;
   std::optional<int64_t> node_clock_zero_;      // utime of the first node status
   int write_errors_ = 0;
 
@@ -111,6 +115,7 @@ private:
   void write_chi4(const chi4_t &m);
   void write_msd(const msd_t &m);
   void write_clusters(const clusters_t &m);
+  void write_displacement(const displacement_t &m);
   void write_summary(const std::vector<std::string> &missing);
   void sim_ended(const sim_status_t &m);
   template <class F> void guarded(const char *what, F &&write);

@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Checks a dynhet run file: the H5MD layout, the scene, the frames, no
-loss, and the recorded Q(t) and tau_alpha, chi4, the MSD and the clusters
-against brute-force recomputations from the recorded frames.
+loss, and the recorded Q(t) and tau_alpha, chi4, the MSD (with the
+instantaneous fastest and slowest subsets), P(dx, t) with its fits and the
+clusters against brute-force recomputations from the recorded frames.
 
 Usage: check_run.py RUN.h5 SCENE.toml
 """
@@ -37,7 +38,157 @@ def crossing_time(t, q, level):
     return math.nan
 
 
-def check_msd(f, unwrapped, origin_frame, pair_frame, lag):
+def origin_mean(x):
+    """Mean over origins (axis 0) and its standard error, as the node's BlockAverage."""
+    return x.mean(axis=0), x.std(axis=0, ddof=1) / math.sqrt(x.shape[0])
+
+
+def check_msd_extremes(g, d2, species, scene):
+    """The instantaneous fastest and slowest subsets: at every (origin, lag) the particles of the set
+    sorted by their own |dr|^2 over that lag, the top and bottom k = round(fraction * set size)."""
+    fractions = {"all": 0.1, "small": 0.2} | {k[9:]: v for k, v in scene.get("msd", {}).items()}
+    check(float(g.attrs["fraction_all"]) == fractions["all"] and float(g.attrs["fraction_small"]) == fractions["small"],
+          f"msd: fractions {fractions}")
+    for name, sel in (("all", slice(None)), ("small", species == 0)):
+        v = np.sort(d2[:, :, sel], axis=2)  # origin, lag, particle
+        m = v.shape[2]
+        k = min(m, max(1, math.floor(fractions[name] * m + 0.5)))
+        mid = v.mean(axis=2).mean(axis=0)
+        for kind, x in (("fast", v[:, :, m - k:]), ("slow", v[:, :, :k])):
+            mean, err = origin_mean(x.mean(axis=2))
+            rec, rec_err = g[f"msd_{kind}_{name}"]["value"][-1], g[f"msd_{kind}_{name}_err"]["value"][-1]
+            d = np.max(np.abs(rec - mean) / mean)
+            # 1e-12: the same sums in another order; the error from Welford against two passes: 1e-9
+            check(d < 1e-12, f"msd: {kind}est {fractions[name]:.0%} of {name} ({k} of {m}) equals brute force "
+                  f"(max rel diff {d:.2g})")
+            check(np.allclose(rec_err, err, rtol=1e-9, atol=1e-15 * mean.max()), f"msd: its error over origins")
+            check(np.all(rec > mid) if kind == "fast" else np.all(rec < mid), f"msd: {kind} subset on the "
+                  f"{'far' if kind == 'fast' else 'near'} side of the {name}-particle MSD at every lag")
+
+
+def golden_min(fn, a, b, iters=200):
+    """Minimum of a unimodal fn on [a, b] by golden-section search."""
+    r = (math.sqrt(5) - 1) / 2
+    c, d = b - r * (b - a), a + r * (b - a)
+    for _ in range(iters):
+        if fn(c) < fn(d):
+            b, d = d, c
+            c = b - r * (b - a)
+        else:
+            a, c = c, d
+            d = a + r * (b - a)
+    return (a + b) / 2
+
+
+def fit_distribution(x, count, samples, w, t, tail_sigmas, min_count):
+    """The node's fits redone: Gaussian ln P_g with D free, weighted by counts, over bins with at least
+    min_count; exponential tail over those with |x| >= tail_sigmas sqrt(<x^2>) (straight line in ln P)."""
+    p = count / (samples * w)
+    use = count >= min_count
+    d = x_min = x0 = math.nan
+    if use.sum() >= 3:
+        xu, cu, lpu = x[use], count[use], np.log(p[use])
+
+        def sse(u):
+            fourdt = 4 * math.exp(u) * t
+            return np.sum(cu * (lpu + xu ** 2 / fourdt + 0.5 * math.log(math.pi * fourdt)) ** 2)
+        u0 = math.log(np.sum(cu * xu ** 2) / cu.sum() / (2 * t))
+        d = math.exp(golden_min(sse, u0 - 3, u0 + 3))
+    if count.sum() > 0:
+        x_min = tail_sigmas * math.sqrt(np.sum(count * x ** 2) / count.sum())
+        tail = use & (np.abs(x) >= x_min)
+        if tail.sum() >= 3:
+            ax, wt = np.abs(x[tail]), count[tail].astype(float)
+            slope = np.polyfit(ax, np.log(p[tail]), 1, w=np.sqrt(wt))[0]
+            slope_err = math.sqrt(wt.sum() / (wt.sum() * np.sum(wt * ax ** 2) - np.sum(wt * ax) ** 2))
+            if slope < -slope_err:  # decays by more than one (Poisson) standard error, else no tail
+                x0 = -1 / slope
+    return d, x_min, x0
+
+
+def jackknife(v):
+    v = np.asarray(v)
+    return math.sqrt((len(v) - 1) / len(v) * np.sum((v - v.mean()) ** 2))
+
+
+def check_displacement(f, unwrapped, origin_frame, pair_frame, lag, scene):
+    """P(dx, t) of all and small particles at the lags nearest the scene's targets: counts, density and
+    its jackknife error over blocks of origins against numpy histograms of the recorded frames; the
+    Gaussian and exponential-tail fits (and their jackknife errors) redone in numpy."""
+    g = f["observables/displacement"]
+    sp = scene.get("displacement", {})
+    species = f["particles/all/species"][()]
+    x, w = g["x"][()], float(g.attrs["bin_width"])
+    nb, lo = len(x), x[0] - w / 2
+    tail_sigmas, min_count = float(g.attrs["tail_sigmas"]), int(g.attrs["min_bin_count"])
+    check(tail_sigmas == sp.get("tail_sigmas", 2.0) and min_count == sp.get("min_bin_count", 5)
+          and abs(w - sp.get("bin_width", 0.05)) < 1e-15 and nb == round(2 * sp.get("x_max", 10.0) / w),
+          f"displacement: {nb} bins of {w}, tail beyond {tail_sigmas} sigma, bins with >= {min_count}")
+    a0 = f["observables/schedule/cutoff_a"][0]
+    tau = float(g["tau_alpha"]["value"][-1])
+    tau_q = float(f[f"observables/overlap/a{a0:g}/tau_alpha/value"][-1])
+    check(tau == tau_q, f"displacement: tau_alpha {tau:.5g} is the overlap node's for a = {a0:g}")
+    mult = sp.get("lags_tau_alpha", [0.01, 1.0, 8.5])
+    want = np.array([m * tau for m in mult] + list(sp.get("lags", [])), dtype=float)
+    targets = g["target_time"]["value"][-1]
+    lag_index = g["lag_index"]["value"][-1]
+    check(np.allclose(targets, want, rtol=1e-15), f"displacement: targets {np.round(targets, 4)}")
+    nearest = np.array([np.argmin(np.abs(np.log(lag / t))) for t in want])
+    check(np.array_equal(lag_index, nearest), f"displacement: lags {lag[nearest]} nearest the targets in ln t")
+    n_origins = len(origin_frame)
+    blocks = min(int(g.attrs["n_blocks"]), n_origins)
+    check(blocks == min(sp.get("error_blocks", 20), n_origins), f"displacement: {blocks} blocks of origins")
+    block_of = np.arange(n_origins) * blocks // n_origins
+    nt = len(targets)
+    rec = {k: g[k]["value"][-1] for k in ("count", "p", "p_err", "gauss_d", "gauss_d_err", "tail_x0",
+                                           "tail_x0_err", "tail_x_min", "samples", "fraction_outside")}
+    n_fits = 0
+    for s, sel in enumerate((np.ones(len(species), bool), species == 0)):
+        for l_, j in enumerate(lag_index):
+            t = lag[j]
+            dx = [unwrapped[pair_frame[k][j]][sel, 0] - unwrapped[of][sel, 0] for k, of in enumerate(origin_frame)]
+            # The kernel's slot: floor((dx - lo) / w) + 1 clamped to 0 .. nb + 1 (0 and nb + 1: outside).
+            slot = [np.clip(np.floor((d - lo) * (1.0 / w) + 1.0), 0, nb + 1).astype(int) for d in dx]
+            per_block = np.zeros((blocks, nb + 2), dtype=np.int64)
+            samples = np.zeros(blocks, dtype=np.int64)
+            for k in range(n_origins):
+                per_block[block_of[k]] += np.bincount(slot[k], minlength=nb + 2)
+                samples[block_of[k]] += len(dx[k])
+            count = per_block.sum(axis=0)[1:nb + 1]
+            sl = slice((s * nt + l_) * nb, (s * nt + l_ + 1) * nb)
+            i = s * nt + l_
+            what = f"displacement {('all', 'small')[s]} t = {t:.3g}"
+            check(np.array_equal(rec["count"][sl], count) and rec["samples"][i] == samples.sum(),
+                  f"{what}: counts equal numpy's ({count.sum()} of {samples.sum()} inside)")
+            out_bf = 1 - count.sum() / samples.sum()
+            check(abs(rec["fraction_outside"][i] - out_bf) < 1e-15, f"{what}: fraction outside {out_bf:.3g}")
+            p = count / (samples.sum() * w)
+            loo = [(per_block.sum(axis=0) - per_block[b])[1:nb + 1] for b in range(blocks)]
+            loo_n = [samples.sum() - samples[b] for b in range(blocks)]
+            p_err = np.array([jackknife([c[b] / (n_ * w) for c, n_ in zip(loo, loo_n)]) for b in range(nb)])
+            check(np.allclose(rec["p"][sl], p, rtol=1e-12, atol=0)
+                  and np.allclose(rec["p_err"][sl], p_err, rtol=1e-9, atol=1e-12 * p.max()),
+                  f"{what}: P(dx) and its jackknife error equal numpy's")
+            d, x_min, x0 = fit_distribution(x, count, samples.sum(), w, t, tail_sigmas, min_count)
+            # D: the node's Levenberg-Marquardt stops when chi2 changes by < 1e-12 relative, which leaves
+            # D good to ~1e-6; x0 and x_min are closed forms (1e-9: sums in another order).
+            for name, mine, tol in (("gauss_d", d, 1e-5), ("tail_x_min", x_min, 1e-12), ("tail_x0", x0, 1e-9)):
+                r = float(rec[name][i])
+                ok = (math.isnan(mine) and math.isnan(r)) or abs(r - mine) <= tol * abs(mine)
+                check(ok, f"{what}: {name} = {r:.6g} (numpy {mine:.6g})")
+            if math.isfinite(x0) and math.isfinite(d):
+                n_fits += 1
+                fits = [fit_distribution(x, c, n_, w, t, tail_sigmas, min_count) for c, n_ in zip(loo, loo_n)]
+                d_err, x0_err = jackknife([q[0] for q in fits]), jackknife([q[2] for q in fits])
+                # NaN if some block's leave-one-out fit has no decaying tail, in both.
+                x0_same = (math.isnan(x0_err) and math.isnan(rec["tail_x0_err"][i])) or \
+                    abs(rec["tail_x0_err"][i] - x0_err) <= 1e-6 * x0_err + 1e-12 * x0
+                check(abs(rec["gauss_d_err"][i] - d_err) <= 1e-3 * d_err + 1e-5 * d and x0_same,
+                      f"{what}: jackknife errors D +- {d_err:.2g}, x0 +- {x0_err:.2g} equal numpy's")
+    check(n_fits > 0, f"displacement: {n_fits} series with both fits")
+
+
+def check_msd(f, unwrapped, origin_frame, pair_frame, lag, scene):
     """Delta(t) = <|r(t0+t) - r(t0)|^2> over particles (all, small), then over origins; D by brute force."""
     species = f["particles/all/species"][()]
     g = f["observables/msd"]
@@ -56,6 +207,7 @@ def check_msd(f, unwrapped, origin_frame, pair_frame, lag):
         check(abs(D - slope / 4) <= 1e-9 * abs(D), f"msd: D = {D:.5g} is the slope/4 over [{t_min:.3g}, {t_max:.3g}]")
     else:
         check(False, "msd: no diffusion coefficient")
+    check_msd_extremes(g, d2, species, scene)
 
 
 def check_chi4(f, unwrapped, L, origin_frame, pair_frame):
@@ -298,12 +450,14 @@ def main(path, scene_path):
         check(best <= nudged * (1 + 1e-9), f"{name}: fit beta={beta:.4g} tau0={tau0:.4g} is a least-squares minimum")
     if "observables/chi4" in f:
         check_chi4(f, unwrapped, L, origin_frame, pair_frame)
+    scene = tomllib.loads(text)
     if "observables/msd" in f:
-        check_msd(f, unwrapped, origin_frame, pair_frame, lag)
+        check_msd(f, unwrapped, origin_frame, pair_frame, lag, scene)
+    if "observables/displacement" in f:
+        check_displacement(f, unwrapped, origin_frame, pair_frame, lag, scene)
     if "observables/clusters" in f:
         nodes = f["observables/nodes/clusters"]
         check(int(nodes["frames_lost"]["value"][-1]) == 0, "clusters node lost no frame")
-        scene = tomllib.loads(text)
         check_clusters(f, unwrapped, L, origin_frame, pair_frame, lag, scene)
         for name, g in f["observables/clusters"].items():
             if "observables/overlap/" + name in f:

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Replays must reproduce the live results (Q(t), chi4, MSD, clusters) bit for bit (if the live run lost
+"""Replays must reproduce the live results (Q(t), chi4, MSD, P(dx, t), clusters) bit for bit (if the live run lost
 no frame) and must be identical to each other.
 
 Usage: compare_runs.py LIVE.h5 REPLAY1.h5 REPLAY2.h5
@@ -20,8 +20,12 @@ def final_results(path):
             for obs in ("chi4", "chi4_err", "chi4_peak", "tau4"):
                 out[f"chi4/{name}/{obs}"] = np.atleast_1d(g[obs]["value"][-1])
         if "observables/msd" in f:
-            for obs in ("msd_all", "msd_small", "diffusion"):
+            for obs in ("msd_all", "msd_small", "diffusion", "msd_fast_all", "msd_slow_all", "msd_fast_small",
+                        "msd_slow_small"):
                 out[f"msd/{obs}"] = np.atleast_1d(f["observables/msd"][obs]["value"][-1])
+        if "observables/displacement" in f:
+            for obs in ("p", "p_err", "gauss_d", "gauss_d_err", "tail_x0", "tail_x0_err", "tail_x_min"):
+                out[f"displacement/{obs}"] = np.atleast_1d(f["observables/displacement"][obs]["value"][-1])
         for name, g in f.get("observables/clusters", {}).items():
             for obs in ("neighbour_cutoff", "tau_alpha", "lag", "mean_size_slow", "mean_size_fast", "p_slow",
                         "p_fast", "rg_slow", "rg_fast", "slow_d_f", "slow_kappa", "fast_n0", "fast_sigma"):

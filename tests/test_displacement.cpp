@@ -172,3 +172,24 @@ TEST(Displacement, ExtremeSubsetsMatchASortedList) {
     EXPECT_NEAR(e.fast, std::accumulate(v.end() - k, v.end(), 0.0) / k, 1e-12);
   }
 }
+
+TEST(Displacement, ExtremeSubsetsWithAReusedBufferMatchASortedList) {
+  // One buffer for every call, as the node does: all, then small, then all
+  // again; fractions from one particle to more than half (subsets overlap).
+  const System s = random_system(1001, 30.0, 0.7, 9);
+  std::vector<double> d2(s.n), buffer;
+  for (long i = 0; i < s.n; ++i)
+    d2[i] = std::pow(s.pt[2 * i] - s.p0[2 * i], 2) + std::pow(s.pt[2 * i + 1] - s.p0[2 * i + 1], 2);
+  for (const double f : {0.1, 0.2, 0.001, 0.5, 0.7})
+    for (int which : {-1, 0, 1, -1}) {
+      std::vector<double> v;
+      for (long i = 0; i < s.n; ++i)
+        if (which < 0 || s.species[i] == which) v.push_back(d2[i]);
+      std::sort(v.begin(), v.end());
+      const long k = std::max(1L, std::lround(f * v.size()));
+      const ExtremeMsd e = msd_extremes(d2.data(), s.species.data(), s.n, f, which, buffer);
+      EXPECT_EQ(e.count, k);
+      EXPECT_NEAR(e.slow, std::accumulate(v.begin(), v.begin() + k, 0.0) / k, 1e-12 * v.back());
+      EXPECT_NEAR(e.fast, std::accumulate(v.end() - k, v.end(), 0.0) / k, 1e-12 * v.back());
+    }
+}

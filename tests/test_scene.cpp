@@ -113,3 +113,29 @@ TEST(Scene, ClustersTableIsValidated) {
   expect_error("[clusters]\nerror_blocks = 1\n", {"clusters.error_blocks", "2 <= value"});
   expect_error("[clusters]\nsmoothing = 1\n", {"clusters.smoothing", "unknown key", "gr_smoothing"});
 }
+
+TEST(Scene, MsdAndDisplacementTablesAreValidated) {
+  const auto d = parse_scene_text("", "test.toml");
+  EXPECT_DOUBLE_EQ(d.msd.fraction_all, 0.1);   // the paper's 10% of all particles
+  EXPECT_DOUBLE_EQ(d.msd.fraction_small, 0.2); // and 20% of small ones
+  EXPECT_EQ(d.displacement.lags_tau_alpha, (std::vector<double>{0.01, 1.0, 8.5})); // its fig. "tails"
+  EXPECT_EQ(d.displacement.bins(), 400);
+  const auto s = parse_scene_text("[observables]\ncompute = [\"displacement\"]\n[msd]\nfraction_small = 0.5\n"
+                                  "[displacement]\nlags_tau_alpha = []\nlags = [2, 4.5]\nx_max = 3\n"
+                                  "bin_width = 0.1\n",
+                                  "test.toml");
+  EXPECT_EQ(dynhet::nodes_for(s.observables), std::vector<std::string>{"overlap_node"});
+  EXPECT_DOUBLE_EQ(s.msd.fraction_small, 0.5);
+  EXPECT_EQ(s.displacement.lags, (std::vector<double>{2.0, 4.5}));
+  EXPECT_EQ(s.displacement.bins(), 60);
+  expect_error("[msd]\nfraction_all = 0.6\n", {"msd.fraction_all", "0 < fraction <= 0.5"});
+  expect_error("[msd]\nfraction_small = 0\n", {"msd.fraction_small", "0 < fraction <= 0.5"});
+  expect_error("[displacement]\nlags = [1, -2]\n", {"displacement.lags", "> 0"});
+  expect_error("[displacement]\nlags_tau_alpha = 1.0\n", {"displacement.lags_tau_alpha", "an array"});
+  expect_error("[observables]\ncompute = [\"displacement\"]\n[displacement]\nlags_tau_alpha = []\n",
+               {"displacement.lags_tau_alpha", "both empty"});
+  expect_error("[displacement]\nbin_width = 5.0\n", {"displacement.bin_width", "10 to 4000 bins"});
+  expect_error("[displacement]\nbin_width = 0.005\n", {"displacement.bin_width", "more than 4096"});
+  expect_error("[displacement]\nerror_blocks = 1\n", {"displacement.error_blocks", "2 <= value"});
+  expect_error("[displacement]\ntail = 2\n", {"displacement.tail", "unknown key", "tail_sigmas"});
+}

@@ -266,20 +266,29 @@ void displacement_pass(const double* pos0, const double* pos_t, const std::uint8
 }
 
 ExtremeMsd msd_extremes(const double* d2, const std::uint8_t* species, long n, double fraction,
-                        int which_species) {
-  std::vector<double> v;
-  v.reserve(n);
-  for (long i = 0; i < n; ++i)
-    if (which_species < 0 || species[i] == which_species) v.push_back(d2[i]);
+                        int which_species, std::vector<double>& v) {
+  v.clear();
+  if (which_species < 0) v.assign(d2, d2 + n);
+  else
+    for (long i = 0; i < n; ++i)
+      if (species[i] == which_species) v.push_back(d2[i]);
   const long m = static_cast<long>(v.size());
-  const long k = std::min(m, std::max(1L, std::lround(fraction * m)));
   if (m == 0) return {NAN, NAN, 0};
-  // Slowest k in v[0, k), then fastest k in v[m-k, m).
+  const long k = std::min(m, std::max(1L, std::lround(fraction * m)));
+  // Slowest k in v[0, k); the fastest k are then the top of v[k, m) (the
+  // whole of v if the subsets overlap), so the second selection skips v[0, k).
   std::nth_element(v.begin(), v.begin() + (k - 1), v.end());
   const double slow = std::accumulate(v.begin(), v.begin() + k, 0.0) / k;
-  std::nth_element(v.begin(), v.begin() + (m - k), v.end());
+  const auto from = 2 * k <= m ? v.begin() + k : v.begin();
+  std::nth_element(from, v.begin() + (m - k), v.end());
   const double fast = std::accumulate(v.begin() + (m - k), v.end(), 0.0) / k;
   return {fast, slow, k};
+}
+
+ExtremeMsd msd_extremes(const double* d2, const std::uint8_t* species, long n, double fraction,
+                        int which_species) {
+  std::vector<double> buffer;
+  return msd_extremes(d2, species, n, fraction, which_species, buffer);
 }
 
 void overlap_weights(const double* d2, long n, double a, std::vector<double>& weight) {

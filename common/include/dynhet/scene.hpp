@@ -4,6 +4,7 @@
 // is allowed.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <stdexcept>
 #include <string>
@@ -85,6 +86,27 @@ struct Scene {
     int error_blocks = 20;      // errors from at most this many blocks of consecutive origins
   } clusters;
 
+  // [msd]: the instantaneous fastest and slowest subsets (paper fig. MSD)
+  struct Msd {
+    double fraction_all = 0.1;   // fastest / slowest 10% of all particles
+    double fraction_small = 0.2; // fastest / slowest 20% of the small ones
+  } msd;
+
+  // [displacement]: P(dx, t) of x displacements with Gaussian and
+  // exponential-tail fits (paper sec. 3.2, fig. "tails")
+  struct Displacement {
+    // The lags: the scheduled lags nearest these multiples of tau_alpha
+    // (the paper's 0.01, 1 and 8.5 tau_alpha) and nearest these times.
+    std::vector<double> lags_tau_alpha{0.01, 1.0, 8.5};
+    std::vector<double> lags;
+    double x_max = 10.0;     // histogram over -x_max <= dx < x_max ...
+    double bin_width = 0.05; // ... in bins of this width
+    double tail_sigmas = 2.0; // exponential tail over |dx| >= tail_sigmas sqrt(<dx^2>)
+    int min_bin_count = 5;    // bins with fewer displacements stay out of the fits
+    int error_blocks = 20;    // errors: jackknife over at most this many blocks of origins
+    int bins() const { return static_cast<int>(std::lround(2 * x_max / bin_width)); }
+  } displacement;
+
   // [transport]
   int chunk_particles = 8192; // 16 bytes each: 128 KiB of positions
 
@@ -99,9 +121,10 @@ Scene parse_scene_file(const std::string& path);
 // Observables this build knows how to compute.
 const std::vector<std::string>& known_observables();
 
-// The node that computes an observable: Q(t), chi4(t) and the MSD come from
-// the same pass over the displacements of the same (origin, lag) pairs, so
-// one node, "overlap", serves all three (one pass, one copy of the frames).
+// The node that computes an observable: Q(t), chi4(t), the MSD and P(dx, t)
+// come from the same pass over the displacements of the same (origin, lag)
+// pairs, so one node, "overlap", serves all four (one pass, one copy of the
+// frames).
 std::string node_of(const std::string& observable);
 // The executables a list of observables needs ("overlap_node", ...), each once.
 std::vector<std::string> nodes_for(const std::vector<std::string>& observables);

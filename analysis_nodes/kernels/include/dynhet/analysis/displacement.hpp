@@ -108,11 +108,17 @@ void displacement_pass(const double* pos0, const double* pos_t, const std::uint8
 
 // Mean of |dr|^2 over the instantaneous fastest and slowest `fraction` of a
 // set of particles (species -1: all, else that species), e.g. 10% of all,
-// 20% of small ones (paper, fig. MSD). Exact: selection by nth_element.
+// 20% of small ones (paper, fig. MSD). "Instantaneous": the subsets are
+// chosen anew for every (origin, lag) pair, by the particles' own |dr|^2
+// over that lag; each holds round(fraction * set size) particles (at least
+// one). Exact: selection by nth_element in `buffer` (reused: no allocation
+// once it has grown to the set's size).
 struct ExtremeMsd {
   double fast, slow;
   long count; // particles in each subset
 };
+ExtremeMsd msd_extremes(const double* d2, const std::uint8_t* species, long n, double fraction,
+                        int which_species, std::vector<double>& buffer);
 ExtremeMsd msd_extremes(const double* d2, const std::uint8_t* species, long n, double fraction,
                         int which_species = -1);
 
