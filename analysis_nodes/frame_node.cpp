@@ -1,0 +1,172 @@
+#include "frame_node.hpp"
+
+#include <algorithm>
+#include <cstdio>
+
+#include <CLI/CLI.hpp>
+
+namespace dynhet {
+
+FrameNode::FrameNode(lcm::LCM& out, int64_t run_filter, std::string name)
+    : out_(out), run_filter_(run_filter), name_(std::move(name)) {
+  status_.node = name_;
+  status_.state = "waiting";
+}
+
+void FrameNode::check_sim_alive(double timeout) {
+  if (!info_ || finished_ || sim_interrupted_) return;
+  const double silent = std::chrono::duration<double>(Clock::now() - last_sim_news_).count();
+  if (silent > timeout) finish(1, "the sim has been silent for " + std::to_string(static_cast<int>(silent)) + " s");
+}
+
+void FrameNode::input_ended() {
+  if (!finished_) finish(1, info_ ? "input ended before the run did" : "no run info in the input");
+}
+
+void FrameNode::on_run(const lcm::ReceiveBuffer*, const std::string&, const run_info_t* m) {
+  if (info_ || (run_filter_ && m->run_id != run_filter_)) return;
+  info_ = std::make_unique<run_info_t>(*m);
+  last_sim_news_ = Clock::now();
+  status_.run_id = m->run_id;
+  status_.frames_expected = m->n_frames;
+  status_.state = "running";
+  try {
+    start(*m);
+  } catch (const std::exception& e) {
+    finish(1, e.what());
+    return;
+  }
+  // Which origins and which used (origin, lag) pairs each frame serves.
+  origin_at_.assign(m->n_frames, -1);
+  pairs_at_.assign(m->n_frames, {});
+  last_use_.assign(m->n_origins, -1);
+  for (int k = 0; k < m->n_origins; ++k) {
+    origin_at_[m->origin_frame[k]] = k;
+    for (int j = 0; j < m->n_lags; ++j) {
+      const int f = m->pair_frame[static_cast<size_t>(k) * m->n_lags + j];
+      if (f < 0 || !uses_lag(j)) continue;
+      pairs_at_[f].push_back({k, j});
+      last_use_[k] = std::max(last_use_[k], f);
+    }
+  }
+}
+
+void FrameNode::on_chunk(const lcm::ReceiveBuffer*, const std::string&, const frame_chunk_t* m) {
+  if (!info_ || finished_ || m->run_id != info_->run_id || m->n_values != 2 * m->count) return;
+  last_sim_news_ = Clock::now();
+  const ChunkHeader h{m->frame_index, m->time,           m->n_particles, m->chunk_index,
+                      m->chunk_count, m->first_particle, m->count};
+  auto frame = assembler_.add(h, m->position.data());
+  if (frame && frame->index < info_->n_frames) on_frame(*frame);
+}
+
+void FrameNode::on_sim_status(const lcm::ReceiveBuffer*, const std::string&, const sim_status_t* m) {
+  if (!info_ || m->run_id != info_->run_id || finished_) return;
+  last_sim_news_ = Clock::now();
+  sim_interrupted_ = m->phase == "interrupted"; // checkpointed: wait for --resume
+  if (m->phase == "done") finish(0, "");
+  if (m->phase == "failed") finish(1, "sim failed: " + m->message);
+}
+
+void FrameNode::on_frame(const Frame& f) {
+  const int k0 = origin_at_[f.index];
+  if (k0 >= 0 && last_use_[k0] > f.index) { // an origin some later frame needs
+    origins_[k0] = f.position;
+    on_origin(k0, origins_[k0]);
+  }
+  bool added = false;
+  for (const auto& [k, j] : pairs_at_[f.index]) {
+    auto it = origins_.find(k);
+    if (it == origins_.end()) continue; // the origin frame was lost
+    on_pair(k, j, it->second, f);
+    ++pairs_done_;
+    added = true;
+  }
+  // Drop origins no later frame needs.
+  for (auto it = origins_.begin(); it != origins_.end();)
+    if (last_use_[it->first] <= f.index) {
+      on_origin_dropped(it->first);
+      it = origins_.erase(it);
+    } else {
+      ++it;
+    }
+  last_frame_ = f.index;
+  last_time_ = f.time;
+  if (added) publish_results(false);
+  tick();
+}
+
+void FrameNode::publish_status() {
+  status_.utime = utime_now();
+  status_.frames_whole = assembler_.frames_whole();
+  status_.frames_lost = assembler_.frames_lost();
+  status_.chunks_received = assembler_.chunks_received();
+  status_.pairs_done = pairs_done_;
+  status_.origins_held = static_cast<int32_t>(origins_.size());
+  out_.publish(kChanNodeStatus, &status_);
+  last_status_ = Clock::now();
+}
+
+void FrameNode::tick() {
+  if (std::chrono::duration<double>(Clock::now() - last_status_).count() >= 1.0) publish_status();
+}
+
+void FrameNode::finish(int code, const std::string& why) {
+  if (info_) assembler_.finish(info_->n_frames);
+  if (info_ && status_.state == "running") publish_results(true);
+  status_.state = code == 0 ? "done" : "failed";
+  status_.message = why;
+  publish_status();
+  std::fprintf(stderr, "%s_node: %s: %d frames whole, %d lost%s%s\n", name_.c_str(), status_.state.c_str(),
+               assembler_.frames_whole(), assembler_.frames_lost(), why.empty() ? "" : "; ", why.c_str());
+  finished_ = true;
+  exit_code_ = code;
+}
+
+int node_main(const std::string& program, const std::string& description, NodeFactory make_node, int argc,
+              char** argv) {
+  CLI::App app{description};
+  std::string url, publish_url;
+  int64_t run_id = 0;
+  double wait_run = 300, sim_timeout = 60;
+  app.add_option("--lcm-url", url, "LCM URL to read from (file://LOG?speed=0 replays a log)");
+  app.add_option("--publish-url", publish_url, "LCM URL to publish on (default: the input bus)");
+  app.add_option("--run-id", run_id, "only this run (default: the first one seen)");
+  app.add_option("--wait-run", wait_run, "give up after this many seconds without run info");
+  app.add_option("--sim-timeout", sim_timeout, "give up if the sim is silent this long (s) during a run");
+  CLI11_PARSE(app, argc, argv);
+
+  const std::string in_url = resolve_lcm_url(url);
+  const bool replay = in_url.rfind("file://", 0) == 0;
+  lcm::LCM in(in_url);
+  std::unique_ptr<lcm::LCM> out_owned;
+  if (!publish_url.empty() || replay) out_owned = std::make_unique<lcm::LCM>(resolve_lcm_url(publish_url));
+  lcm::LCM& out = out_owned ? *out_owned : in;
+  if (!in.good() || !out.good()) {
+    std::fprintf(stderr, "%s: cannot open LCM (%s)\n", program.c_str(), in_url.c_str());
+    return 3;
+  }
+
+  std::unique_ptr<FrameNode> node = make_node(out, run_id);
+  in.subscribe(kChanRun, &FrameNode::on_run, node.get());
+  in.subscribe(kChanFrame, &FrameNode::on_chunk, node.get())->setQueueCapacity(100000);
+  in.subscribe(kChanSimStatus, &FrameNode::on_sim_status, node.get());
+
+  std::fprintf(stderr, "%s: ready, reading %s\n", program.c_str(), in_url.c_str());
+  const auto start = FrameNode::Clock::now();
+  while (!node->finished()) {
+    if (in.handleTimeout(200) < 0) { // a replayed log has ended
+      node->input_ended();
+      break;
+    }
+    node->tick();
+    if (!replay) node->check_sim_alive(sim_timeout);
+    if (!node->has_run() && std::chrono::duration<double>(FrameNode::Clock::now() - start).count() > wait_run) {
+      std::fprintf(stderr, "%s: no run info on %s within %g s\n", program.c_str(), in_url.c_str(), wait_run);
+      return 4;
+    }
+  }
+  return node->exit_code();
+}
+
+} // namespace dynhet

@@ -1,0 +1,106 @@
+// What every analysis node shares, in the LCM layer above the kernels: it
+// takes the run info of the first run seen (or of --run-id), reassembles
+// frames from chunks, knows from the schedule which frame is which origin
+// and which (origin, lag) pairs it completes, holds each origin frame
+// (16 N bytes) only until the last pair the node uses has been seen,
+// watches the sim (done, failed, interrupted, silent) and publishes the
+// node status every second. A node says which lags it uses, what to do
+// with a pair, and how to publish its results; node_main() is its main().
+#pragma once
+
+#include <chrono>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "dynhet/chunking.hpp"
+#include "dynhet/frame_chunk_t.hpp"
+#include "dynhet/lcm_url.hpp"
+#include "dynhet/node_status_t.hpp"
+#include "dynhet/run_info_t.hpp"
+#include "dynhet/sim_status_t.hpp"
+
+namespace dynhet {
+
+class FrameNode {
+public:
+  using Clock = std::chrono::steady_clock;
+
+  FrameNode(lcm::LCM& out, int64_t run_filter, std::string name);
+  virtual ~FrameNode() = default;
+
+  bool finished() const { return finished_; }
+  bool has_run() const { return info_ != nullptr; }
+  int exit_code() const { return exit_code_; }
+  // The sim publishes its status every second; silence longer than
+  // `timeout` (not after a checkpointed interruption) means it died.
+  void check_sim_alive(double timeout);
+  // The input ended (log replayed to its end) before the sim said done.
+  void input_ended();
+  void tick(); // node status once a second
+
+  void on_run(const lcm::ReceiveBuffer*, const std::string&, const run_info_t* m);
+  void on_chunk(const lcm::ReceiveBuffer*, const std::string&, const frame_chunk_t* m);
+  void on_sim_status(const lcm::ReceiveBuffer*, const std::string&, const sim_status_t* m);
+
+protected:
+  // The run has started: set up. Throwing fails the node with the message.
+  virtual void start(const run_info_t& m) = 0;
+  // Whether the node evaluates lag j (asked after start()); origins are held
+  // only until their last used lag.
+  virtual bool uses_lag(int) const { return true; }
+  virtual void on_origin(int /*k*/, const std::vector<double>& /*pos0*/) {}
+  virtual void on_origin_dropped(int /*k*/) {}
+  // One (origin k, lag j) pair: origin positions and the frame at t0 + lag.
+  virtual void on_pair(int k, int j, const std::vector<double>& pos0, const Frame& f) = 0;
+  // After a frame that completed at least one pair, and at the end (final).
+  virtual void publish_results(bool final) = 0;
+
+  // The fields every result message shares: when, which run, which frame.
+  template <class Msg> void stamp(Msg& m, bool final) const {
+    m.utime = utime_now();
+    m.run_id = info_->run_id;
+    m.sim_time = last_time_;
+    m.frame_index = last_frame_;
+    m.is_final = final;
+  }
+  const run_info_t& info() const { return *info_; }
+  lcm::LCM& out() { return out_; }
+  int pairs_done() const { return pairs_done_; }
+  const std::string& name() const { return name_; }
+
+private:
+  void on_frame(const Frame& f);
+  void publish_status();
+  void finish(int code, const std::string& why);
+
+  lcm::LCM& out_;
+  int64_t run_filter_;
+  std::string name_;
+  std::unique_ptr<run_info_t> info_;
+  std::vector<int> origin_at_, last_use_;
+  std::vector<std::vector<std::pair<int, int>>> pairs_at_;
+  std::map<int, std::vector<double>> origins_; // origin k -> positions at t0
+  FrameAssembler assembler_;
+  node_status_t status_{};
+  Clock::time_point last_status_ = Clock::now();
+  Clock::time_point last_sim_news_ = Clock::now();
+  bool sim_interrupted_ = false;
+  int pairs_done_ = 0, last_frame_ = -1;
+  double last_time_ = 0;
+  bool finished_ = false;
+  int exit_code_ = 0;
+};
+
+// A node's main(): flags (--lcm-url, --publish-url, --run-id, --wait-run,
+// --sim-timeout), the buses (file://LOG?speed=0 replays a log and then
+// publishes on --publish-url), subscriptions and the loop.
+// make_node(out, run_id) builds the node.
+using NodeFactory = std::unique_ptr<FrameNode> (*)(lcm::LCM& out, int64_t run_id);
+int node_main(const std::string& program, const std::string& description, NodeFactory make_node, int argc,
+              char** argv);
+
+} // namespace dynhet
