@@ -10,6 +10,7 @@
 //   sim/<field>            {step = collisions + kicks, time = sim time}
 //   nodes/<node>/<field>   {step = frames handled, time = wall s since the first node status}
 //   overlap/a<cutoff>/<field> {step = frame index, time = sim time}, lag_time
+//   chi4/a<cutoff>/..., msd/..., s4/... likewise (s4: see write_s4)
 #pragma once
 
 #include <cstdint>
@@ -26,6 +27,7 @@
 #include "dynhet/node_status_t.hpp"
 #include "dynhet/chi4_t.hpp"
 #include "dynhet/msd_t.hpp"
+#include "dynhet/s4_t.hpp"
 #include "dynhet/overlap_t.hpp"
 #include "dynhet/run_info_t.hpp"
 #include "dynhet/sim_status_t.hpp"
@@ -67,6 +69,7 @@ public:
   bool on_overlap(const overlap_t &m);
   bool on_chi4(const chi4_t &m);
   bool on_msd(const msd_t &m);
+  bool on_s4(const s4_t &m);
   bool on_frame_chunk(const frame_chunk_t &m);
 
   bool has_run() const { return info_ != nullptr; }
@@ -97,6 +100,7 @@ private:
   std::map<std::string, bool> chi4_started_;    // by cutoff label
   std::map<std::string, bool> overlap_t0_written_;
   bool msd_started_ = false;
+  bool s4_started_ = false;
   std::optional<int64_t> node_clock_zero_;      // utime of the first node status
   int write_errors_ = 0;
 
@@ -106,6 +110,7 @@ private:
   void write_overlap(const overlap_t &m);
   void write_chi4(const chi4_t &m);
   void write_msd(const msd_t &m);
+  void write_s4(const s4_t &m);
   void write_summary(const std::vector<std::string> &missing);
   void sim_ended(const sim_status_t &m);
   template <class F> void guarded(const char *what, F &&write);

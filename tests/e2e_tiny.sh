@@ -13,7 +13,7 @@ export BUILD_DIR=$build
 bash "$root/launch_scripts/run_scene.sh" "$root/scenes/tiny.toml" --out "$tmp/live" \
   --url 'udpm://239.255.76.67:7681?ttl=0' --record "$tmp/run.lcmlog" --no-build
 /usr/bin/python3 "$root/tests/check_run.py" "$tmp/live/run.h5" "$root/scenes/tiny.toml"
-[[ -s $tmp/live/overlap.png && -s $tmp/live/chi4.png && -s $tmp/live/msd.png ]] || { echo "FAIL: no plot"; exit 1; }
+[[ -s $tmp/live/overlap.png && -s $tmp/live/chi4.png && -s $tmp/live/msd.png && -s $tmp/live/s4.png ]] || { echo "FAIL: no plot"; exit 1; }
 
 bash "$root/launch_scripts/replay.sh" "$tmp/run.lcmlog" --out "$tmp/replay1" --no-build
 bash "$root/launch_scripts/replay.sh" "$tmp/run.lcmlog" --out "$tmp/replay2" --no-build
