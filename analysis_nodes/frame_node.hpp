@@ -102,5 +102,11 @@ private:
 using NodeFactory = std::unique_ptr<FrameNode> (*)(lcm::LCM& out, int64_t run_id);
 int node_main(const std::string& program, const std::string& description, NodeFactory make_node, int argc,
               char** argv);
+template <class Node> int node_main(const std::string& program, const std::string& description, int argc, char** argv) {
+  return node_main(
+      program, description,
+      [](lcm::LCM& out, int64_t run_id) -> std::unique_ptr<FrameNode> { return std::make_unique<Node>(out, run_id); },
+      argc, argv);
+}
 
 } // namespace dynhet

@@ -209,9 +209,5 @@ private:
 } // namespace
 
 int main(int argc, char** argv) {
-  return dynhet::node_main("overlap_node", "dynhet overlap_node: Q(t), tau_alpha from frames on LCM",
-                           [](lcm::LCM& out, int64_t run_id) -> std::unique_ptr<dynhet::FrameNode> {
-                             return std::make_unique<OverlapNode>(out, run_id);
-                           },
-                           argc, argv);
+  return dynhet::node_main<OverlapNode>("overlap_node", "dynhet overlap_node: Q(t), tau_alpha from frames on LCM", argc, argv);
 }

@@ -79,7 +79,7 @@ private:
     const std::vector<double> none;
     for (const an::SubboxGrid& g : s4_grids(m.n_particles, m.box_length, sizes)) {
       grids_.push_back(g);
-      fft_.push_back(std::make_unique<an::S4Grid>(g, q_max_, an::S4GridParams{scene.s4_grid_spacing, scene.s4_half_width}));
+      fft_.push_back(std::make_unique<an::S4Grid>(g, q_max_, an::S4GridParams{scene.s4_grid_spacing, scene.s4_half_width, false}));
       // The shells of this grid (from zero weights: only q and the vector counts matter).
       const an::S4Shells shells = an::s4_shells(fft_.back()->modes(none.data(), none.data(), 0));
       acc_.emplace_back(m.n_origins, static_cast<int>(lags_.size()), shells.q, shells.n_vectors);
@@ -196,9 +196,5 @@ private:
 } // namespace
 
 int main(int argc, char** argv) {
-  return dynhet::node_main("s4_node", "dynhet s4_node: S4(q,t), xi and chi0 from frames on LCM",
-                           [](lcm::LCM& out, int64_t run_id) -> std::unique_ptr<dynhet::FrameNode> {
-                             return std::make_unique<S4Node>(out, run_id);
-                           },
-                           argc, argv);
+  return dynhet::node_main<S4Node>("s4_node", "dynhet s4_node: S4(q,t), xi and chi0 from frames on LCM", argc, argv);
 }

@@ -22,6 +22,9 @@ def final_results(path):
         if "observables/msd" in f:
             for obs in ("msd_all", "msd_small", "diffusion"):
                 out[f"msd/{obs}"] = np.atleast_1d(f["observables/msd"][obs]["value"][-1])
+        if "observables/s4" in f:  # FFTW_ESTIMATE plans: the same arithmetic every run
+            for obs in ("s4", "s4_err", "s4_lag", "oz_xi", "oz_chi0", "a2_xi", "chi4", "tau_alpha"):
+                out[f"s4/{obs}"] = np.atleast_1d(f["observables/s4"][obs]["value"][-1])
         lost = int(f["observables/nodes/overlap/frames_lost/value"][-1])
         return out, lost
 
