@@ -9,7 +9,7 @@
 // (kernels/s4.cpp), then S4 per |q| shell. Lags: every scheduled lag by
 // default (the grid costs a few ms per pair at N = 10^4, so S4(q,t) and
 // xi(t) come at every t), or the scheduled lags nearest the times in
-// s4.lags (to bound the cost at N = 10^5, ~60 ms per pair for six grids).
+// s4.lags (to bound the cost at N = 10^5, ~70 ms per pair for six grids).
 // The fits with jackknife errors and the chi4 comparison are made at t_s4,
 // the computed lag nearest the node's own running tau_alpha (Q(t) from the
 // same weights, W(q = 0) of the whole box; the paper evaluates S4 at
