@@ -13,6 +13,10 @@ FrameNode::FrameNode(lcm::LCM& out, int64_t run_filter, std::string name)
   status_.state = "waiting";
 }
 
+bool FrameNode::wants(const std::string& o) const {
+  return std::find(info_->observables.begin(), info_->observables.end(), o) != info_->observables.end();
+}
+
 void FrameNode::check_sim_alive(double timeout) {
   if (!info_ || finished_ || sim_interrupted_) return;
   const double silent = std::chrono::duration<double>(Clock::now() - last_sim_news_).count();
@@ -30,12 +34,15 @@ void FrameNode::on_run(const lcm::ReceiveBuffer*, const std::string&, const run_
   status_.run_id = m->run_id;
   status_.frames_expected = m->n_frames;
   status_.state = "running";
+  std::fprintf(stderr, "%s_node: run %lld, N=%d, %d frames, %d origins x %d lags\n", name_.c_str(),
+               static_cast<long long>(m->run_id), m->n_particles, m->n_frames, m->n_origins, m->n_lags);
   try {
     start(*m);
   } catch (const std::exception& e) {
     finish(1, e.what());
     return;
   }
+  started_ = true;
   // Which origins and which used (origin, lag) pairs each frame serves.
   origin_at_.assign(m->n_frames, -1);
   pairs_at_.assign(m->n_frames, {});
@@ -70,7 +77,9 @@ void FrameNode::on_sim_status(const lcm::ReceiveBuffer*, const std::string&, con
 
 void FrameNode::on_frame(const Frame& f) {
   const int k0 = origin_at_[f.index];
-  if (k0 >= 0 && last_use_[k0] > f.index) { // an origin some later frame needs
+  last_frame_ = f.index;
+  last_time_ = f.time;
+  if (k0 >= 0) { // every origin frame is seen (clusters' g_ab uses them all), then held while needed
     origins_[k0] = f.position;
     on_origin(k0, origins_[k0]);
   }
@@ -90,8 +99,6 @@ void FrameNode::on_frame(const Frame& f) {
     } else {
       ++it;
     }
-  last_frame_ = f.index;
-  last_time_ = f.time;
   if (added) publish_results(false);
   tick();
 }
@@ -113,7 +120,7 @@ void FrameNode::tick() {
 
 void FrameNode::finish(int code, const std::string& why) {
   if (info_) assembler_.finish(info_->n_frames);
-  if (info_ && status_.state == "running") publish_results(true);
+  if (info_ && started_) publish_results(true);
   status_.state = code == 0 ? "done" : "failed";
   status_.message = why;
   publish_status();

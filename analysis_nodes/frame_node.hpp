@@ -3,12 +3,19 @@
 // frames from chunks, knows from the schedule which frame is which origin
 // and which (origin, lag) pairs it completes, holds each origin frame
 // (16 N bytes) only until the last pair the node uses has been seen,
-// watches the sim (done, failed, interrupted, silent) and publishes the
-// node status every second. A node says which lags it uses, what to do
-// with a pair, and how to publish its results; node_main() is its main().
+// watches the sim (done, failed, interrupted, silent, or a replayed log
+// that ends) and publishes the node status every second. A node derives
+// from FrameNode and says which lags it uses, what to do with an origin
+// frame and with a pair, and how to publish its results; node_main<Node>()
+// is its main().
+//
+// (Two branches took this layer out of overlap_node independently; this is
+// their union: the per-origin and per-pair hooks, uses_lag and node_main of
+// one, held_origins() and wants() of the other.)
 #pragma once
 
 #include <chrono>
+#include <cstdint>
 #include <map>
 #include <memory>
 #include <string>
@@ -29,6 +36,7 @@ class FrameNode {
 public:
   using Clock = std::chrono::steady_clock;
 
+  // `name` is the node's name in its status ("overlap") and logs ("overlap_node").
   FrameNode(lcm::LCM& out, int64_t run_filter, std::string name);
   virtual ~FrameNode() = default;
 
@@ -47,14 +55,18 @@ public:
   void on_sim_status(const lcm::ReceiveBuffer*, const std::string&, const sim_status_t* m);
 
 protected:
-  // The run has started: set up. Throwing fails the node with the message.
+  // The run has started: set up. Throwing fails the node with the message
+  // (no results are published then).
   virtual void start(const run_info_t& m) = 0;
   // Whether the node evaluates lag j (asked after start()); origins are held
   // only until their last used lag.
   virtual bool uses_lag(int) const { return true; }
+  // Origin frame k has arrived (before the pairs the same frame ends); it
+  // is held (held_origins()) until on_origin_dropped(k).
   virtual void on_origin(int /*k*/, const std::vector<double>& /*pos0*/) {}
   virtual void on_origin_dropped(int /*k*/) {}
-  // One (origin k, lag j) pair: origin positions and the frame at t0 + lag.
+  // One (origin k, lag j) pair: origin positions and the frame at t0 + lag
+  // (pairs whose origin frame was lost are left out).
   virtual void on_pair(int k, int j, const std::vector<double>& pos0, const Frame& f) = 0;
   // After a frame that completed at least one pair, and at the end (final).
   virtual void publish_results(bool final) = 0;
@@ -68,6 +80,10 @@ protected:
     m.is_final = final;
   }
   const run_info_t& info() const { return *info_; }
+  // The origin frames held now: origin k -> positions at t0.
+  const std::map<int, std::vector<double>>& held_origins() const { return origins_; }
+  // Whether the run's scene asks for `observable`.
+  bool wants(const std::string& observable) const;
   lcm::LCM& out() { return out_; }
   int pairs_done() const { return pairs_done_; }
   const std::string& name() const { return name_; }
@@ -81,18 +97,15 @@ private:
   int64_t run_filter_;
   std::string name_;
   std::unique_ptr<run_info_t> info_;
-  std::vector<int> origin_at_, last_use_;
-  std::vector<std::vector<std::pair<int, int>>> pairs_at_;
-  std::map<int, std::vector<double>> origins_; // origin k -> positions at t0
+  std::vector<int> origin_at_, last_use_;                 // per frame; per origin
+  std::vector<std::vector<std::pair<int, int>>> pairs_at_; // per frame: the used (origin, lag)
+  std::map<int, std::vector<double>> origins_;             // origin k -> positions at t0
   FrameAssembler assembler_;
   node_status_t status_{};
-  Clock::time_point last_status_ = Clock::now();
-  Clock::time_point last_sim_news_ = Clock::now();
-  bool sim_interrupted_ = false;
-  int pairs_done_ = 0, last_frame_ = -1;
+  Clock::time_point last_status_ = Clock::now(), last_sim_news_ = Clock::now();
+  bool sim_interrupted_ = false, started_ = false, finished_ = false;
+  int pairs_done_ = 0, last_frame_ = -1, exit_code_ = 0;
   double last_time_ = 0;
-  bool finished_ = false;
-  int exit_code_ = 0;
 };
 
 // A node's main(): flags (--lcm-url, --publish-url, --run-id, --wait-run,

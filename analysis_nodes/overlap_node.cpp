@@ -40,13 +40,11 @@ private:
   void start(const dynhet::run_info_t& m) override {
     grid_ = an::make_subbox_grid(m.n_particles, m.box_length, m.overlap_subbox_particles);
     for (int c = 0; c < m.n_cutoffs; ++c) acc_.emplace_back(m.n_origins, m.lag_time);
-    auto wants = [&](const char* o) { return std::find(m.observables.begin(), m.observables.end(), o) != m.observables.end(); };
     want_chi4_ = wants("chi4");
     want_msd_ = wants("msd");
     if (want_chi4_ || want_msd_) start_pass(m);
-    std::fprintf(stderr, "overlap_node: run %lld, N=%d, %d frames, %d origins x %d lags, %dx%d sub-boxes of N=%.1f\n",
-                 static_cast<long long>(m.run_id), m.n_particles, m.n_frames, m.n_origins,
-                 m.n_lags, grid_.per_side, grid_.per_side, grid_.mean_particles);
+    std::fprintf(stderr, "overlap_node: %dx%d sub-boxes of N=%.1f\n", grid_.per_side, grid_.per_side,
+                 grid_.mean_particles);
   }
 
   void on_origin(int k, const std::vector<double>& pos0) override {

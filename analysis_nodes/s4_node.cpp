@@ -84,8 +84,8 @@ private:
       const an::S4Shells shells = an::s4_shells(fft_.back()->modes(none.data(), none.data(), 0));
       acc_.emplace_back(m.n_origins, static_cast<int>(lags_.size()), shells.q, shells.n_vectors);
     }
-    std::fprintf(stderr, "s4_node: run %lld, N=%d, a=%g, q <= %g, %zu of %d lags, grids (m: points):",
-                 static_cast<long long>(m.run_id), m.n_particles, cutoff_, q_max_, lags_.size(), m.n_lags);
+    std::fprintf(stderr, "s4_node: a=%g, q <= %g, %zu of %d lags, grids (m: points):", cutoff_, q_max_,
+                 lags_.size(), m.n_lags);
     for (size_t g = 0; g < grids_.size(); ++g) std::fprintf(stderr, " %d: %d", grids_[g].per_side, fft_[g]->points());
     std::fprintf(stderr, "\n");
   }

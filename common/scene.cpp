@@ -100,7 +100,7 @@ std::string known_keys(const Table& t) {
 } // namespace
 
 const std::vector<std::string>& known_observables() {
-  static const std::vector<std::string> v{"overlap", "chi4", "msd", "s4"};
+  static const std::vector<std::string> v{"overlap", "chi4", "msd", "clusters", "s4"};
   return v;
 }
 
@@ -310,6 +310,52 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
       {"half_width", int_in(s.s4_half_width, 2, 16)},
       {"subbox_particles", subbox_sizes(s.s4_subbox_particles)},
   };
+  auto& cl = s.clusters;
+  auto int_list = [&](std::vector<int64_t>& out, size_t size) {
+    return [&c, &out, size](const std::string& key, const toml::node& n) {
+      const auto* arr = n.as_array();
+      if (!arr || arr->size() != size)
+        return c.bad_type(key, n, "an array of " + std::to_string(size) + " integers");
+      std::vector<int64_t> v;
+      for (const auto& e : *arr) {
+        int64_t x;
+        if (!c.get_int(key, e, x)) return;
+        v.push_back(x);
+      }
+      out = v;
+    };
+  };
+  schema["clusters"] = {
+      {"lag", number_or(cl.lag, "tau_alpha")},
+      {"neighbour_cutoffs",
+       [&](const std::string& key, const toml::node& n) {
+         if (n.is_string()) {
+           if (*n.value<std::string>() != "g_ab")
+             c.bad_value(key, n, "allowed: \"g_ab\" or [r11, r12, r22], each > 0");
+           cl.neighbour_cutoffs.clear();
+           return;
+         }
+         const auto* arr = n.as_array();
+         if (!arr || arr->size() != 3) return c.bad_type(key, n, "\"g_ab\" or an array [r11, r12, r22]");
+         std::vector<double> v;
+         for (const auto& e : *arr) {
+           double x;
+           if (!c.get_double(key, e, x)) return;
+           if (x <= 0) return c.bad_value(key, e, "every neighbour cutoff must be > 0");
+           v.push_back(x);
+         }
+         cl.neighbour_cutoffs = v;
+       }},
+      {"cutoff_frames", int_in(cl.cutoff_frames, 1, 1000000)},
+      {"gr_r_max", positive(cl.gr_r_max)},
+      {"gr_bin", positive(cl.gr_bin)},
+      {"gr_smoothing", non_negative(cl.gr_smoothing)},
+      {"bins_per_decade", int_in(cl.bins_per_decade, 1, 100)},
+      {"power_law_sizes", int_list(cl.power_law_sizes, 2)},
+      {"min_bin_count", int_in(cl.min_bin_count, 1, 1000000000)},
+      {"fractal_min_size", int_in(cl.fractal_min_size, 1, 1000000000)},
+      {"error_blocks", int_in(cl.error_blocks, 2, 1000)},
+  };
   schema["transport"] = {
       {"chunk_particles", int_in(s.chunk_particles, 1, 65000)}, // 16 B each: < 1 MiB
   };
@@ -376,6 +422,23 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
     if (t < sch.lag_min * (1 - 1e-12) || t > sch.lag_max * (1 + 1e-12))
       c.fail("s4.lags", "value " + std::to_string(t) + " is outside the scheduled lags [" +
                             std::to_string(sch.lag_min) + ", " + std::to_string(sch.lag_max) + "]");
+  if (cl.cutoff_frames > sch.origins)
+    c.fail("clusters.cutoff_frames", "value " + std::to_string(cl.cutoff_frames) +
+                                         " is more than the schedule's origins (" +
+                                         std::to_string(sch.origins) + ")");
+  if (cl.gr_r_max > m.box_length / 2)
+    c.fail("clusters.gr_r_max", "value " + std::to_string(cl.gr_r_max) + " is more than half the box side (" +
+                                    std::to_string(m.box_length / 2) + ")");
+  if (cl.gr_bin * 10 > cl.gr_r_max)
+    c.fail("clusters.gr_bin", "value " + std::to_string(cl.gr_bin) +
+                                  " leaves fewer than 10 bins below clusters.gr_r_max = " +
+                                  std::to_string(cl.gr_r_max));
+  if (const auto& r = cl.neighbour_cutoffs; !r.empty() && *std::max_element(r.begin(), r.end()) * 3 > m.box_length)
+    c.fail("clusters.neighbour_cutoffs", "the largest cutoff must be under a third of the box side (" +
+                                             std::to_string(m.box_length / 3) + ")");
+  if (const auto& p = cl.power_law_sizes; !(p[0] >= 1 && p[0] < p[1]))
+    c.fail("clusters.power_law_sizes", "[" + std::to_string(p[0]) + ", " + std::to_string(p[1]) +
+                                           "] is not allowed; allowed: [lo, hi] with 1 <= lo < hi");
   if (s.observables.empty())
     c.fail("observables.compute", "is empty; name at least one of the known observables");
   c.throw_if_failed();

@@ -10,7 +10,8 @@ namespace dynhet {
 namespace {
 // Observables whose result messages the recorder knows how to write.
 bool recordable(const std::string &observable) {
-  return observable == "overlap" || observable == "chi4" || observable == "msd" || observable == "s4";
+  return observable == "overlap" || observable == "chi4" || observable == "msd" || observable == "clusters" ||
+         observable == "s4";
 }
 } // namespace
 

@@ -225,6 +225,72 @@ void RunRecorder::write_s4(const s4_t &m) {
   writer_->append_observable("s4/n_origins", step, t, &m.n_origins, 1);
 }
 
+bool RunRecorder::on_clusters(const clusters_t &m) {
+  if (!info_ || m.run_id != info_->run_id) return false;
+  guarded("clusters", [&] { write_clusters(m); });
+  if (m.is_final) completion_.final_result("clusters", m.cutoff_a);
+  return true;
+}
+
+// clusters/a<cutoff>/: lag_time, r (of g_ab) and size_lo, size_hi,
+// size_centre (the N_c bins) written once; per record: the scalars, the
+// per-lag arrays (records, lags), g11/g12/g22 (records, r) and the per-bin
+// arrays (records, bins), the latter two from the first record that has them.
+void RunRecorder::write_clusters(const clusters_t &m) {
+  const std::string label = cutoff_label(m.cutoff_a);
+  const std::string base = "clusters/" + label + "/";
+  if (!clusters_started_[label]) {
+    writer_->write_fixed(base + "lag_time", m.lag_time);
+    writer_->set_attribute("observables/" + base, "cutoff_a", m.cutoff_a);
+    writer_->set_attribute("observables/" + base, "n_blocks", m.n_blocks);
+    writer_->set_attribute("observables/" + base, "kappa_n_min", m.kappa_n_min);
+    writer_->set_attribute("observables/" + base, "kappa_n_max", m.kappa_n_max);
+    clusters_started_[label] = true;
+  }
+  const int64_t step = m.frame_index;
+  const double t = m.sim_time;
+  auto scalar = [&](const char *name, const auto &v) { writer_->append_observable(base + name, step, t, &v, 1); };
+  auto array = [&](const char *name, const auto &v) { writer_->append_observable(base + name, step, t, v); };
+  writer_->append_observable(base + "neighbour_cutoff", step, t, m.neighbour_cutoff, 3);
+  writer_->append_observable(base + "pooled_minimum", step, t, m.pooled_minimum, 3);
+  scalar("g_frames", m.g_frames);
+  if (m.n_r > 0) {
+    if (!clusters_r_written_[label]) writer_->write_fixed(base + "r", m.r);
+    clusters_r_written_[label] = true;
+    array("g11", m.g11), array("g12", m.g12), array("g22", m.g22);
+  }
+  scalar("tau_alpha", m.tau_alpha), scalar("tau_alpha_err", m.tau_alpha_err);
+  scalar("lag_index", m.lag_index), scalar("lag", m.lag);
+  array("n_origins", m.n_origins), array("n_slow", m.n_slow), array("n_fast", m.n_fast);
+  array("mean_size_slow", m.mean_size_slow), array("mean_size_slow_err", m.mean_size_slow_err);
+  array("mean_size_fast", m.mean_size_fast), array("mean_size_fast_err", m.mean_size_fast_err);
+  scalar("origins_at_lag", m.origins_at_lag);
+  scalar("slow_clusters", m.slow_clusters), scalar("fast_clusters", m.fast_clusters);
+  scalar("slow_mean_size", m.slow_mean_size), scalar("slow_mean_size_err", m.slow_mean_size_err);
+  scalar("fast_mean_size", m.fast_mean_size), scalar("fast_mean_size_err", m.fast_mean_size_err);
+  scalar("slow_largest", m.slow_largest), scalar("fast_largest", m.fast_largest);
+  scalar("slow_spanning", m.slow_spanning), scalar("fast_spanning", m.fast_spanning);
+  scalar("slow_d_f", m.slow_d_f), scalar("slow_d_f_err", m.slow_d_f_err);
+  scalar("fast_d_f", m.fast_d_f), scalar("fast_d_f_err", m.fast_d_f_err);
+  scalar("slow_kappa", m.slow_kappa), scalar("slow_kappa_err", m.slow_kappa_err);
+  scalar("fast_n0", m.fast_n0), scalar("fast_n0_err", m.fast_n0_err);
+  scalar("fast_sigma", m.fast_sigma), scalar("fast_sigma_err", m.fast_sigma_err);
+  scalar("fast_n_sigma", m.fast_n_sigma), scalar("fast_p0", m.fast_p0);
+  if (m.n_bins > 0) {
+    if (!clusters_bins_written_[label]) {
+      writer_->write_fixed(base + "size_lo", m.size_lo);
+      writer_->write_fixed(base + "size_hi", m.size_hi);
+      writer_->write_fixed(base + "size_centre", m.size_centre);
+    }
+    clusters_bins_written_[label] = true;
+    array("p_slow", m.p_slow), array("p_slow_err", m.p_slow_err);
+    array("p_fast", m.p_fast), array("p_fast_err", m.p_fast_err);
+    array("count_slow", m.count_slow), array("count_fast", m.count_fast);
+    array("rg_size_slow", m.rg_size_slow), array("rg_slow", m.rg_slow), array("rg_slow_err", m.rg_slow_err);
+    array("rg_size_fast", m.rg_size_fast), array("rg_fast", m.rg_fast), array("rg_fast_err", m.rg_fast_err);
+  }
+}
+
 bool RunRecorder::on_chi4(const chi4_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
   guarded("chi4", [&] { write_chi4(m); });

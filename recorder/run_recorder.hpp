@@ -11,6 +11,7 @@
 //   nodes/<node>/<field>   {step = frames handled, time = wall s since the first node status}
 //   overlap/a<cutoff>/<field> {step = frame index, time = sim time}, lag_time
 //   chi4/a<cutoff>/..., msd/..., s4/... likewise (s4: see write_s4)
+//   clusters/a<cutoff>/<field> likewise, with lag_time, r and the size bins
 #pragma once
 
 #include <cstdint>
@@ -26,6 +27,7 @@
 #include "dynhet/h5md.hpp"
 #include "dynhet/node_status_t.hpp"
 #include "dynhet/chi4_t.hpp"
+#include "dynhet/clusters_t.hpp"
 #include "dynhet/msd_t.hpp"
 #include "dynhet/s4_t.hpp"
 #include "dynhet/overlap_t.hpp"
@@ -70,6 +72,7 @@ public:
   bool on_chi4(const chi4_t &m);
   bool on_msd(const msd_t &m);
   bool on_s4(const s4_t &m);
+  bool on_clusters(const clusters_t &m);
   bool on_frame_chunk(const frame_chunk_t &m);
 
   bool has_run() const { return info_ != nullptr; }
@@ -98,6 +101,7 @@ private:
   std::map<std::string, Node> nodes_;
   std::map<std::string, bool> overlap_started_; // by cutoff label
   std::map<std::string, bool> chi4_started_;    // by cutoff label
+  std::map<std::string, bool> clusters_started_, clusters_r_written_, clusters_bins_written_;
   std::map<std::string, bool> overlap_t0_written_;
   bool msd_started_ = false;
   bool s4_started_ = false;
@@ -111,6 +115,7 @@ private:
   void write_chi4(const chi4_t &m);
   void write_msd(const msd_t &m);
   void write_s4(const s4_t &m);
+  void write_clusters(const clusters_t &m);
   void write_summary(const std::vector<std::string> &missing);
   void sim_ended(const sim_status_t &m);
   template <class F> void guarded(const char *what, F &&write);

@@ -1,12 +1,14 @@
 #!/usr/bin/python3
 """Checks a dynhet run file: the H5MD layout, the scene, the frames, no
-loss, and the recorded Q(t), tau_alpha, chi4, MSD and S4(q,t) against a
-brute-force recomputation from the recorded frames.
+loss, and the recorded Q(t) and tau_alpha, chi4, the MSD, the clusters and
+S4(q,t) against brute-force recomputations from the recorded frames.
 
 Usage: check_run.py RUN.h5 SCENE.toml
 """
 import math
 import sys
+import tomllib
+from collections import deque
 
 import h5py
 import numpy as np
@@ -204,6 +206,155 @@ def check_s4(f, unwrapped, L, origin_frame, pair_frame, sched_lag):
         check(False, "s4: no OZ fit of the whole box")
 
 
+def pair_counts(x, species, L, nb, dr):
+    """Pairs i < j per species pair (11, 12, 22) and bin [k dr, (k+1) dr), k < nb, minimum image."""
+    d = x[None, :, :] - x[:, None, :]
+    d -= L * np.floor(d / L + 0.5)
+    r = np.hypot(d[..., 0], d[..., 1])
+    i, j = np.triu_indices(len(x), 1)
+    r, sp = r[i, j], species[i] + species[j]
+    keep = r < nb * dr
+    counts = np.zeros((3, nb))
+    np.add.at(counts, (sp[keep], np.minimum(nb - 1, (r[keep] / dr).astype(int))), 1)
+    return counts
+
+
+def first_minimum(r, g, width):
+    """The kernel's recipe: Gaussian smoothing (renormalised at the ends), first peak above 1,
+    then the first minimum, refined by a parabola through the three bins around it."""
+    dr = r[1] - r[0]
+    half = int(math.ceil(3 * width / dr))
+    s = np.array([sum(math.exp(-0.5 * ((l - k) * dr / width) ** 2) * g[l] for l in range(max(0, k - half), min(len(g), k + half + 1)))
+                  / sum(math.exp(-0.5 * ((l - k) * dr / width) ** 2) for l in range(max(0, k - half), min(len(g), k + half + 1)))
+                  for k in range(len(g))])
+    k = 1
+    while k < len(s) - 1 and not (s[k] > 1 and s[k] >= s[k - 1] and s[k] >= s[k + 1]):
+        k += 1
+    while k < len(s) - 1 and not (s[k] <= s[k - 1] and s[k] < s[k + 1]):
+        k += 1
+    if k >= len(s) - 1:
+        return math.nan
+    den = s[k - 1] - 2 * s[k] + s[k + 1]
+    return r[k] + (0.5 * (s[k - 1] - s[k + 1]) / den if den > 0 else 0.0) * dr
+
+
+def clusters_bf(x0, xt, neighbours, selected, L):
+    """Clusters of the selected particles over the t0 neighbour lists, by breadth-first search:
+    (size, R_g at t or NaN if the cluster winds around the box) for each."""
+    label = -np.ones(len(x0), dtype=int)
+    out = []
+    for root in np.flatnonzero(selected):
+        if label[root] >= 0:
+            continue
+        label[root] = len(out)
+        u = {root: np.zeros(2)}
+        queue, spans = deque([root]), False
+        while queue:
+            a = queue.popleft()
+            for b in neighbours[a]:
+                if not selected[b]:
+                    continue
+                bond = x0[b] - x0[a]
+                ub = u[a] + bond - L * np.floor(bond / L + 0.5)
+                if label[b] < 0:
+                    label[b] = label[root]
+                    u[b] = ub
+                    queue.append(b)
+                elif np.any(np.abs(u[b] - ub) > L / 2):
+                    spans = True
+        members = np.array(list(u))
+        pos_t = np.array([u[i] for i in members]) + xt[members] - x0[members]
+        rg = math.nan if spans else math.sqrt(max(0.0, np.mean(np.sum((pos_t - pos_t.mean(axis=0)) ** 2, axis=1))))
+        out.append((len(members), rg))
+    return out
+
+
+def check_clusters(f, unwrapped, L, origin_frame, pair_frame, lag, scene):
+    """The cluster node's results against a brute-force recomputation from the frames: g_ab and
+    the neighbour cutoffs, tau_alpha and the lag chosen, the sizes at every lag, and at the chosen
+    lag the P(N_c) counts, the R_g bins and d_f."""
+    spec = scene.get("clusters", {})
+    species = f["particles/all/species"][()].astype(int)
+    n = unwrapped.shape[1]
+    n_min = spec.get("fractal_min_size", 10)
+    for name, g in f["observables/clusters"].items():
+        a = float(g.attrs["cutoff_a"])
+        r = g["r"][()]
+        dr, nb = r[1] - r[0], len(r)
+        na = np.bincount(species, minlength=2).astype(float)
+        ideal = np.outer([na[0] * (na[0] - 1) / 2, na[0] * na[1], na[1] * (na[1] - 1) / 2],
+                         np.pi * dr * dr * ((np.arange(nb) + 1) ** 2 - np.arange(nb) ** 2) / L ** 2)
+        gs = [pair_counts(unwrapped[of] % L, species, L, nb, dr) / ideal for of in origin_frame]
+        g_rec = np.array([g[k]["value"][-1] for k in ("g11", "g12", "g22")])
+        err = np.max(np.abs(np.mean(gs, axis=0) - g_rec))
+        check(err < 1e-9, f"clusters {name}: g_ab over {len(gs)} origin frames equals brute force (max diff {err:.2g})")
+        frames = spec.get("cutoff_frames", 1)
+        g_fix = np.mean(gs[:frames], axis=0)
+        cut_bf = np.array([first_minimum(r, g_fix[p], spec.get("gr_smoothing", 0.1)) for p in range(3)])
+        cut = g["neighbour_cutoff"]["value"][-1]
+        check(np.allclose(cut, cut_bf, rtol=1e-9, atol=0), f"clusters {name}: neighbour cutoffs {cut} are the first minima of g_ab")
+
+        # tau_alpha from Q(t) = fraction of slow particles; the lag nearest it in ln t.
+        disp = np.array([[unwrapped[pf] - unwrapped[of] for pf in pair_frame[k]] for k, of in enumerate(origin_frame)])
+        d2 = np.sum(disp ** 2, axis=3)  # origin, lag, particle
+        q_bf = np.mean(d2 < a * a, axis=2).mean(axis=0)
+        tau, tau_bf = float(g["tau_alpha"]["value"][-1]), crossing_time(lag, q_bf, math.exp(-1))
+        check(abs(tau - tau_bf) <= 1e-9 * tau_bf, f"clusters {name}: tau_alpha {tau:.6g} (brute force {tau_bf:.6g})")
+        j = int(g["lag_index"]["value"][-1])
+        check(j == int(np.argmin(np.abs(np.log(lag / tau_bf)))), f"clusters {name}: lag {lag[j]:.4g} is the one nearest tau_alpha")
+
+        # Neighbours at t0, clusters at every lag.
+        neighbours = []
+        for of in origin_frame:
+            x = unwrapped[of]
+            d = x[None, :, :] - x[:, None, :]
+            d -= L * np.floor(d / L + 0.5)
+            close = np.hypot(d[..., 0], d[..., 1]) < cut[species[:, None] + species[None, :]]
+            np.fill_diagonal(close, False)
+            neighbours.append([np.flatnonzero(row) for row in close])
+        mean_size = {"slow": [], "fast": []}
+        at_lag = {"slow": [], "fast": []}
+        for jj in range(len(lag)):
+            for kind, sel in (("slow", d2[:, jj] < a * a), ("fast", d2[:, jj] > 9 * a * a)):
+                cl = [c for k, of in enumerate(origin_frame)
+                      for c in clusters_bf(unwrapped[of], unwrapped[pair_frame[k][jj]], neighbours[k], sel[k], L)]
+                mean_size[kind].append(sum(c[0] for c in cl) / len(cl) if cl else math.nan)
+                if jj == j:
+                    at_lag[kind] = cl
+        for kind in ("slow", "fast"):
+            rec = g[f"mean_size_{kind}"]["value"][-1]
+            same = np.allclose(rec, mean_size[kind], rtol=1e-12, atol=0, equal_nan=True)
+            check(same, f"clusters {name}: mean {kind} cluster size at every lag equals brute force")
+            n_sel = g[f"n_{kind}"]["value"][-1]
+            sel_bf = np.mean(d2 < a * a if kind == "slow" else d2 > 9 * a * a, axis=2).mean(axis=0) * n
+            check(np.allclose(n_sel, sel_bf, rtol=1e-12), f"clusters {name}: {kind} particles per origin at every lag")
+            # At the chosen lag: the size histogram, R_g per bin, d_f.
+            lo, hi = g["size_lo"][()], g["size_hi"][()]
+            sizes = np.array([c[0] for c in at_lag[kind]])
+            count_bf = np.array([np.sum((sizes >= l) & (sizes <= h)) for l, h in zip(lo, hi)])
+            check(np.array_equal(g[f"count_{kind}"]["value"][-1], count_bf), f"clusters {name}: {kind} P(N_c) counts equal brute force")
+            p_bf = count_bf / (len(sizes) * (hi - lo + 1))
+            check(np.allclose(g[f"p_{kind}"]["value"][-1], p_bf, rtol=1e-12, atol=0), f"clusters {name}: {kind} P(N_c)")
+            spans = sum(math.isnan(c[1]) for c in at_lag[kind])
+            check(int(g[f"{kind}_spanning"]["value"][-1]) == spans, f"clusters {name}: {spans} spanning {kind} clusters")
+            used = [(c[0], c[1]) for c in at_lag[kind] if c[0] >= n_min and c[1] > 0]
+            ln_n, ln_rg = [], []
+            for l, h in zip(lo, hi):
+                inbin = [(math.log(s), math.log(rg)) for s, rg in used if l <= s <= h]
+                ln_n.append(np.mean([v[0] for v in inbin]) if inbin else math.nan)
+                ln_rg.append(np.mean([v[1] for v in inbin]) if inbin else math.nan)
+            rg_rec = g[f"rg_{kind}"]["value"][-1]
+            same = np.allclose(rg_rec, np.exp(ln_rg), rtol=1e-9, atol=0, equal_nan=True)
+            check(same, f"clusters {name}: {kind} R_g per N_c bin (R_g at t0 + t, periodic) equals brute force")
+            ok = np.isfinite(ln_n)
+            d_f = float(g[f"{kind}_d_f"]["value"][-1])
+            if ok.sum() >= 2:
+                d_f_bf = 1 / np.polyfit(np.array(ln_n)[ok], np.array(ln_rg)[ok], 1)[0]
+                check(abs(d_f - d_f_bf) <= 1e-9 * abs(d_f_bf), f"clusters {name}: {kind} d_f = {d_f:.4g} (brute force {d_f_bf:.4g})")
+            else:
+                check(math.isnan(d_f), f"clusters {name}: {kind} d_f is NaN with {ok.sum()} R_g bins")
+
+
 def main(path, scene_path):
     f = h5py.File(path, "r")
     check(list(f["h5md"].attrs["version"]) == [1, 1], "h5md version 1.1")
@@ -212,6 +363,8 @@ def main(path, scene_path):
     text = text.decode() if isinstance(text, bytes) else str(text)
     check(text == open(scene_path).read(), "parameters/scene_toml is the scene file")
     check(int(f.attrs.get("complete", 0)) == 1, "file marked complete")
+    for obs in tomllib.loads(text).get("observables", {}).get("compute", []):
+        check(f"observables/{obs}" in f, f"observables/{obs} recorded (the scene asks for it)")
 
     box = f["particles/all/box"]
     check(int(box.attrs["dimension"]) == 2, "box is 2D")
@@ -267,6 +420,15 @@ def main(path, scene_path):
         check_msd(f, unwrapped, origin_frame, pair_frame, lag)
     if "observables/s4" in f:
         check_s4(f, unwrapped, L, origin_frame, pair_frame, lag)
+    if "observables/clusters" in f:
+        nodes = f["observables/nodes/clusters"]
+        check(int(nodes["frames_lost"]["value"][-1]) == 0, "clusters node lost no frame")
+        scene = tomllib.loads(text)
+        check_clusters(f, unwrapped, L, origin_frame, pair_frame, lag, scene)
+        for name, g in f["observables/clusters"].items():
+            if "observables/overlap/" + name in f:
+                t1, t2 = float(g["tau_alpha"]["value"][-1]), float(f["observables/overlap/" + name]["tau_alpha"]["value"][-1])
+                check(abs(t1 - t2) <= 1e-9 * t2, f"clusters {name}: tau_alpha is the overlap node's")
     if failures:
         print(f"{len(failures)} check(s) failed")
         return 1

@@ -13,10 +13,16 @@ add_test(NAME checkpoint_resume_bit_for_bit
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/checkpoint_resume.sh ${PROJECT_SOURCE_DIR} $<TARGET_FILE_DIR:sim_node>)
 set_tests_properties(checkpoint_resume_bit_for_bit PROPERTIES LABELS process TIMEOUT 300)
 
-# Engine stress test (bench/stress_engine.cpp): a short run in the default
-# suite; the full 10^9 collisions per case under the label `stress`
-# (ctest --test-dir build -L stress), about an hour on 2 cores.
+# Engine stress test (bench/stress_engine.cpp): a short run of all three
+# cases in the default suite; under the label `stress`
+# (ctest --test-dir build -L stress) 10^9 collisions for each of the two
+# inelastic cases (about 25 minutes each on one core) and 10^8 for the
+# elastic energy-drift case (about 3 minutes).
 add_test(NAME stress_engine_short COMMAND stress_engine --collisions 5e6)
 set_tests_properties(stress_engine_short PROPERTIES LABELS engine TIMEOUT 600)
-add_test(NAME stress_engine_1e9 COMMAND stress_engine --collisions 1e9)
-set_tests_properties(stress_engine_1e9 PROPERTIES LABELS stress TIMEOUT 14400)
+foreach(c 0 1)
+  add_test(NAME stress_engine_1e9_case${c} COMMAND stress_engine --collisions 1e9 --case ${c})
+  set_tests_properties(stress_engine_1e9_case${c} PROPERTIES LABELS stress TIMEOUT 7200)
+endforeach()
+add_test(NAME stress_engine_elastic_1e8 COMMAND stress_engine --collisions 1e8 --case 2)
+set_tests_properties(stress_engine_elastic_1e8 PROPERTIES LABELS stress TIMEOUT 3600)

@@ -261,3 +261,108 @@ TEST(Clusters, FractalDimensionOfDisksAndRods) {
   EXPECT_NEAR(fr.d_f, 1.0, 0.02);
   EXPECT_GE(fr.n_bins, 3);
 }
+
+TEST(Clusters, NeighboursAtT0AndRadiusOfGyrationAtT) {
+  // Random disks, a random half selected; the frame at t moves every particle
+  // by up to 3 (some across the boundary, positions unwrapped). Clusters are
+  // those of the t0 frame; R_g is that of the members' positions at t.
+  std::mt19937_64 gen(53);
+  std::uniform_real_distribution<double> u(0, 1);
+  const long n = 1200;
+  const double box = 40.0;
+  Layout l;
+  for (long i = 0; i < n; ++i) l.add(box * u(gen), box * u(gen), u(gen) < 0.5, u(gen) < 0.5);
+  std::vector<double> pt(l.pos);
+  for (double& x : pt) x += 6 * u(gen) - 3;
+  const NeighbourCutoffs cut{{1.0, 1.2, 1.4}};
+  const NeighbourPairs nb = neighbour_pairs(l.pos.data(), l.species.data(), n, box, cut);
+  NeighbourGraph g;
+  g.build(nb);
+  ClusterFinder finder;
+  const ClusterSet at_t0 = find_clusters(nb, l.pos.data(), box, l.selected.data());
+  const ClusterSet c = finder.find(g, l.pos.data(), pt.data(), box, l.selected.data());
+  EXPECT_EQ(c.label, at_t0.label); // the same partition, found the same way
+  ASSERT_EQ(c.clusters.size(), at_t0.clusters.size());
+  // Brute force: members unwrapped at t0 around the first member by the
+  // minimum image (the clusters here are far smaller than box/2), plus
+  // their displacements.
+  int checked = 0;
+  for (size_t k = 0; k < c.clusters.size(); ++k) {
+    const Cluster& cl = c.clusters[k];
+    EXPECT_EQ(cl.size, at_t0.clusters[k].size);
+    if (cl.size < 2) continue;
+    ASSERT_FALSE(cl.spans);
+    long first = -1;
+    double sx = 0, sy = 0, s2 = 0;
+    for (long i = 0; i < n; ++i) {
+      if (c.label[i] != static_cast<int>(k)) continue;
+      if (first < 0) first = i;
+      const double x = min_image(l.pos[2 * i] - l.pos[2 * first], box) + pt[2 * i] - l.pos[2 * i];
+      const double y = min_image(l.pos[2 * i + 1] - l.pos[2 * first + 1], box) + pt[2 * i + 1] - l.pos[2 * i + 1];
+      sx += x, sy += y, s2 += x * x + y * y;
+    }
+    const double m = double(cl.size), mx = sx / m, my = sy / m;
+    EXPECT_NEAR(cl.radius_of_gyration, std::sqrt(s2 / m - mx * mx - my * my), 1e-9);
+    EXPECT_NEAR(min_image(cl.cx - (l.pos[2 * first] + mx), box), 0.0, 1e-9);
+    EXPECT_NEAR(min_image(cl.cy - (l.pos[2 * first + 1] + my), box), 0.0, 1e-9);
+    ++checked;
+  }
+  EXPECT_GT(checked, 50);
+}
+
+TEST(Clusters, SpanningSurvivesTheDisplacements) {
+  // A row all around the box at t0 spans, wherever its particles are at t.
+  const double box = 20.0;
+  Layout l;
+  for (int k = 0; k < 20; ++k) l.add(0.5 + k, 12.0);
+  std::vector<double> pt(l.pos);
+  for (int k = 0; k < 20; ++k) pt[2 * k] += 7.0 * k, pt[2 * k + 1] -= 3.0 * (k % 3);
+  const NeighbourPairs nb = neighbour_pairs(l.pos.data(), l.species.data(), l.n(), box, {{1.2, 1.2, 1.2}});
+  NeighbourGraph g;
+  g.build(nb);
+  ClusterFinder finder;
+  const ClusterSet& c = finder.find(g, l.pos.data(), pt.data(), box, l.selected.data());
+  ASSERT_EQ(c.clusters.size(), 1u);
+  EXPECT_TRUE(c.clusters[0].spans);
+  EXPECT_TRUE(std::isnan(c.clusters[0].radius_of_gyration));
+}
+
+TEST(Clusters, TallyAddsUpToTheWholeList) {
+  // Two cluster sets (random disks, two selections) tallied apart and
+  // merged give what the pooled cluster list gives: P(N_c) and d_f.
+  std::mt19937_64 gen(59);
+  std::uniform_real_distribution<double> u(0, 1);
+  const long n = 4000;
+  const double box = 60.0;
+  Layout l;
+  for (long i = 0; i < n; ++i) l.add(box * u(gen), box * u(gen), true, u(gen) < 0.5);
+  const NeighbourPairs nb = neighbour_pairs(l.pos.data(), l.species.data(), n, box, {{1.6, 1.8, 2.0}});
+  std::vector<Cluster> all;
+  std::vector<long> sizes;
+  ClusterTally a(n, 5, 3), b(n, 5, 3);
+  for (int s = 0; s < 2; ++s) {
+    std::vector<std::uint8_t> sel(n);
+    for (auto& x : sel) x = u(gen) < (s ? 0.42 : 0.35); // near percolation: sizes over decades
+    const ClusterSet c = find_clusters(nb, l.pos.data(), box, sel.data());
+    (s ? b : a).add(c);
+    all.insert(all.end(), c.clusters.begin(), c.clusters.end());
+    for (long z : cluster_sizes(c)) sizes.push_back(z);
+  }
+  ClusterTally t(n, 5, 3);
+  t.add(a), t.add(b);
+  EXPECT_EQ(t.sets, 2);
+  EXPECT_EQ(t.clusters, static_cast<long>(all.size()));
+  long particles = 0;
+  for (long z : sizes) particles += z;
+  EXPECT_DOUBLE_EQ(t.mean_size(), double(particles) / sizes.size());
+  const SizeHistogram h = t.histogram(), ref = cluster_size_distribution(sizes, 5);
+  EXPECT_EQ(h.count, ref.count);
+  EXPECT_EQ(h.lo, ref.lo);
+  EXPECT_EQ(h.hi, ref.hi);
+  for (size_t k = 0; k < h.p.size(); ++k) EXPECT_DOUBLE_EQ(h.p[k], ref.p[k]);
+  const FractalFit ft = fit_fractal_dimension(t), fl = fit_fractal_dimension(all, 3, 5);
+  EXPECT_GE(ft.n_bins, 3);
+  EXPECT_NEAR(ft.d_f, fl.d_f, 1e-12 * fl.d_f); // sums in another order: rounding only
+  EXPECT_NEAR(ft.d_f_err, fl.d_f_err, 1e-9 * fl.d_f_err);
+  EXPECT_EQ(ft.n_clusters, fl.n_clusters);
+}

@@ -117,3 +117,18 @@ TEST(Fits, GaussianAndExponentialTailsOfDisplacements) {
   EXPECT_NEAR(fe.x0, x0, 4 * fe.x0_err);
   EXPECT_LT(fe.x0_err, 0.01 * x0);
 }
+
+TEST(Fits, JackknifeOfTheMeanIsItsStandardError) {
+  // For the mean, the leave-one-out estimates are (n mean - x_b)/(n - 1) and
+  // the jackknife error is exactly s / sqrt(n).
+  const std::vector<double> x{1.0, 4.0, 2.5, 7.0, 3.0, 5.5};
+  const double n = double(x.size());
+  double mean = 0, s2 = 0;
+  for (double v : x) mean += v / n;
+  for (double v : x) s2 += (v - mean) * (v - mean);
+  std::vector<double> loo;
+  for (double v : x) loo.push_back((n * mean - v) / (n - 1));
+  EXPECT_NEAR(jackknife_error(loo), std::sqrt(s2 / (n - 1) / n), 1e-12);
+  EXPECT_TRUE(std::isnan(jackknife_error({1.0})));
+  EXPECT_TRUE(std::isnan(jackknife_error({1.0, NAN})));
+}

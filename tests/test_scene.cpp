@@ -108,3 +108,26 @@ TEST(Scene, S4TableIsValidated) {
   expect_error("[s4]\nsubbox_particles = [0]\n", {"s4.subbox_particles", ">= 1"});
   expect_error("[s4]\nxi = 1\n", {"s4.xi", "unknown key", "q_max"});
 }
+
+TEST(Scene, ClustersTableIsValidated) {
+  const auto d = parse_scene_text("", "test.toml");
+  EXPECT_LT(d.clusters.lag, 0); // tau_alpha
+  EXPECT_TRUE(d.clusters.neighbour_cutoffs.empty()); // from g_ab
+  const auto s = parse_scene_text("[observables]\ncompute = [\"clusters\"]\n[clusters]\nlag = 2.5\n"
+                                  "neighbour_cutoffs = [2.6, 3.2, 3.8]\npower_law_sizes = [2, 50]\n",
+                                  "test.toml");
+  EXPECT_TRUE(s.wants("clusters"));
+  EXPECT_EQ(dynhet::nodes_for(s.observables), std::vector<std::string>{"clusters_node"});
+  EXPECT_DOUBLE_EQ(s.clusters.lag, 2.5);
+  EXPECT_EQ(s.clusters.neighbour_cutoffs, (std::vector<double>{2.6, 3.2, 3.8}));
+  EXPECT_EQ(s.clusters.power_law_sizes, (std::vector<int64_t>{2, 50}));
+  expect_error("[clusters]\nlag = \"tau\"\n", {"clusters.lag", "\"tau_alpha\" or a number > 0"});
+  expect_error("[clusters]\nneighbour_cutoffs = [2.6, 3.2]\n", {"clusters.neighbour_cutoffs", "[r11, r12, r22]"});
+  expect_error("[clusters]\nneighbour_cutoffs = [2.6, -3.2, 3.8]\n", {"clusters.neighbour_cutoffs", "> 0"});
+  expect_error("[clusters]\npower_law_sizes = [50, 2]\n", {"clusters.power_law_sizes", "1 <= lo < hi"});
+  expect_error("[clusters]\ncutoff_frames = 11\n", {"clusters.cutoff_frames", "origins"});
+  expect_error("[clusters]\ngr_r_max = 1000.0\n", {"clusters.gr_r_max", "half the box"});
+  expect_error("[clusters]\ngr_bin = 1.0\n", {"clusters.gr_bin", "10 bins"});
+  expect_error("[clusters]\nerror_blocks = 1\n", {"clusters.error_blocks", "2 <= value"});
+  expect_error("[clusters]\nsmoothing = 1\n", {"clusters.smoothing", "unknown key", "gr_smoothing"});
+}

@@ -217,80 +217,62 @@ std::vector<std::uint8_t> fast_particles(const double* d2, long n, double a) {
   return s;
 }
 
-namespace {
+void NeighbourGraph::build(const NeighbourPairs& nb) {
+  start.assign(nb.n + 1, 0);
+  for (const auto& p : nb.pairs) ++start[p[0] + 1], ++start[p[1] + 1];
+  for (long i = 0; i < nb.n; ++i) start[i + 1] += start[i];
+  to.resize(start[nb.n]);
+  std::vector<std::int32_t> fill(start.begin(), start.end() - 1);
+  for (const auto& p : nb.pairs) to[fill[p[0]]++] = p[1], to[fill[p[1]]++] = p[0];
+}
 
-// One bond seen from a particle: the neighbour and r_neighbour - r_particle.
-struct Link {
-  std::int32_t to;
-  double dx, dy;
-};
-
-} // namespace
-
-// What a search keeps between calls: the adjacency of the selected
-// particles (CSR, each bond stored from both ends so the walk reads memory
-// in order), unwrapped positions and the walk's queue.
-struct ClusterFinder::Scratch {
-  std::vector<std::int32_t> start, fill, queue;
-  std::vector<Link> links;
-  std::vector<std::array<double, 2>> u;
-
-  void graph(const NeighbourPairs& nb, const std::uint8_t* sel) {
-    start.assign(nb.n + 1, 0);
-    for (const auto& p : nb.pairs)
-      if (sel[p[0]] && sel[p[1]]) ++start[p[0] + 1], ++start[p[1] + 1];
-    for (long i = 0; i < nb.n; ++i) start[i + 1] += start[i];
-    links.resize(start[nb.n]);
-    fill.assign(start.begin(), start.end() - 1);
-    for (size_t e = 0; e < nb.pairs.size(); ++e) {
-      const std::int32_t i = nb.pairs[e][0], j = nb.pairs[e][1];
-      if (!sel[i] || !sel[j]) continue;
-      links[fill[i]++] = {j, nb.bond[e][0], nb.bond[e][1]};
-      links[fill[j]++] = {i, -nb.bond[e][0], -nb.bond[e][1]};
-    }
-  }
-};
-
-ClusterFinder::ClusterFinder() : s_(std::make_unique<Scratch>()) {}
+ClusterFinder::ClusterFinder() = default;
 ClusterFinder::~ClusterFinder() = default;
 
 const ClusterSet& ClusterFinder::find(const NeighbourPairs& nb, const double* pos, double box,
                                       const std::uint8_t* selected) {
-  const long n = nb.n;
-  Scratch& s = *s_;
-  s.graph(nb, selected);
+  graph_.build(nb);
+  return find(graph_, pos, pos, box, selected);
+}
+
+const ClusterSet& ClusterFinder::find(const NeighbourGraph& g, const double* p0, const double* pt, double box,
+                                      const std::uint8_t* selected) {
+  const long n = g.n();
   out_.label.assign(n, -1);
   out_.clusters.clear();
-  s.u.resize(n); // positions unwrapped along the tree, relative to the root
+  u_.resize(n);
   for (long root = 0; root < n; ++root) {
     if (!selected[root] || out_.label[root] >= 0) continue;
     const auto id = static_cast<std::int32_t>(out_.clusters.size());
     // Breadth-first over the cluster: each new particle sits at its parent's
-    // unwrapped position plus the (minimum-image) bond.
-    s.queue.assign(1, static_cast<std::int32_t>(root));
-    out_.label[root] = id, s.u[root] = {0.0, 0.0};
+    // unwrapped t0 position plus the minimum-image bond at t0.
+    queue_.assign(1, static_cast<std::int32_t>(root));
+    out_.label[root] = id, u_[root] = {0.0, 0.0};
     bool spans = false;
-    double sx = 0, sy = 0, sxx = 0;
-    for (size_t h = 0; h < s.queue.size(); ++h) {
-      const std::int32_t a = s.queue[h];
-      const double ax = s.u[a][0], ay = s.u[a][1];
-      sx += ax, sy += ay, sxx += ax * ax + ay * ay;
-      for (int k = s.start[a]; k < s.start[a + 1]; ++k) {
-        const Link& l = s.links[k];
-        const double bx = ax + l.dx, by = ay + l.dy;
-        if (out_.label[l.to] < 0) {
-          out_.label[l.to] = id, s.u[l.to] = {bx, by};
-          s.queue.push_back(l.to);
-        } else if (std::abs(s.u[l.to][0] - bx) > box / 2 || std::abs(s.u[l.to][1] - by) > box / 2) {
+    double sx = 0, sy = 0, sxx = 0; // of the positions at t, relative to the root's at t0
+    for (size_t h = 0; h < queue_.size(); ++h) {
+      const std::int32_t a = queue_[h];
+      const double ax = u_[a][0], ay = u_[a][1];
+      const double x = ax + pt[2 * a] - p0[2 * a], y = ay + pt[2 * a + 1] - p0[2 * a + 1];
+      sx += x, sy += y, sxx += x * x + y * y;
+      for (int k = g.start[a]; k < g.start[a + 1]; ++k) {
+        const std::int32_t b = g.to[k];
+        if (!selected[b]) continue;
+        const double bx = ax + min_image(p0[2 * b] - p0[2 * a], box);
+        const double by = ay + min_image(p0[2 * b + 1] - p0[2 * a + 1], box);
+        if (out_.label[b] < 0) {
+          out_.label[b] = id, u_[b] = {bx, by};
+          queue_.push_back(b);
+        } else if (std::abs(u_[b][0] - bx) > box / 2 || std::abs(u_[b][1] - by) > box / 2) {
           spans = true; // the bond closes a loop around the periodic box
         }
       }
     }
-    const double nc = double(s.queue.size()), mx = sx / nc, my = sy / nc;
-    Cluster c{static_cast<long>(s.queue.size()), kNaN, kNaN, kNaN, spans};
+    const double nc = double(queue_.size()), mx = sx / nc, my = sy / nc;
+    Cluster c{static_cast<long>(queue_.size()), kNaN, kNaN, kNaN, spans};
     if (!spans) {
       c.radius_of_gyration = std::sqrt(std::max(0.0, sxx / nc - mx * mx - my * my)); // eq. (10)
-      c.cx = fold(pos[2 * root] + mx, box), c.cy = fold(pos[2 * root + 1] + my, box);
+      c.cx = fold(p0[2 * root] + mx, box), c.cy = fold(p0[2 * root + 1] + my, box);
     }
     out_.clusters.push_back(c);
   }
@@ -309,10 +291,7 @@ std::vector<long> cluster_sizes(const ClusterSet& c) {
   return s;
 }
 
-namespace {
-
-// Integer log-bin edges 1 = e_0 < e_1 < ... covering up to max_size.
-std::vector<long> log_edges(long max_size, int per_decade) {
+std::vector<long> log_bin_edges(long max_size, int per_decade) {
   std::vector<long> e;
   long last = 1;
   e.push_back(last);
@@ -323,16 +302,20 @@ std::vector<long> log_edges(long max_size, int per_decade) {
   return e;
 }
 
-} // namespace
+namespace {
 
-SizeHistogram cluster_size_distribution(const std::vector<long>& sizes, int bins_per_decade) {
+// The bin of size s: edges[b] <= s < edges[b + 1].
+size_t bin_of(const std::vector<long>& e, long s) {
+  return std::upper_bound(e.begin(), e.end(), s) - e.begin() - 1;
+}
+
+// P(N_c) from counts on integer log bins, over the first n_bins bins.
+SizeHistogram size_histogram(const std::vector<long>& e, const std::vector<long>& count, size_t n_bins) {
   SizeHistogram h;
-  if (sizes.empty()) return h;
-  const std::vector<long> e = log_edges(*std::max_element(sizes.begin(), sizes.end()), bins_per_decade);
-  h.count.assign(e.size() - 1, 0);
-  for (long s : sizes) ++h.count[std::upper_bound(e.begin(), e.end(), s) - e.begin() - 1];
-  h.total = static_cast<long>(sizes.size());
-  for (size_t b = 0; b + 1 < e.size(); ++b) {
+  h.count.assign(count.begin(), count.begin() + n_bins);
+  for (long c : h.count) h.total += c;
+  if (h.total == 0) return SizeHistogram{};
+  for (size_t b = 0; b < n_bins; ++b) {
     h.lo.push_back(e[b]), h.hi.push_back(e[b + 1] - 1);
     h.centre.push_back(std::sqrt(double(e[b]) * (e[b + 1] - 1)));
     h.p.push_back(h.count[b] / (double(h.total) * (e[b + 1] - e[b]))); // P(N_c): fraction per size
@@ -340,25 +323,66 @@ SizeHistogram cluster_size_distribution(const std::vector<long>& sizes, int bins
   return h;
 }
 
+} // namespace
+
+SizeHistogram cluster_size_distribution(const std::vector<long>& sizes, int bins_per_decade) {
+  if (sizes.empty()) return {};
+  const std::vector<long> e = log_bin_edges(*std::max_element(sizes.begin(), sizes.end()), bins_per_decade);
+  std::vector<long> count(e.size() - 1, 0);
+  for (long s : sizes) ++count[bin_of(e, s)];
+  return size_histogram(e, count, count.size());
+}
+
+ClusterTally::ClusterTally(long max_size, int bins_per_decade, long rg_min)
+    : edges(log_bin_edges(max_size, bins_per_decade)), rg_min_size(rg_min), count(edges.size() - 1, 0),
+      rg_count(count), sum_ln_n(count.size(), 0.0), sum_ln_rg(count.size(), 0.0) {}
+
+void ClusterTally::add(const ClusterSet& c) {
+  ++sets;
+  for (const Cluster& k : c.clusters) {
+    const size_t b = bin_of(edges, k.size);
+    ++count.at(b), ++clusters, particles += k.size, spanning += k.spans;
+    largest = std::max(largest, k.size);
+    if (k.spans || k.size < rg_min_size || !(k.radius_of_gyration > 0)) continue;
+    ++rg_count[b], sum_ln_n[b] += std::log(double(k.size)), sum_ln_rg[b] += std::log(k.radius_of_gyration);
+  }
+}
+
+void ClusterTally::add(const ClusterTally& o) {
+  sets += o.sets, particles += o.particles, clusters += o.clusters, spanning += o.spanning;
+  largest = std::max(largest, o.largest);
+  for (size_t b = 0; b < count.size(); ++b) {
+    count[b] += o.count[b], rg_count[b] += o.rg_count[b];
+    sum_ln_n[b] += o.sum_ln_n[b], sum_ln_rg[b] += o.sum_ln_rg[b];
+  }
+}
+
+double ClusterTally::mean_size() const { return clusters ? double(particles) / clusters : kNaN; }
+
+SizeHistogram ClusterTally::histogram() const {
+  return clusters ? size_histogram(edges, count, bin_of(edges, largest) + 1) : SizeHistogram{};
+}
+
+FractalFit fit_fractal_dimension(const ClusterTally& t) {
+  // Mean ln N_c and mean ln R_g of the non-empty bins.
+  std::vector<double> ln_n, ln_rg;
+  long used = 0;
+  for (size_t b = 0; b < t.rg_count.size(); ++b)
+    if (t.rg_count[b] > 0) {
+      ln_n.push_back(t.sum_ln_n[b] / t.rg_count[b]), ln_rg.push_back(t.sum_ln_rg[b] / t.rg_count[b]);
+      used += t.rg_count[b];
+    }
+  if (ln_n.size() < 2) return {kNaN, kNaN, static_cast<int>(ln_n.size()), used};
+  const LinearFit f = linear_fit(ln_n, ln_rg); // ln R_g = (1/d_f) ln N_c + c
+  return {1 / f.slope, f.slope_err / (f.slope * f.slope), f.n, used};
+}
+
 FractalFit fit_fractal_dimension(const std::vector<Cluster>& clusters, long n_min, int bins_per_decade) {
   long max_size = 1;
   for (const Cluster& c : clusters) max_size = std::max(max_size, c.size);
-  const std::vector<long> e = log_edges(max_size, bins_per_decade);
-  std::vector<double> sn(e.size(), 0.0), sr(e.size(), 0.0);
-  std::vector<long> cnt(e.size(), 0);
-  long used = 0;
-  for (const Cluster& c : clusters) {
-    if (c.spans || c.size < n_min || !(c.radius_of_gyration > 0)) continue;
-    const size_t b = std::upper_bound(e.begin(), e.end(), c.size) - e.begin() - 1;
-    sn[b] += std::log(double(c.size)), sr[b] += std::log(c.radius_of_gyration), ++cnt[b], ++used;
-  }
-  // Mean ln N_c and mean ln R_g of the non-empty bins, compacted in place.
-  size_t used_bins = 0;
-  for (size_t b = 0; b < e.size(); ++b)
-    if (cnt[b] > 0) sn[used_bins] = sn[b] / cnt[b], sr[used_bins] = sr[b] / cnt[b], ++used_bins;
-  sn.resize(used_bins), sr.resize(used_bins);
-  const LinearFit f = linear_fit(sn, sr); // ln R_g = (1/d_f) ln N_c + c
-  return {1 / f.slope, f.slope_err / (f.slope * f.slope), f.n, used};
+  ClusterTally t(max_size, bins_per_decade, n_min);
+  t.add(ClusterSet{{}, clusters});
+  return fit_fractal_dimension(t);
 }
 
 } // namespace dynhet::analysis

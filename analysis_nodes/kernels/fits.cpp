@@ -72,6 +72,16 @@ Residuals size_residuals(const SizeHistogram& h, const std::vector<int>& bins,
 
 } // namespace
 
+double jackknife_error(const std::vector<double>& x) {
+  const size_t n = x.size();
+  if (n < 2 || std::any_of(x.begin(), x.end(), [](double v) { return std::isnan(v); }))
+    return std::numeric_limits<double>::quiet_NaN();
+  double mean = 0, s2 = 0;
+  for (double v : x) mean += v / n;
+  for (double v : x) s2 += (v - mean) * (v - mean);
+  return std::sqrt(s2 * (n - 1) / n);
+}
+
 LinearFit linear_fit(const std::vector<double>& x, const std::vector<double>& y,
                      const std::vector<double>& w) {
   double s = 0, sx = 0, sy = 0, sxx = 0, sxy = 0;

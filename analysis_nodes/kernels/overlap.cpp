@@ -1,5 +1,7 @@
 #include "dynhet/analysis/overlap.hpp"
 
+#include "dynhet/analysis/fits.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -113,15 +115,7 @@ OverlapAccumulator::Result OverlapAccumulator::result() const {
     for (size_t j = 0; j < nj && !used; ++j) used = !std::isnan(q_[index(k, static_cast<int>(j))]);
     if (used) taus.push_back(crossing_time(lag_, mean_over_origins(k), level));
   }
-  r.tau_alpha_err = kNaN;
-  const size_t nk = taus.size();
-  if (nk > 1 && !std::isnan(r.tau_alpha) &&
-      std::none_of(taus.begin(), taus.end(), [](double t) { return std::isnan(t); })) {
-    double mean = 0, s2 = 0;
-    for (double t : taus) mean += t / nk;
-    for (double t : taus) s2 += (t - mean) * (t - mean);
-    r.tau_alpha_err = std::sqrt(s2 * (nk - 1) / nk);
-  }
+  r.tau_alpha_err = std::isnan(r.tau_alpha) ? kNaN : jackknife_error(taus);
   return r;
 }
 

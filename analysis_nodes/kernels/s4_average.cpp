@@ -10,16 +10,11 @@ namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
-// Jackknife standard error from the n leave-one-out estimates:
-// sqrt((n-1)/n sum (x_k - mean)^2); NaN below 3 estimates or if any is NaN.
-double jackknife_error(const std::vector<double>& x) {
-  const size_t n = x.size();
-  if (n < 3) return kNaN;
-  double mean = 0;
-  for (double v : x) mean += v / n;
-  double s2 = 0;
-  for (double v : x) s2 += (v - mean) * (v - mean);
-  return std::sqrt(s2 * (n - 1) / n);
+// Jackknife standard error from the n leave-one-out estimates (fits.hpp's
+// jackknife_error), NaN below 3 estimates: S4's errors need at least three
+// origins.
+double jackknife_error_3(const std::vector<double>& x) {
+  return x.size() < 3 ? kNaN : jackknife_error(x);
 }
 
 } // namespace
@@ -67,9 +62,9 @@ S4FitAtLag fit_s4_at_lag(const S4Accumulator& acc, int j, double qxi_max) {
     chi0.push_back(f.chi0), xi.push_back(f.xi);
     chi0_a2.push_back(g.chi0), xi_a2.push_back(g.xi), a.push_back(g.a);
   }
-  out.oz.chi0_err = jackknife_error(chi0), out.oz.xi_err = jackknife_error(xi);
-  out.oz_a2.chi0_err = jackknife_error(chi0_a2), out.oz_a2.xi_err = jackknife_error(xi_a2);
-  out.oz_a2.a_err = jackknife_error(a);
+  out.oz.chi0_err = jackknife_error_3(chi0), out.oz.xi_err = jackknife_error_3(xi);
+  out.oz_a2.chi0_err = jackknife_error_3(chi0_a2), out.oz_a2.xi_err = jackknife_error_3(xi_a2);
+  out.oz_a2.a_err = jackknife_error_3(a);
   return out;
 }
 
@@ -87,7 +82,7 @@ ValueErr whole_box_chi4(const std::vector<double>& q_per_origin, double n_total)
   };
   std::vector<double> loo;
   for (size_t k = 0; k < q.size(); ++k) loo.push_back(chi4(k));
-  return {chi4(q.size()), jackknife_error(loo)};
+  return {chi4(q.size()), jackknife_error_3(loo)};
 }
 
 } // namespace dynhet::analysis

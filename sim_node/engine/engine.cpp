@@ -31,7 +31,7 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
                                 " holds fewer than 3 cells; use more particles");
   cw_ = box_ / nc_;
 
-  part_.assign(n_, Particle{0, 0, 0, 0, 0, kNever, 0, -1, 0});
+  part_.assign(n_, Particle{0, 0, 0, 0, 0, kNever, 0, 0});
   for (long i = 0; i < n_; ++i) part_[i].species = species_by_id_[i];
   image_x_.assign(n_, 0);
   image_y_.assign(n_, 0);
@@ -49,43 +49,47 @@ double Engine::packing_fraction() const {
 
 // ---------------------------------------------------------------- cells
 
-void Engine::cell_insert(int i, int c) {
-  cell_of_[i] = c;
-  prev_[i] = -1;
-  part_[i].next = head_[c];
-  if (head_[c] >= 0) prev_[head_[c]] = i;
-  head_[c] = i;
+void Engine::cell_insert(int i, int cx, int cy) {
+  if (cell(cx, cy)[0] == cell_stride_ - 1) grow_cells();
+  int32_t* c = cell(cx, cy);
+  c[++c[0]] = i;
+  cell_x_[i] = cx;
+  cell_y_[i] = cy;
 }
 
+// Swaps the last member into i's place: the order within a cell depends only
+// on the sequence of inserts and removals, not on the capacity.
 void Engine::cell_remove(int i) {
-  const int c = cell_of_[i];
-  const int next = part_[i].next;
-  if (prev_[i] >= 0)
-    part_[prev_[i]].next = next;
-  else
-    head_[c] = next;
-  if (next >= 0) prev_[next] = prev_[i];
+  int32_t* c = cell(cell_x_[i], cell_y_[i]);
+  int k = 1;
+  while (c[k] != i) ++k;
+  c[k] = c[c[0]--];
+}
+
+void Engine::grow_cells() {
+  const int old = cell_stride_;
+  cell_stride_ *= 2;
+  std::vector<int32_t, BigArrayAlloc<int32_t>> bigger(static_cast<size_t>(nc_) * nc_ * cell_stride_, 0);
+  for (size_t c = 0; c < static_cast<size_t>(nc_) * nc_; ++c)
+    std::copy(&cells_[c * old], &cells_[c * old] + cells_[c * old] + 1, &bigger[c * cell_stride_]);
+  cells_.swap(bigger);
+}
+
+void Engine::clear_cells() {
+  cells_.assign(static_cast<size_t>(nc_) * nc_ * cell_stride_, 0);
+  cell_x_.assign(n_, 0);
+  cell_y_.assign(n_, 0);
 }
 
 void Engine::build_cells() {
-  head_.assign(static_cast<size_t>(nc_) * nc_, -1);
-  cell_of_.assign(n_, -1);
-  for (auto& a : part_) a.next = -1;
-  prev_.assign(n_, -1);
-  for (long i = 0; i < n_; ++i) {
-    const int cx = std::min(nc_ - 1, static_cast<int>(part_[i].x / cw_));
-    const int cy = std::min(nc_ - 1, static_cast<int>(part_[i].y / cw_));
-    cell_insert(static_cast<int>(i), cell_index(cx, cy));
-  }
+  clear_cells();
+  for (long i = 0; i < n_; ++i)
+    cell_insert(static_cast<int>(i), cell_coord(part_[i].x), cell_coord(part_[i].y));
 }
 
 void Engine::reorder() {
   std::vector<int32_t> cell(n_);
-  for (long s = 0; s < n_; ++s) {
-    const int cx = std::clamp(static_cast<int>(part_[s].x / cw_), 0, nc_ - 1);
-    const int cy = std::clamp(static_cast<int>(part_[s].y / cw_), 0, nc_ - 1);
-    cell[s] = cell_index(cx, cy);
-  }
+  for (long s = 0; s < n_; ++s) cell[s] = cell_index(cell_coord(part_[s].x), cell_coord(part_[s].y));
   std::vector<int32_t> order(n_);
   for (long s = 0; s < n_; ++s) order[s] = static_cast<int32_t>(s);
   std::sort(order.begin(), order.end(), [&](int32_t a, int32_t b) {
@@ -105,8 +109,8 @@ void Engine::reorder() {
 }
 
 void Engine::image_shift(int i, int j, double& sx, double& sy) const {
-  const int dx = cell_of_[j] % nc_ - cell_of_[i] % nc_;
-  const int dy = cell_of_[j] / nc_ - cell_of_[i] / nc_;
+  const int dx = cell_x_[j] - cell_x_[i];
+  const int dy = cell_y_[j] - cell_y_[i];
   sx = dx > 1 ? -box_ : (dx < -1 ? box_ : 0.0);
   sy = dy > 1 ? -box_ : (dy < -1 ? box_ : 0.0);
 }
@@ -124,9 +128,12 @@ void Engine::sync(int i) {
 // Next event of particle i (synchronised to now): leaving its cell, or the
 // earliest collision with a particle of the 3x3 cells around it. A neighbour
 // for which the collision with i comes before its own next event takes it.
+// The candidates are gathered first and their cache lines requested all at
+// once: at large N each is a cache miss, and waiting for them one by one
+// would cost most of the time.
 void Engine::predict(int i) {
   const Particle& a = part_[i];
-  const int c = cell_of_[i], cx = c % nc_, cy = c / nc_;
+  const int cx = cell_x_[i], cy = cell_y_[i];
 
   // Leaving the cell: direction 0 (+x), 1 (-x), 2 (+y), 3 (-y).
   double best = kNever;
@@ -139,27 +146,52 @@ void Engine::predict(int i) {
   }
   best = std::max(best, 0.0);
 
-  for (int dy = -1; dy <= 1; ++dy) {
-    const int ny = (cy + dy + nc_) % nc_;
-    const double sy = cy + dy < 0 ? -box_ : (cy + dy >= nc_ ? box_ : 0.0);
-    for (int dx = -1; dx <= 1; ++dx) {
-      const int nx = (cx + dx + nc_) % nc_;
-      const double sx = cx + dx < 0 ? -box_ : (cx + dx >= nc_ ? box_ : 0.0);
-      for (int j = head_[cell_index(nx, ny)]; j >= 0; j = part_[j].next) {
-        if (j == i) continue;
-        const Particle& b = part_[j];
-        const double bdt = now_ - b.t;
-        const double ddx = a.x - (b.x + b.vx * bdt + sx), ddy = a.y - (b.y + b.vy * bdt + sy);
-        const double dt =
-            pair_collision_time(ddx, ddy, a.vx - b.vx, a.vy - b.vy, sigma(i, j), growth(i, j));
-        if (dt == kNever) continue;
-        const double t = now_ + dt;
-        if (dt < best) best = dt, ev = Event{j, kCollision, b.coll};
-        if (t < b.event_time) {
-          event_[j] = Event{i, kCollision, a.coll};
-          set_event_time(j, t);
-        }
+  // Candidates and the periodic shift of each (index into sx[], sy[]).
+  constexpr int kMax = 512;
+  int32_t cand[kMax];
+  uint8_t shift[kMax];
+  int nc = 0;
+  double sxs[3], sys[3];
+  int nxs[3];
+  for (int d = 0; d < 3; ++d) {
+    const int x = cx + d - 1;
+    nxs[d] = x < 0 ? x + nc_ : (x >= nc_ ? x - nc_ : x);
+    sxs[d] = x < 0 ? -box_ : (x >= nc_ ? box_ : 0.0);
+    const int y = cy + d - 1;
+    sys[d] = y < 0 ? -box_ : (y >= nc_ ? box_ : 0.0);
+  }
+  for (int dy = 0; dy < 3; ++dy) {
+    const int y = cy + dy - 1, ny = y < 0 ? y + nc_ : (y >= nc_ ? y - nc_ : y);
+    for (int dx = 0; dx < 3; ++dx) {
+      const int32_t* c = cell(nxs[dx], ny);
+      const int m = c[0];
+      if (nc + m > kMax) throw std::logic_error("engine: more than 512 neighbour candidates");
+      for (int k = 1; k <= m; ++k) {
+        const int j = c[k];
+        __builtin_prefetch(&part_[j]);
+        cand[nc] = j;
+        shift[nc++] = static_cast<uint8_t>(3 * dy + dx);
       }
+    }
+  }
+
+  const double sig_i = radius_[a.species];
+  const double sc = scale();
+  for (int k = 0; k < nc; ++k) {
+    const int j = cand[k];
+    if (j == i) continue;
+    const Particle& b = part_[j];
+    const double sx = sxs[shift[k] % 3], sy = sys[shift[k] / 3];
+    const double bdt = now_ - b.t;
+    const double ddx = a.x - (b.x + b.vx * bdt + sx), ddy = a.y - (b.y + b.vy * bdt + sy);
+    const double rsum = sig_i + radius_[b.species];
+    const double dt = pair_collision_time(ddx, ddy, a.vx - b.vx, a.vy - b.vy, sc * rsum, grow_ * rsum);
+    if (dt == kNever) continue;
+    const double t = now_ + dt;
+    if (dt < best) best = dt, ev = Event{j, kCollision, b.coll};
+    if (t < b.event_time) {
+      event_[j] = Event{i, kCollision, a.coll};
+      set_event_time(j, t);
     }
   }
   event_[i] = ev;
@@ -198,7 +230,7 @@ void Engine::collide(int i, int j) {
 void Engine::cross(int i, int dir) {
   sync(i);
   Particle& a = part_[i];
-  int cx = cell_of_[i] % nc_, cy = cell_of_[i] / nc_;
+  int cx = cell_x_[i], cy = cell_y_[i];
   switch (dir) {
   case 0:
     if (++cx == nc_) cx = 0, a.x -= box_, ++image_x_[i];
@@ -213,7 +245,7 @@ void Engine::cross(int i, int dir) {
     if (--cy < 0) cy = nc_ - 1, a.y += box_, --image_y_[i];
   }
   cell_remove(i);
-  cell_insert(i, cell_index(cx, cy));
+  cell_insert(i, cx, cy);
   ++count_.cell_crossings;
   predict(i);
 }
@@ -315,10 +347,7 @@ void Engine::place_random(double scale) {
   scale0_ = scale;
   grow_ = 0;
   now_ = 0;
-  head_.assign(static_cast<size_t>(nc_) * nc_, -1);
-  cell_of_.assign(n_, -1);
-  for (auto& a : part_) a.next = -1;
-  prev_.assign(n_, -1);
+  clear_cells();
   for (long i = 0; i < n_; ++i) {
     bool placed = false;
     for (int attempt = 0; attempt < 100000 && !placed; ++attempt) {
@@ -328,8 +357,9 @@ void Engine::place_random(double scale) {
       placed = true;
       for (int dy = -1; dy <= 1 && placed; ++dy)
         for (int dx = -1; dx <= 1 && placed; ++dx) {
-          const int c = cell_index((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_);
-          for (int j = head_[c]; j >= 0; j = part_[j].next) {
+          const int32_t* c = cell((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_);
+          for (int k = 1; k <= c[0]; ++k) {
+            const int j = c[k];
             double ddx = x - part_[j].x, ddy = y - part_[j].y;
             ddx -= box_ * std::round(ddx / box_);
             ddy -= box_ * std::round(ddy / box_);
@@ -343,7 +373,7 @@ void Engine::place_random(double scale) {
       if (placed) {
         Particle& p = part_[i];
         p.x = x, p.y = y, p.vx = p.vy = p.t = 0;
-        cell_insert(static_cast<int>(i), cell_index(cx, cy));
+        cell_insert(static_cast<int>(i), cx, cy);
       }
     }
     if (!placed) throw std::runtime_error("engine: random placement failed at particle " + std::to_string(i));
@@ -459,7 +489,7 @@ void Engine::restore(const State& s) {
   now_ = 0;
   events_since_rebase_ = 0;
   for (long i = 0; i < n_; ++i) {
-    part_[i] = Particle{s.x[i], s.y[i], s.vx[i], s.vy[i], 0.0, kNever, s.collision_count[i], -1, species_by_id_[i]};
+    part_[i] = Particle{s.x[i], s.y[i], s.vx[i], s.vy[i], 0.0, kNever, s.collision_count[i], species_by_id_[i]};
     last_collision_[i] = s.last_collision[i];
   }
   image_x_ = s.image_x;
@@ -508,12 +538,14 @@ double Engine::min_gap_ratio() const {
   for (long i = 0; i < n_; ++i) {
     const auto& a = part_[i];
     const double ax = a.x + a.vx * (now_ - a.t), ay = a.y + a.vy * (now_ - a.t);
-    const int c = cell_of_[i], cx = c % nc_, cy = c / nc_;
+    const int cx = cell_x_[i], cy = cell_y_[i];
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
         const double sx = cx + dx < 0 ? -box_ : (cx + dx >= nc_ ? box_ : 0.0);
         const double sy = cy + dy < 0 ? -box_ : (cy + dy >= nc_ ? box_ : 0.0);
-        for (int j = head_[cell_index((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_)]; j >= 0; j = part_[j].next) {
+        const int32_t* c = cell((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_);
+        for (int k = 1; k <= c[0]; ++k) {
+          const int j = c[k];
           if (j <= i) continue;
           const auto& b = part_[j];
           const double ddx = ax - (b.x + b.vx * (now_ - b.t) + sx);

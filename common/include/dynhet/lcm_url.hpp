@@ -33,5 +33,6 @@ inline constexpr const char* kChanOverlap = "DYNHET_OVERLAP";
 inline constexpr const char* kChanChi4 = "DYNHET_CHI4";
 inline constexpr const char* kChanMsd = "DYNHET_MSD";
 inline constexpr const char* kChanS4 = "DYNHET_S4";
+inline constexpr const char* kChanClusters = "DYNHET_CLUSTERS";
 
 } // namespace dynhet

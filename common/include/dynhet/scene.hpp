@@ -72,6 +72,26 @@ struct Scene {
   int s4_half_width = 4;                // Gaussian half-width in grid points
   std::vector<int> s4_subbox_particles; // sub-box sizes (the whole box is always added); empty: chi4's
 
+  // [clusters]: clusters of slow and fast particles (paper sec. 3.3)
+  struct Clusters {
+    // The lag t of the clusters: < 0 ("tau_alpha") the scheduled lag nearest
+    // (in ln t) the node's running tau_alpha of each cutoff; else the
+    // scheduled lag nearest this time.
+    double lag = -1.0;
+    // r^min_11, r^min_12, r^min_22; empty ("g_ab"): the first minima of the
+    // smoothed g_ab(r) of the first `cutoff_frames` origin frames.
+    std::vector<double> neighbour_cutoffs;
+    int cutoff_frames = 1;
+    double gr_r_max = 8.0;      // g_ab(r) on [0, gr_r_max) (at most box/2) ...
+    double gr_bin = 0.05;       // ... in bins of this width
+    double gr_smoothing = 0.1;  // Gaussian width of the smoothing before the minimum is sought
+    int bins_per_decade = 5;    // log bins of N_c for P(N_c) and the R_g - N_c bins
+    std::vector<int64_t> power_law_sizes{1, 100}; // N_c range of the kappa fit (slow clusters)
+    int min_bin_count = 5;      // bins with fewer clusters are left out of the fits
+    int fractal_min_size = 10;  // smallest N_c in the d_f fit
+    int error_blocks = 20;      // errors from at most this many blocks of consecutive origins
+  } clusters;
+
   // [transport]
   int chunk_particles = 8192; // 16 bytes each: 128 KiB of positions
 

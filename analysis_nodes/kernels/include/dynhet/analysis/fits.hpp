@@ -22,6 +22,11 @@ struct LinearFit {
 LinearFit linear_fit(const std::vector<double>& x, const std::vector<double>& y,
                      const std::vector<double>& w = {});
 
+// Jackknife standard error of an estimate from its leave-one-out values
+// (one per block left out): sqrt((n-1)/n sum (x_b - mean)^2). NaN with
+// fewer than two blocks or if any value is NaN.
+double jackknife_error(const std::vector<double>& leave_one_out);
+
 // Minimises |r(p)|^2 for residuals r already divided by their errors.
 struct LmResult {
   Eigen::VectorXd p;

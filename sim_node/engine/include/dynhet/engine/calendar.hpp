@@ -9,6 +9,8 @@
 #include <cstdint>
 #include <vector>
 
+#include "dynhet/engine/memory.hpp"
+
 namespace dynhet::engine {
 
 class Calendar {
@@ -23,13 +25,22 @@ public:
   int top() const { return node_[1].leaf; }
   double top_time() const { return node_[1].time; }
   double time(int leaf) const { return node_[size_ + leaf].time; }
+  // A time that comes earlier climbs while it wins; one that comes later is
+  // replayed only where the leaf was the winner. Either loop stops at the
+  // first node that does not change.
   void set(int leaf, double t) {
     int v = size_ + leaf;
+    const double old = node_[v].time;
     node_[v].time = t;
-    for (v /= 2; v >= 1; v /= 2) {
-      const Node m = pick(node_[2 * v], node_[2 * v + 1]);
-      if (m.leaf == node_[v].leaf && m.leaf != leaf) break; // same winner, same time: nothing above changes
-      node_[v] = m;
+    if (t <= old) {
+      for (v /= 2; v >= 1; v /= 2) {
+        Node& n = node_[v];
+        if (n.leaf != leaf && (n.time < t || (n.time == t && n.leaf < leaf))) break;
+        n.time = t;
+        n.leaf = leaf;
+      }
+    } else {
+      for (v /= 2; v >= 1 && node_[v].leaf == leaf; v /= 2) node_[v] = pick(node_[2 * v], node_[2 * v + 1]);
     }
   }
   // Subtract dt from every time (rebasing the clock).
@@ -43,11 +54,13 @@ private:
     int32_t leaf;
   };
   // Earlier time wins; ties go to the lower leaf, so the order is reproducible.
-  static const Node& pick(const Node& a, const Node& b) {
-    return b.time < a.time || (b.time == a.time && b.leaf < a.leaf) ? b : a;
+  // Without branches: which child wins is unpredictable.
+  static Node pick(const Node& a, const Node& b) {
+    const bool second = (b.time < a.time) | ((b.time == a.time) & (b.leaf < a.leaf));
+    return Node{second ? b.time : a.time, second ? b.leaf : a.leaf};
   }
   int size_ = 1;
-  std::vector<Node> node_;
+  std::vector<Node, BigArrayAlloc<Node>> node_;
 };
 
 } // namespace dynhet::engine

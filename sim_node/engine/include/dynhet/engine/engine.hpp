@@ -9,12 +9,14 @@
 // counter has moved on, and is then predicted again when it comes up.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <functional>
 #include <string>
 #include <vector>
 
 #include "dynhet/engine/calendar.hpp"
+#include "dynhet/engine/memory.hpp"
 #include "dynhet/engine/rng.hpp"
 #include "dynhet/model.hpp"
 
@@ -137,7 +139,6 @@ private:
     double x, y, vx, vy, t; // position (in the box) at local time t, velocity
     double event_time;      // its next event (a copy of its calendar leaf)
     uint64_t coll;          // collision counter (also counts kicks): staleness of predictions
-    int32_t next;           // next particle in the same cell, -1 at the end
     uint8_t species;
   };
   struct Event {
@@ -166,8 +167,16 @@ private:
   void rescale_velocities(double energy);
   void start_run(); // restitution, driving on; the first kick drawn
   int cell_index(int cx, int cy) const { return cy * nc_ + cx; }
-  void cell_insert(int i, int c);
+  // Cell (cx, cy) of a position in the box.
+  int cell_coord(double x) const { return std::clamp(static_cast<int>(x / cw_), 0, nc_ - 1); }
+  int32_t* cell(int cx, int cy) { return &cells_[static_cast<size_t>(cell_index(cx, cy)) * cell_stride_]; }
+  const int32_t* cell(int cx, int cy) const {
+    return &cells_[static_cast<size_t>(cell_index(cx, cy)) * cell_stride_];
+  }
+  void cell_insert(int i, int cx, int cy);
   void cell_remove(int i);
+  void clear_cells();
+  void grow_cells(); // twice the capacity per cell, contents and their order kept
   // Shift to add to j's position so that it is the image next to i.
   void image_shift(int i, int j, double& sx, double& sy) const;
   void place_random(double scale);
@@ -186,16 +195,22 @@ private:
 
   // Per-particle arrays are indexed by storage slot; id_[slot] is the
   // particle's id (its index in frames and checkpoints), slot_of_ the inverse.
-  std::vector<Particle> part_;
+  std::vector<Particle, BigArrayAlloc<Particle>> part_;
   std::vector<uint8_t> species_by_id_;
   std::vector<int32_t> id_, slot_of_;
   std::vector<int32_t> image_x_, image_y_;
   std::vector<double> last_collision_; // internal time of each particle's last collision (TC model)
-  std::vector<Event> event_;
+  std::vector<Event, BigArrayAlloc<Event>> event_;
 
   int nc_ = 0;   // cells per side
   double cw_ = 0; // cell width
-  std::vector<int32_t> cell_of_, head_, prev_;
+  // Cells as fixed-capacity arrays, not linked lists, so that predicting
+  // reads a cell's members in one cache line and can fetch all neighbours at
+  // once: cell c is cells_[c * cell_stride_ ...], first its count, then the
+  // slots of its particles. cell_x_, cell_y_ are each particle's cell.
+  std::vector<int32_t, BigArrayAlloc<int32_t>> cells_;
+  int cell_stride_ = 16; // one cache line: a count and up to 15 members
+  std::vector<int32_t> cell_x_, cell_y_;
 
   Calendar cal_;
   int kick_leaf_;
