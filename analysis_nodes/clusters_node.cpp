@@ -29,6 +29,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -99,13 +100,12 @@ public:
   ClustersNode(lcm::LCM& out, int64_t run_filter) : FrameNode(out, run_filter, "clusters") {}
 
 private:
-  void start() override {
+  void start(const dynhet::run_info_t& m) override {
     try {
-      spec_ = dynhet::parse_scene_text(info().scene_toml, "run info scene").clusters;
+      spec_ = dynhet::parse_scene_text(m.scene_toml, "run info scene").clusters;
     } catch (const std::exception& e) {
-      return fail(std::string("cannot read the scene's [clusters] table: ") + e.what());
+      throw std::runtime_error(std::string("cannot read the scene's [clusters] table: ") + e.what());
     }
-    const auto& m = info();
     n_ = m.n_particles, box_ = m.box_length;
     species_.assign(m.species.begin(), m.species.end());
     gr_r_max_ = std::min(spec_.gr_r_max, box_ / 2);
@@ -116,7 +116,6 @@ private:
     tallies_.assign(static_cast<size_t>(m.n_cutoffs) * m.n_lags * 2,
                     BlockTallies{empty, std::vector<an::ClusterTally>(n_blocks_, empty)});
     for (int c = 0; c < m.n_cutoffs; ++c) q_.emplace_back(m.n_origins, m.lag_time);
-    started_ = true;
   }
 
   BlockTallies& tallies(int c, int j, Kind kind) {
@@ -158,31 +157,28 @@ private:
     return g;
   }
 
-  void frame(const dynhet::Frame& f, int k0, const std::vector<Pair>& pairs) override {
-    if (!started_) return;
-    if (k0 >= 0) add_origin(k0, f.position);
-    for (const Pair& p : pairs) add_pair(p, f.position);
-  }
-  void drop_origin(int k) override { graphs_.erase(k); }
+  void on_origin(int k, const std::vector<double>& pos0) override { add_origin(k, pos0); }
+  void on_origin_dropped(int k) override { graphs_.erase(k); }
 
   // One (origin, lag): Q for tau_alpha, then slow and fast clusters for every cutoff.
-  void add_pair(const Pair& p, const std::vector<double>& pt) {
+  void on_pair(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) override {
+    const std::vector<double>& pt = f.position;
     d2_.resize(n_);
     for (long i = 0; i < n_; ++i)
-      d2_[i] = std::pow(pt[2 * i] - p.pos0[2 * i], 2) + std::pow(pt[2 * i + 1] - p.pos0[2 * i + 1], 2);
-    auto graph = graphs_.find(p.origin);
-    const int block = static_cast<int>(static_cast<long>(p.origin) * n_blocks_ / info().n_origins);
+      d2_[i] = std::pow(pt[2 * i] - pos0[2 * i], 2) + std::pow(pt[2 * i + 1] - pos0[2 * i + 1], 2);
+    auto graph = graphs_.find(k);
+    const int block = static_cast<int>(static_cast<long>(k) * n_blocks_ / info().n_origins);
     for (int c = 0; c < info().n_cutoffs; ++c) {
       const double a = info().cutoff_a[c];
       const std::vector<std::uint8_t> slow = an::slow_particles(d2_.data(), n_, a);
       long n_slow = 0;
       for (std::uint8_t s : slow) n_slow += s;
       const double q = double(n_slow) / n_; // Q(t;t0), eq. (6) over the whole box
-      q_[c].add(p.origin, p.lag, &q, 1);
+      q_[c].add(k, j, &q, 1);
       if (graph == graphs_.end()) continue; // before the cutoffs were fixed
-      tallies(c, p.lag, kSlow).block[block].add(finder_.find(graph->second, p.pos0.data(), pt.data(), box_, slow.data()));
+      tallies(c, j, kSlow).block[block].add(finder_.find(graph->second, pos0.data(), pt.data(), box_, slow.data()));
       const std::vector<std::uint8_t> fast = an::fast_particles(d2_.data(), n_, a);
-      tallies(c, p.lag, kFast).block[block].add(finder_.find(graph->second, p.pos0.data(), pt.data(), box_, fast.data()));
+      tallies(c, j, kFast).block[block].add(finder_.find(graph->second, pos0.data(), pt.data(), box_, fast.data()));
     }
   }
 
@@ -200,7 +196,6 @@ private:
   }
 
   void publish_results(bool final) override {
-    if (!started_) return;
     for (int c = 0; c < info().n_cutoffs; ++c) {
       dynhet::clusters_t m{};
       stamp(m, final);
@@ -212,7 +207,7 @@ private:
       m.lag_index = chosen_lag(c, q.tau_alpha);
       m.lag = m.lag_index >= 0 ? info().lag_time[m.lag_index] : kNaN;
       fill_at_lag(c, m.lag_index, m);
-      out_.publish(dynhet::kChanClusters, &m);
+      out().publish(dynhet::kChanClusters, &m);
       if (final)
         std::fprintf(stderr,
                      "clusters_node: a=%g tau_alpha=%.4g lag %.4g: slow <N_c>=%.4g d_f=%.3g kappa=%.3g; "
@@ -339,7 +334,6 @@ private:
     m.fast_n0_err = an::jackknife_error(n0), m.fast_sigma_err = an::jackknife_error(sigma);
   }
 
-  bool started_ = false;
   dynhet::Scene::Clusters spec_;
   long n_ = 0;
   double box_ = 0, gr_r_max_ = 0;
@@ -360,7 +354,6 @@ private:
 } // namespace
 
 int main(int argc, char** argv) {
-  return dynhet::run_node(argc, argv, "clusters_node",
-                          "dynhet clusters_node: clusters of slow and fast particles from frames on LCM",
-                          [](lcm::LCM& out, int64_t run) { return std::make_unique<ClustersNode>(out, run); });
+  return dynhet::node_main<ClustersNode>(
+      "clusters_node", "dynhet clusters_node: clusters of slow and fast particles from frames on LCM", argc, argv);
 }

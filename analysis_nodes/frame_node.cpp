@@ -8,7 +8,7 @@
 namespace dynhet {
 
 FrameNode::FrameNode(lcm::LCM& out, int64_t run_filter, std::string name)
-    : out_(out), name_(std::move(name)), run_filter_(run_filter) {
+    : out_(out), run_filter_(run_filter), name_(std::move(name)) {
   status_.node = name_;
   status_.state = "waiting";
 }
@@ -23,6 +23,10 @@ void FrameNode::check_sim_alive(double timeout) {
   if (silent > timeout) finish(1, "the sim has been silent for " + std::to_string(static_cast<int>(silent)) + " s");
 }
 
+void FrameNode::input_ended() {
+  if (!finished_) finish(1, info_ ? "input ended before the run did" : "no run info in the input");
+}
+
 void FrameNode::on_run(const lcm::ReceiveBuffer*, const std::string&, const run_info_t* m) {
   if (info_ || (run_filter_ && m->run_id != run_filter_)) return;
   info_ = std::make_unique<run_info_t>(*m);
@@ -30,7 +34,16 @@ void FrameNode::on_run(const lcm::ReceiveBuffer*, const std::string&, const run_
   status_.run_id = m->run_id;
   status_.frames_expected = m->n_frames;
   status_.state = "running";
-  // Which origins and which (origin, lag) pairs each frame serves.
+  std::fprintf(stderr, "%s_node: run %lld, N=%d, %d frames, %d origins x %d lags\n", name_.c_str(),
+               static_cast<long long>(m->run_id), m->n_particles, m->n_frames, m->n_origins, m->n_lags);
+  try {
+    start(*info_); // the node may keep references into it: the copy lives as long as the node
+  } catch (const std::exception& e) {
+    finish(1, e.what());
+    return;
+  }
+  started_ = true;
+  // Which origins and which used (origin, lag) pairs each frame serves.
   origin_at_.assign(m->n_frames, -1);
   pairs_at_.assign(m->n_frames, {});
   last_use_.assign(m->n_origins, -1);
@@ -38,18 +51,15 @@ void FrameNode::on_run(const lcm::ReceiveBuffer*, const std::string&, const run_
     origin_at_[m->origin_frame[k]] = k;
     for (int j = 0; j < m->n_lags; ++j) {
       const int f = m->pair_frame[static_cast<size_t>(k) * m->n_lags + j];
-      if (f < 0) continue;
+      if (f < 0 || !uses_lag(j)) continue;
       pairs_at_[f].push_back({k, j});
       last_use_[k] = std::max(last_use_[k], f);
     }
   }
-  std::fprintf(stderr, "%s_node: run %lld, N=%d, %d frames, %d origins x %d lags\n", name_.c_str(),
-               static_cast<long long>(m->run_id), m->n_particles, m->n_frames, m->n_origins, m->n_lags);
-  start();
 }
 
 void FrameNode::on_chunk(const lcm::ReceiveBuffer*, const std::string&, const frame_chunk_t* m) {
-  if (!info_ || m->run_id != info_->run_id || m->n_values != 2 * m->count) return;
+  if (!info_ || finished_ || m->run_id != info_->run_id || m->n_values != 2 * m->count) return;
   last_sim_news_ = Clock::now();
   const ChunkHeader h{m->frame_index, m->time,           m->n_particles, m->chunk_index,
                       m->chunk_count, m->first_particle, m->count};
@@ -65,31 +75,31 @@ void FrameNode::on_sim_status(const lcm::ReceiveBuffer*, const std::string&, con
   if (m->phase == "failed") finish(1, "sim failed: " + m->message);
 }
 
-void FrameNode::input_ended() {
-  if (!finished_) finish(1, info_ ? "input ended before the run did" : "no run info in the input");
-}
-
 void FrameNode::on_frame(const Frame& f) {
   const int k0 = origin_at_[f.index];
-  if (k0 >= 0) origins_[k0] = f.position;
-  std::vector<Pair> pairs;
-  for (const auto& [k, j] : pairs_at_[f.index]) {
-    auto it = origins_.find(k);
-    if (it != origins_.end()) pairs.push_back({k, j, it->second}); // else the origin frame was lost
-  }
   last_frame_ = f.index;
   last_time_ = f.time;
-  frame(f, k0, pairs);
-  pairs_done_ += static_cast<int>(pairs.size());
+  if (k0 >= 0) { // every origin frame is seen (clusters' g_ab uses them all), then held while needed
+    origins_[k0] = f.position;
+    on_origin(k0, origins_[k0]);
+  }
+  bool added = false;
+  for (const auto& [k, j] : pairs_at_[f.index]) {
+    auto it = origins_.find(k);
+    if (it == origins_.end()) continue; // the origin frame was lost
+    on_pair(k, j, it->second, f);
+    ++pairs_done_;
+    added = true;
+  }
   // Drop origins no later frame needs.
   for (auto it = origins_.begin(); it != origins_.end();)
     if (last_use_[it->first] <= f.index) {
-      drop_origin(it->first);
+      on_origin_dropped(it->first);
       it = origins_.erase(it);
     } else {
       ++it;
     }
-  if (!pairs.empty()) publish_results(false);
+  if (added) publish_results(false);
   tick();
 }
 
@@ -110,7 +120,7 @@ void FrameNode::tick() {
 
 void FrameNode::finish(int code, const std::string& why) {
   if (info_) assembler_.finish(info_->n_frames);
-  if (info_) publish_results(true);
+  if (info_ && started_) publish_results(true);
   status_.state = code == 0 ? "done" : "failed";
   status_.message = why;
   publish_status();
@@ -120,8 +130,8 @@ void FrameNode::finish(int code, const std::string& why) {
   exit_code_ = code;
 }
 
-int run_node(int argc, char** argv, const std::string& program, const std::string& description,
-             const NodeFactory& make) {
+int node_main(const std::string& program, const std::string& description, NodeFactory make_node, int argc,
+              char** argv) {
   CLI::App app{description};
   std::string url, publish_url;
   int64_t run_id = 0;
@@ -144,13 +154,13 @@ int run_node(int argc, char** argv, const std::string& program, const std::strin
     return 3;
   }
 
-  std::unique_ptr<FrameNode> node = make(out, run_id);
+  std::unique_ptr<FrameNode> node = make_node(out, run_id);
   in.subscribe(kChanRun, &FrameNode::on_run, node.get());
   in.subscribe(kChanFrame, &FrameNode::on_chunk, node.get())->setQueueCapacity(100000);
   in.subscribe(kChanSimStatus, &FrameNode::on_sim_status, node.get());
 
   std::fprintf(stderr, "%s: ready, reading %s\n", program.c_str(), in_url.c_str());
-  const auto start = std::chrono::steady_clock::now();
+  const auto start = FrameNode::Clock::now();
   while (!node->finished()) {
     if (in.handleTimeout(200) < 0) { // a replayed log has ended
       node->input_ended();
@@ -158,7 +168,7 @@ int run_node(int argc, char** argv, const std::string& program, const std::strin
     }
     node->tick();
     if (!replay) node->check_sim_alive(sim_timeout);
-    if (!node->has_run() && std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() > wait_run) {
+    if (!node->has_run() && std::chrono::duration<double>(FrameNode::Clock::now() - start).count() > wait_run) {
       std::fprintf(stderr, "%s: no run info on %s within %g s\n", program.c_str(), in_url.c_str(), wait_run);
       return 4;
     }

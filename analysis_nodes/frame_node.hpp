@@ -1,15 +1,21 @@
-// What every analysis node does around its physics: take the first run
-// info, assemble frames from their chunks, know which origin and which
-// (origin, lag) pairs each frame serves, hold each origin frame only until
-// the last frame that needs it, publish the node status every second,
-// notice the end of the run (the sim says done or failed, goes silent, or
-// a replayed log ends), and run the LCM loop. A node derives from
-// FrameNode and says what to do with the run, a frame and its results.
+// What every analysis node shares, in the LCM layer above the kernels: it
+// takes the run info of the first run seen (or of --run-id), reassembles
+// frames from chunks, knows from the schedule which frame is which origin
+// and which (origin, lag) pairs it completes, holds each origin frame
+// (16 N bytes) only until the last pair the node uses has been seen,
+// watches the sim (done, failed, interrupted, silent, or a replayed log
+// that ends) and publishes the node status every second. A node derives
+// from FrameNode and says which lags it uses, what to do with an origin
+// frame and with a pair, and how to publish its results; node_main<Node>()
+// is its main().
+//
+// (Two branches took this layer out of overlap_node independently; this is
+// their union: the per-origin and per-pair hooks, uses_lag and node_main of
+// one, held_origins() and wants() of the other.)
 #pragma once
 
 #include <chrono>
 #include <cstdint>
-#include <functional>
 #include <map>
 #include <memory>
 #include <string>
@@ -28,13 +34,11 @@ namespace dynhet {
 
 class FrameNode {
 public:
+  using Clock = std::chrono::steady_clock;
+
   // `name` is the node's name in its status ("overlap") and logs ("overlap_node").
   FrameNode(lcm::LCM& out, int64_t run_filter, std::string name);
   virtual ~FrameNode() = default;
-
-  void on_run(const lcm::ReceiveBuffer*, const std::string&, const run_info_t* m);
-  void on_chunk(const lcm::ReceiveBuffer*, const std::string&, const frame_chunk_t* m);
-  void on_sim_status(const lcm::ReceiveBuffer*, const std::string&, const sim_status_t* m);
 
   bool finished() const { return finished_; }
   bool has_run() const { return info_ != nullptr; }
@@ -44,30 +48,29 @@ public:
   void check_sim_alive(double timeout);
   // The input ended (log replayed to its end) before the sim said done.
   void input_ended();
-  void tick(); // the node status, once a second
+  void tick(); // node status once a second
+
+  void on_run(const lcm::ReceiveBuffer*, const std::string&, const run_info_t* m);
+  void on_chunk(const lcm::ReceiveBuffer*, const std::string&, const frame_chunk_t* m);
+  void on_sim_status(const lcm::ReceiveBuffer*, const std::string&, const sim_status_t* m);
 
 protected:
-  struct Pair {
-    int origin, lag;
-    const std::vector<double>& pos0; // the origin frame
-  };
-  // The run has started: info() is set.
-  virtual void start() = 0;
-  // A frame: `origin` its origin index (-1 if none), `pairs` the (origin,
-  // lag) pairs it ends whose origin frame is held (lost ones left out).
-  virtual void frame(const Frame& f, int origin, const std::vector<Pair>& pairs) = 0;
-  // No later frame needs origin k: let go of what was kept for it.
-  virtual void drop_origin(int) {}
+  // The run has started: set up. Throwing fails the node with the message
+  // (no results are published then).
+  virtual void start(const run_info_t& m) = 0;
+  // Whether the node evaluates lag j (asked after start()); origins are held
+  // only until their last used lag.
+  virtual bool uses_lag(int) const { return true; }
+  // Origin frame k has arrived (before the pairs the same frame ends); it
+  // is held (held_origins()) until on_origin_dropped(k).
+  virtual void on_origin(int /*k*/, const std::vector<double>& /*pos0*/) {}
+  virtual void on_origin_dropped(int /*k*/) {}
+  // One (origin k, lag j) pair: origin positions and the frame at t0 + lag
+  // (pairs whose origin frame was lost are left out).
+  virtual void on_pair(int k, int j, const std::vector<double>& pos0, const Frame& f) = 0;
+  // After a frame that completed at least one pair, and at the end (final).
   virtual void publish_results(bool final) = 0;
 
-  const run_info_t& info() const { return *info_; }
-  // The origin frames held now: origin k -> positions at t0.
-  const std::map<int, std::vector<double>>& held_origins() const { return origins_; }
-  // Give up on the run (the results so far are published as final).
-  void fail(const std::string& why) { finish(1, why); }
-  const std::string& name() const { return name_; }
-  int pairs_done() const { return pairs_done_; }
-  bool wants(const std::string& observable) const;
   // The fields every result message shares: when, which run, which frame.
   template <class Msg> void stamp(Msg& m, bool final) const {
     m.utime = utime_now();
@@ -76,33 +79,47 @@ protected:
     m.frame_index = last_frame_;
     m.is_final = final;
   }
-
-  lcm::LCM& out_;
+  const run_info_t& info() const { return *info_; }
+  // The origin frames held now: origin k -> positions at t0.
+  const std::map<int, std::vector<double>>& held_origins() const { return origins_; }
+  // Whether the run's scene asks for `observable`.
+  bool wants(const std::string& observable) const;
+  lcm::LCM& out() { return out_; }
+  int pairs_done() const { return pairs_done_; }
+  const std::string& name() const { return name_; }
 
 private:
-  using Clock = std::chrono::steady_clock;
   void on_frame(const Frame& f);
   void publish_status();
   void finish(int code, const std::string& why);
 
-  std::string name_;
+  lcm::LCM& out_;
   int64_t run_filter_;
+  std::string name_;
   std::unique_ptr<run_info_t> info_;
   std::vector<int> origin_at_, last_use_;                 // per frame; per origin
-  std::vector<std::vector<std::pair<int, int>>> pairs_at_; // per frame: (origin, lag)
+  std::vector<std::vector<std::pair<int, int>>> pairs_at_; // per frame: the used (origin, lag)
   std::map<int, std::vector<double>> origins_;             // origin k -> positions at t0
   FrameAssembler assembler_;
   node_status_t status_{};
   Clock::time_point last_status_ = Clock::now(), last_sim_news_ = Clock::now();
-  bool sim_interrupted_ = false, finished_ = false;
+  bool sim_interrupted_ = false, started_ = false, finished_ = false;
   int pairs_done_ = 0, last_frame_ = -1, exit_code_ = 0;
   double last_time_ = 0;
 };
 
 // A node's main(): flags (--lcm-url, --publish-url, --run-id, --wait-run,
-// --sim-timeout), the buses, the subscriptions and the loop.
-using NodeFactory = std::function<std::unique_ptr<FrameNode>(lcm::LCM& out, int64_t run_filter)>;
-int run_node(int argc, char** argv, const std::string& program, const std::string& description,
-             const NodeFactory& make);
+// --sim-timeout), the buses (file://LOG?speed=0 replays a log and then
+// publishes on --publish-url), subscriptions and the loop.
+// make_node(out, run_id) builds the node.
+using NodeFactory = std::unique_ptr<FrameNode> (*)(lcm::LCM& out, int64_t run_id);
+int node_main(const std::string& program, const std::string& description, NodeFactory make_node, int argc,
+              char** argv);
+template <class Node> int node_main(const std::string& program, const std::string& description, int argc, char** argv) {
+  return node_main(
+      program, description,
+      [](lcm::LCM& out, int64_t run_id) -> std::unique_ptr<FrameNode> { return std::make_unique<Node>(out, run_id); },
+      argc, argv);
+}
 
 } // namespace dynhet

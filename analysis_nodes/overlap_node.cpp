@@ -42,37 +42,37 @@ public:
   OverlapNode(lcm::LCM& out, int64_t run_filter) : FrameNode(out, run_filter, "overlap") {}
 
 private:
-  void start() override {
-    const dynhet::run_info_t* m = &info();
-    grid_ = an::make_subbox_grid(m->n_particles, m->box_length, m->overlap_subbox_particles);
-    for (int c = 0; c < m->n_cutoffs; ++c) acc_.emplace_back(m->n_origins, m->lag_time);
+  void start(const dynhet::run_info_t& m) override {
+    grid_ = an::make_subbox_grid(m.n_particles, m.box_length, m.overlap_subbox_particles);
+    for (int c = 0; c < m.n_cutoffs; ++c) acc_.emplace_back(m.n_origins, m.lag_time);
     want_chi4_ = wants("chi4");
     want_msd_ = wants("msd");
     const bool want_displacement = wants("displacement");
     if (want_msd_ || want_displacement) {
       try {
-        const dynhet::Scene scene = dynhet::parse_scene_text(m->scene_toml, "run info scene");
+        const dynhet::Scene scene = dynhet::parse_scene_text(m.scene_toml, "run info scene");
         msd_spec_ = scene.msd;
-        if (want_displacement) displacement_ = std::make_unique<dynhet::DisplacementResults>(*m, scene.displacement);
+        if (want_displacement) displacement_ = std::make_unique<dynhet::DisplacementResults>(m, scene.displacement);
       } catch (const std::exception& e) {
-        return fail(std::string("cannot read the scene's [msd] and [displacement] tables: ") + e.what());
+        throw std::runtime_error(std::string("cannot read the scene's [msd] and [displacement] tables: ") + e.what());
       }
     }
-    if (want_chi4_ || want_msd_ || want_displacement) start_pass(*m);
+    if (want_chi4_ || want_msd_ || want_displacement) start_pass(m);
     std::fprintf(stderr, "overlap_node: %dx%d sub-boxes of N=%.1f\n", grid_.per_side, grid_.per_side,
                  grid_.mean_particles);
   }
 
-  void frame(const dynhet::Frame& f, int k0, const std::vector<Pair>& pairs) override {
-    if (k0 >= 0 && pass_on_) chi4_index_[k0] = std::make_unique<an::OriginIndex>(f.position.data(), info().n_particles, spec_);
-    for (const Pair& p : pairs) {
-      an::overlap_subboxes(p.pos0.data(), f.position.data(), info().n_particles, grid_, info().cutoff_a, qr_);
-      const int nb = grid_.per_side * grid_.per_side;
-      for (size_t c = 0; c < acc_.size(); ++c) acc_[c].add(p.origin, p.lag, qr_.data() + c * nb, nb);
-      if (pass_on_) add_pass(p.origin, p.lag, p.pos0, f);
-    }
+  void on_origin(int k, const std::vector<double>& pos0) override {
+    if (pass_on_) chi4_index_[k] = std::make_unique<an::OriginIndex>(pos0.data(), info().n_particles, spec_);
   }
-  void drop_origin(int k) override { chi4_index_.erase(k); }
+  void on_origin_dropped(int k) override { chi4_index_.erase(k); }
+
+  void on_pair(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) override {
+    an::overlap_subboxes(pos0.data(), f.position.data(), info().n_particles, grid_, info().cutoff_a, qr_);
+    const int nb = grid_.per_side * grid_.per_side;
+    for (size_t c = 0; c < acc_.size(); ++c) acc_[c].add(k, j, qr_.data() + c * nb, nb);
+    if (pass_on_) add_pass(k, j, pos0, f);
+  }
 
   // Q(t) = 1/((t/tau0)^beta + 1), weighted by the errors if every lag has one.
   void fit_q(const an::OverlapAccumulator::Result& r, dynhet::overlap_t& m) const {
@@ -165,7 +165,7 @@ private:
       const auto d = an::fit_diffusion(m.lag_time, m.msd_all, m.fit_t_min, m.fit_t_max);
       if (d.n >= 3) m.diffusion = d.d, m.diffusion_err = d.d_err;
     }
-    out_.publish(dynhet::kChanMsd, &m);
+    out().publish(dynhet::kChanMsd, &m);
   }
   void publish_chi4(bool final) {
     const size_t nc = spec_.cutoffs.size(), ng = spec_.grids.size(), nj = info().lag_time.size();
@@ -192,7 +192,7 @@ private:
         m.tau4.push_back(r.tau4);
       }
       m.n_values = static_cast<int32_t>(m.chi4.size());
-      out_.publish(dynhet::kChanChi4, &m);
+      out().publish(dynhet::kChanChi4, &m);
     }
   }
 
@@ -205,10 +205,10 @@ private:
     last_displacement_ = now;
     dynhet::displacement_t m = displacement_->message(acc_[0].result().tau_alpha, info().cutoff_a[0]);
     stamp(m, final);
-    out_.publish(dynhet::kChanDisplacement, &m);
+    out().publish(dynhet::kChanDisplacement, &m);
   }
 
-  void publish_results(bool final) {
+  void publish_results(bool final) override {
     if (want_chi4_) publish_chi4(final);
     if (want_msd_) publish_msd(final);
     if (displacement_) publish_displacement(final);
@@ -231,7 +231,7 @@ private:
       for (int k = 0; k < info().n_origins; ++k) m.t0.push_back(info().frame_time[info().origin_frame[k]]);
       m.tau_alpha_t0 = an::tau_alpha_per_origin(acc_[c], info().lag_time, info().n_origins);
       m.n_t0 = static_cast<int32_t>(m.t0.size());
-      out_.publish(dynhet::kChanOverlap, &m);
+      out().publish(dynhet::kChanOverlap, &m);
       if (final)
         std::fprintf(stderr, "overlap_node: a=%g tau_alpha=%.5g +- %.2g (%d pairs)\n", m.cutoff_a,
                      m.tau_alpha, m.tau_alpha_err, pairs_done());
@@ -259,6 +259,5 @@ private:
 } // namespace
 
 int main(int argc, char** argv) {
-  return dynhet::run_node(argc, argv, "overlap_node", "dynhet overlap_node: Q(t), tau_alpha from frames on LCM",
-                          [](lcm::LCM& out, int64_t run) { return std::make_unique<OverlapNode>(out, run); });
+  return dynhet::node_main<OverlapNode>("overlap_node", "dynhet overlap_node: Q(t), tau_alpha from frames on LCM", argc, argv);
 }

@@ -266,6 +266,31 @@ void bench_s4(const Frames& f, double q_max, int reps) {
   }
 }
 
+// What s4_node spends per (origin, lag) pair with the default [s4]
+// parameters: S4 on every grid of the default chi4 sizes (nested) and the
+// whole box, each against its direct sum.
+void bench_s4_node(const Frames& f, double q_max, int reps) {
+  std::vector<double> d2(f.n), w;
+  for (long i = 0; i < f.n; ++i)
+    d2[i] = std::pow(f.pt[2 * i] - f.p0[2 * i], 2) + std::pow(f.pt[2 * i + 1] - f.p0[2 * i + 1], 2);
+  an::overlap_weights(d2.data(), f.n, 0.6, w);
+  std::vector<an::SubboxGrid> grids = an::nested_subbox_grids(f.n, f.box, {25, 100, 400, 1600, 6400});
+  grids.push_back(an::SubboxGrid{1, f.box, double(f.n)});
+  std::vector<std::unique_ptr<an::S4Grid>> fft;
+  double err = 0;
+  for (const auto& g : grids) {
+    fft.push_back(std::make_unique<an::S4Grid>(g, q_max));
+    const an::S4Shells ref = an::s4_shells(an::s4_modes_direct(f.p0.data(), w.data(), f.n, g, q_max));
+    err = std::max(err, max_rel_error(an::s4_shells(fft.back()->modes(f.p0.data(), w.data(), f.n)), ref));
+  }
+  const Timing t = time_calls(reps, [&] {
+    for (auto& g : fft) an::s4_shells(g->modes(f.p0.data(), w.data(), f.n));
+  });
+  std::printf("# s4_node per pair, %zu grids (default chi4 sizes + whole box, R = 2, hw 4): %.1f ms (min; median "
+              "%.1f), max rel error %.1e\n",
+              grids.size(), 1e3 * t.min, 1e3 * t.median, err);
+}
+
 // Clusters as clusters_node does them: g_ab and the neighbour graph once per
 // origin frame (t0), then per (origin, lag) and cutoff the slow and fast
 // selections, their clusters with R_g at t (eq. 10) and the tallies.
@@ -330,6 +355,7 @@ int main(int argc, char** argv) {
   auto wanted = [&](const char* s) { return sections.find(s) != std::string::npos; };
   if (wanted("pass")) bench_pass(f, reps);
   if (wanted("s4")) bench_s4(f, q_max, std::max(3, reps / 4));
+  if (wanted("s4")) bench_s4_node(f, q_max, std::max(3, reps / 4));
   if (wanted("clusters")) bench_clusters(f, std::max(3, reps / 4));
   return 0;
 }

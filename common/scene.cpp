@@ -100,7 +100,7 @@ std::string known_keys(const Table& t) {
 } // namespace
 
 const std::vector<std::string>& known_observables() {
-  static const std::vector<std::string> v{"overlap", "chi4", "msd", "displacement", "clusters"};
+  static const std::vector<std::string> v{"overlap", "chi4", "msd", "displacement", "clusters", "s4"};
   return v;
 }
 
@@ -270,19 +270,45 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
   schema["overlap"] = {
       {"subbox_particles", int_in(s.overlap_subbox_particles, 1, std::numeric_limits<int32_t>::max())},
   };
+  // A non-empty list of sub-box sizes (target particles per sub-box).
+  auto subbox_sizes = [&](std::vector<int>& out) {
+    return [&c, &out](const std::string& key, const toml::node& n) {
+      const auto* arr = n.as_array();
+      if (!arr || arr->empty()) return c.bad_type(key, n, "a non-empty array of integers");
+      out.clear();
+      for (const auto& e : *arr) {
+        int64_t v;
+        if (!c.get_int(key, e, v)) return;
+        if (v < 1) return c.bad_value(key, e, "every size must be >= 1 particle per sub-box");
+        out.push_back(static_cast<int>(std::min<int64_t>(v, 1 << 30)));
+      }
+    };
+  };
   schema["chi4"] = {
-      {"subbox_particles",
+      {"subbox_particles", subbox_sizes(s.chi4_subbox_particles)},
+  };
+  schema["s4"] = {
+      {"lags",
        [&](const std::string& key, const toml::node& n) {
+         if (n.is_string()) {
+           if (*n.value<std::string>() != "all") return c.bad_value(key, n, "allowed: \"all\" or an array of lag times > 0");
+           s.s4_lags.clear();
+           return;
+         }
          const auto* arr = n.as_array();
-         if (!arr || arr->empty()) return c.bad_type(key, n, "a non-empty array of integers");
-         s.chi4_subbox_particles.clear();
+         if (!arr || arr->empty()) return c.bad_type(key, n, "\"all\" or a non-empty array of lag times");
+         s.s4_lags.clear();
          for (const auto& e : *arr) {
-           int64_t v;
-           if (!c.get_int(key, e, v)) return;
-           if (v < 1) return c.bad_value(key, e, "every size must be >= 1 particle per sub-box");
-           s.chi4_subbox_particles.push_back(static_cast<int>(std::min<int64_t>(v, 1 << 30)));
+           double v;
+           if (!c.get_double(key, e, v)) return;
+           if (v <= 0) return c.bad_value(key, e, "every lag time must be > 0");
+           s.s4_lags.push_back(v);
          }
        }},
+      {"q_max", positive(s.s4_q_max)},
+      {"grid_spacing", non_negative(s.s4_grid_spacing)},
+      {"half_width", int_in(s.s4_half_width, 2, 16)},
+      {"subbox_particles", subbox_sizes(s.s4_subbox_particles)},
   };
   auto& cl = s.clusters;
   auto int_list = [&](std::vector<int64_t>& out, size_t size) {
@@ -424,6 +450,15 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
            "value " + std::to_string(s.n_particles) + " is too small at this packing fraction: " +
                "the box side " + std::to_string(m.box_length) +
                " must hold 3 cells of the largest diameter (" + std::to_string(min_box) + ")");
+  // The NUFFT grid must resolve q_max (Nyquist: h < pi / q_max).
+  if (s.s4_grid_spacing > 0 && s.s4_grid_spacing * s.s4_q_max >= 3.14159265358979)
+    c.fail("s4.grid_spacing", "value " + std::to_string(s.s4_grid_spacing) +
+                                  " is too coarse for s4.q_max = " + std::to_string(s.s4_q_max) +
+                                  "; allowed: 0 (the default, pi / (2 q_max)) or spacing < pi / q_max");
+  for (double t : s.s4_lags)
+    if (t < sch.lag_min * (1 - 1e-12) || t > sch.lag_max * (1 + 1e-12))
+      c.fail("s4.lags", "value " + std::to_string(t) + " is outside the scheduled lags [" +
+                            std::to_string(sch.lag_min) + ", " + std::to_string(sch.lag_max) + "]");
   if (cl.cutoff_frames > sch.origins)
     c.fail("clusters.cutoff_frames", "value " + std::to_string(cl.cutoff_frames) +
                                          " is more than the schedule's origins (" +

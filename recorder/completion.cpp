@@ -11,7 +11,7 @@ namespace {
 // Observables whose result messages the recorder knows how to write.
 bool recordable(const std::string &observable) {
   return observable == "overlap" || observable == "chi4" || observable == "msd" || observable == "displacement" ||
-         observable == "clusters";
+         observable == "clusters" || observable == "s4";
 }
 } // namespace
 

@@ -85,6 +85,9 @@ private:
   void on_msd(const lcm::ReceiveBuffer *, const std::string &, const dynhet::msd_t *m) {
     if (rec_.on_msd(*m)) last_progress_ = Clock::now();
   }
+  void on_s4(const lcm::ReceiveBuffer *, const std::string &, const dynhet::s4_t *m) {
+    if (rec_.on_s4(*m)) last_progress_ = Clock::now();
+  }
   void on_clusters(const lcm::ReceiveBuffer *, const std::string &, const dynhet::clusters_t *m) {
     if (rec_.on_clusters(*m)) last_progress_ = Clock::now();
   }
@@ -114,6 +117,7 @@ void Session::subscribe() {
   lcm_.subscribe(dynhet::kChanOverlap, &Session::on_overlap, this)->setQueueCapacity(10000);
   lcm_.subscribe(dynhet::kChanChi4, &Session::on_chi4, this)->setQueueCapacity(10000);
   lcm_.subscribe(dynhet::kChanMsd, &Session::on_msd, this)->setQueueCapacity(10000);
+  lcm_.subscribe(dynhet::kChanS4, &Session::on_s4, this)->setQueueCapacity(1000);
   lcm_.subscribe(dynhet::kChanClusters, &Session::on_clusters, this)->setQueueCapacity(10000);
   lcm_.subscribe(dynhet::kChanDisplacement, &Session::on_displacement, this)->setQueueCapacity(1000);
   // The launch scripts wait for this line before starting the sim.

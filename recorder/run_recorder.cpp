@@ -224,6 +224,60 @@ void RunRecorder::write_displacement(const displacement_t &m) {
   scalar("tail_x0_small_tau_alpha", m.tail_x0_small_tau_alpha);
 }
 
+bool RunRecorder::on_s4(const s4_t &m) {
+  if (!info_ || m.run_id != info_->run_id) return false;
+  guarded("s4", [&] { write_s4(m); });
+  if (m.is_final) completion_.final_result("s4", m.cutoff_a);
+  return true;
+}
+
+// s4/: fixed lag_time (the computed lags) and, per grid, subbox_particles,
+// subbox_per_side, grid_spacing, grid_points, n_shells; per shell value q,
+// shell_vectors (grid g's shells follow grid g-1's). Per record: s4,
+// s4_err (records, values) at t_s4; s4_lag (records, lags * values);
+// xi_lag, chi0_lag (records, lags * grids); oz_*, a2_*, chi4, chi4_err
+// (records, grids); scalars tau_alpha, t_s4, lag_index, n_origins, xi,
+// xi_err, chi0, chi0_err, chi4_box, chi4_box_err.
+void RunRecorder::write_s4(const s4_t &m) {
+  if (!s4_started_) {
+    writer_->write_fixed("s4/lag_time", m.lag_time);
+    writer_->write_fixed("s4/subbox_particles", m.subbox_particles);
+    writer_->write_fixed("s4/subbox_per_side", m.subbox_per_side);
+    writer_->write_fixed("s4/grid_spacing", m.grid_spacing);
+    writer_->write_fixed("s4/grid_points", m.grid_points);
+    writer_->write_fixed("s4/n_shells", m.n_shells);
+    writer_->write_fixed("s4/q", m.q);
+    writer_->write_fixed("s4/shell_vectors", m.shell_vectors);
+    writer_->set_attribute("observables/s4/", "cutoff_a", m.cutoff_a);
+    writer_->set_attribute("observables/s4/", "q_max", m.q_max);
+    writer_->set_attribute("observables/s4/", "qxi_max", m.qxi_max);
+    writer_->set_attribute("observables/s4/", "layout",
+                           "s4[record][value], grid g's shells after grid g-1's; s4_lag[record][lag * n_values + "
+                           "value]; xi_lag, chi0_lag[record][lag * n_grids + grid]");
+    s4_started_ = true;
+  }
+  if (m.n_values <= 0) return;
+  const int64_t step = m.frame_index;
+  const double t = m.sim_time;
+  const std::pair<const char *, const std::vector<double> *> arrays[] = {
+      {"s4", &m.s4},           {"s4_err", &m.s4_err},           {"s4_lag", &m.s4_lag},
+      {"xi_lag", &m.xi_lag},   {"chi0_lag", &m.chi0_lag},       {"oz_chi0", &m.oz_chi0},
+      {"oz_chi0_err", &m.oz_chi0_err}, {"oz_xi", &m.oz_xi},     {"oz_xi_err", &m.oz_xi_err},
+      {"oz_q_fit_max", &m.oz_q_fit_max}, {"a2_chi0", &m.a2_chi0}, {"a2_chi0_err", &m.a2_chi0_err},
+      {"a2_xi", &m.a2_xi},     {"a2_xi_err", &m.a2_xi_err},     {"a2_a", &m.a2_a},
+      {"a2_a_err", &m.a2_a_err}, {"a2_q_fit_max", &m.a2_q_fit_max}, {"chi4", &m.chi4},
+      {"chi4_err", &m.chi4_err}};
+  for (const auto &[name, v] : arrays) writer_->append_observable(std::string("s4/") + name, step, t, *v);
+  writer_->append_observable("s4/oz_n_fit", step, t, m.oz_n_fit);
+  writer_->append_observable("s4/a2_n_fit", step, t, m.a2_n_fit);
+  const std::pair<const char *, double> scalars[] = {
+      {"tau_alpha", m.tau_alpha}, {"t_s4", m.t_s4}, {"xi", m.xi}, {"xi_err", m.xi_err}, {"chi0", m.chi0},
+      {"chi0_err", m.chi0_err}, {"chi4_box", m.chi4_box}, {"chi4_box_err", m.chi4_box_err}};
+  for (const auto &[name, v] : scalars) writer_->append_observable(std::string("s4/") + name, step, t, &v, 1);
+  writer_->append_observable("s4/lag_index", step, t, &m.lag_index, 1);
+  writer_->append_observable("s4/n_origins", step, t, &m.n_origins, 1);
+}
+
 bool RunRecorder::on_clusters(const clusters_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
   guarded("clusters", [&] { write_clusters(m); });

@@ -10,6 +10,7 @@
 //   sim/<field>            {step = collisions + kicks, time = sim time}
 //   nodes/<node>/<field>   {step = frames handled, time = wall s since the first node status}
 //   overlap/a<cutoff>/<field> {step = frame index, time = sim time}, lag_time
+//   chi4/a<cutoff>/..., msd/..., s4/... likewise (s4: see write_s4)
 //   clusters/a<cutoff>/<field> likewise, with lag_time, r and the size bins
 //   msd/<field>, displacement/<field> likewise (one each per run), with
 //   lag_time (msd) and x, the bin centres (displacement)
@@ -31,6 +32,7 @@
 #include "dynhet/clusters_t.hpp"
 #include "dynhet/displacement_t.hpp"
 #include "dynhet/msd_t.hpp"
+#include "dynhet/s4_t.hpp"
 #include "dynhet/overlap_t.hpp"
 #include "dynhet/run_info_t.hpp"
 #include "dynhet/sim_status_t.hpp"
@@ -72,6 +74,7 @@ public:
   bool on_overlap(const overlap_t &m);
   bool on_chi4(const chi4_t &m);
   bool on_msd(const msd_t &m);
+  bool on_s4(const s4_t &m);
   bool on_clusters(const clusters_t &m);
   bool on_displacement(const displacement_t &m);
   bool on_frame_chunk(const frame_chunk_t &m);
@@ -105,6 +108,7 @@ private:
   std::map<std::string, bool> clusters_started_, clusters_r_written_, clusters_bins_written_;
   std::map<std::string, bool> overlap_t0_written_;
   bool msd_started_ = false, displacement_started_ = false;
+  bool s4_started_ = false;
   std::optional<int64_t> node_clock_zero_;      // utime of the first node status
   int write_errors_ = 0;
 
@@ -114,6 +118,7 @@ private:
   void write_overlap(const overlap_t &m);
   void write_chi4(const chi4_t &m);
   void write_msd(const msd_t &m);
+  void write_s4(const s4_t &m);
   void write_clusters(const clusters_t &m);
   void write_displacement(const displacement_t &m);
   void write_summary(const std::vector<std::string> &missing);

@@ -1,8 +1,9 @@
 #!/usr/bin/python3
 """Checks a dynhet run file: the H5MD layout, the scene, the frames, no
 loss, and the recorded Q(t) and tau_alpha, chi4, the MSD (with the
-instantaneous fastest and slowest subsets), P(dx, t) with its fits and the
-clusters against brute-force recomputations from the recorded frames.
+instantaneous fastest and slowest subsets), P(dx, t) with its fits, the
+clusters and S4(q,t) against brute-force recomputations from the recorded
+frames.
 
 Usage: check_run.py RUN.h5 SCENE.toml
 """
@@ -242,6 +243,122 @@ def check_chi4(f, unwrapped, L, origin_frame, pair_frame):
             check(err < 1e-9, f"chi4 {name} m={m}: equals brute force (max rel diff {err:.2g})")
 
 
+def s4_shells_brute(x0, w, L, m, q_max, n_total):
+    """S4 per |q| shell (paper eqs. 15-16) for one origin and lag by the exact
+    sum, as the node defines it: half-plane lattice vectors of the sub-box
+    with |q| <= q_max, shells round(|n|); also, per shell, the largest error
+    the grid may make given the kernel's bound on each sum_i w_i e^{iq.r_i}
+    (bound_rel times sum_i |w_i| of the sub-box)."""
+    ell = L / m
+    dq = 2 * math.pi / ell
+    nm = int(math.floor(q_max / dq + 1e-12))
+    modes = [(nx, ny) for ny in range(nm + 1) for nx in range(0 if ny == 0 else -nm, nm + 1)
+             if (nx * nx + ny * ny) * dq * dq <= q_max * q_max * (1 + 1e-12)]
+    box = (np.minimum((x0[:, 1] // ell).astype(int), m - 1) * m + np.minimum((x0[:, 0] // ell).astype(int), m - 1))
+    N = n_total / (m * m)
+    nvec = np.array(modes, dtype=float)
+    phase = np.exp(1j * dq * (x0 @ nvec.T))  # particle, mode
+    A = np.array([np.sum((w * (box == r))[:, None] * phase, axis=0) for r in range(m * m)])  # box, mode
+    wsum = np.array([np.sum(w * (box == r)) for r in range(m * m)])
+    W = A / N
+    if m > 1:
+        v = N * (np.mean(np.abs(W) ** 2, axis=0) - np.abs(W.mean(axis=0)) ** 2)
+    else:
+        v = N * np.abs(W[0]) ** 2
+    shell = np.rint(np.hypot(nvec[:, 0], nvec[:, 1])).astype(int)
+    qn = np.hypot(nvec[:, 0], nvec[:, 1]) * dq
+    if m == 1:
+        v = np.where(shell == 0, np.nan, v)
+    out_q, out_v, out_d = [], [], []
+    for s in sorted(set(shell)):
+        sel = shell == s
+        out_q.append(qn[sel].mean())
+        out_v.append(v[sel].mean())
+        out_d.append((sel, np.abs(W[:, sel]), wsum / N))
+    return np.array(out_q), np.array(out_v), out_d
+
+
+def check_s4(f, unwrapped, L, origin_frame, pair_frame, sched_lag):
+    """S4(q,t) of every grid at every computed lag against the exact direct
+    sum from the recorded frames, within the error the NUFFT grid may make
+    (the kernel's stated bound, a worst case); chi4 at t_s4 against the
+    brute-force chi4; the OZ fit at t_s4 a least-squares minimum."""
+    g = f["observables/s4"]
+    a = float(g.attrs["cutoff_a"])
+    q_max = float(g.attrs["q_max"])
+    n = unwrapped.shape[1]
+    sides, n_shells = g["subbox_per_side"][()], g["n_shells"][()]
+    h, q_rec = g["grid_spacing"][()], g["q"][()]
+    lags = g["lag_time"][()]
+    s4_lag = g["s4_lag"]["value"][-1].reshape(len(lags), -1)
+    hw = 4  # the Gaussian half-width: the scene's [s4] half_width, default 4
+    if "s4" in f["parameters"] and "half_width" in f["parameters/s4"].attrs:
+        hw = int(f["parameters/s4"].attrs["half_width"])
+    start = np.concatenate([[0], np.cumsum(n_shells)])
+    worst = 0.0
+    for li, t in enumerate(lags):
+        j = int(np.argmin(np.abs(np.log(sched_lag / t))))
+        for gi, m in enumerate(sides):
+            R = math.pi / (h[gi] * q_max)
+            bound_rel = math.exp(-math.pi * hw * (R - 1) / (R - 0.5))  # S4Grid::error_bound()
+            N = n / (m * m)
+            vals, tols = [], []
+            for k, of in enumerate(origin_frame):
+                x0 = unwrapped[of] % L
+                w = (np.hypot(*(unwrapped[pair_frame[k][j]] - unwrapped[of]).T) < a).astype(float)
+                qb, vb, d = s4_shells_brute(x0, w, L, m, q_max, n)
+                tol = []
+                for sel, absw, wN in d:  # per mode: N [<2|W_r| d_r + d_r^2> + 2|<W>| <d> + <d>^2], d_r = bound sum|w|/N
+                    dr = bound_rel * wN[:, None]
+                    e = N * (np.mean(2 * absw * dr + dr ** 2, axis=0)
+                             + (2 * np.abs(absw.mean(axis=0)) * dr.mean() + dr.mean() ** 2 if m > 1 else 0))
+                    tol.append(e.mean())
+                vals.append(vb)
+                tols.append(tol)
+            bf, tol = np.mean(vals, axis=0), np.mean(tols, axis=0) + 1e-12 * np.nanmax(np.abs(np.mean(vals, axis=0)))
+            rec = s4_lag[li, start[gi]:start[gi + 1]]
+            same_q = np.allclose(q_rec[start[gi]:start[gi + 1]], qb, rtol=1e-12)
+            ok = same_q and np.all((np.abs(rec - bf) <= tol) | (np.isnan(rec) & np.isnan(bf)))
+            if not ok:
+                check(False, f"s4 m={m} t={t:.3g}: S4 {rec} vs direct sum {bf} (tolerance {tol})")
+                return
+            fin = np.isfinite(bf) & (bf > 0)
+            worst = max(worst, np.max(np.abs(rec[fin] - bf[fin]) / bf[fin]))
+    check(True, f"s4: every grid and lag within the grid's error bound of the direct sum (max rel diff {worst:.2g})")
+    # The lag of the fits: nearest the node's tau_alpha, which is the overlap node's for this cutoff.
+    tau = float(g["tau_alpha"]["value"][-1])
+    tau_ov = float(f[f"observables/overlap/a{a:g}/tau_alpha"]["value"][-1])
+    check(abs(tau - tau_ov) <= 1e-9 * tau_ov, f"s4: tau_alpha {tau:.6g} is the overlap node's")
+    t_s4 = float(g["t_s4"]["value"][-1])
+    check(t_s4 == lags[np.argmin(np.abs(np.log(lags / tau)))], f"s4: fits at t = {t_s4:.4g}, the lag nearest tau_alpha")
+    li = int(g["lag_index"]["value"][-1])
+    check(np.array_equal(g["s4"]["value"][-1], s4_lag[li], equal_nan=True), "s4: S4 at t_s4 is its row of s4_lag")
+    # chi4 at t_s4: S4 at q = 0 for sub-boxes (checked above, shell 0), N var(Q) for the whole box.
+    j = int(np.argmin(np.abs(np.log(sched_lag / t_s4))))
+    chi4 = g["chi4"]["value"][-1]
+    for gi, m in enumerate(sides):
+        if m == 1:
+            q = [np.mean(np.hypot(*(unwrapped[pair_frame[k][j]] - unwrapped[of]).T) < a) for k, of in enumerate(origin_frame)]
+            bf = n * np.var(q, ddof=1)
+            check(abs(chi4[gi] - bf) <= 1e-9 * bf, f"s4: whole-box chi4 {chi4[gi]:.5g} = N var(Q) over origins")
+        else:
+            check(chi4[gi] == s4_lag[li, start[gi]], f"s4 m={m}: chi4 at t_s4 is S4 at q = 0")
+    # OZ fit of the whole box: a least-squares minimum of the relative residuals over its range.
+    gi = len(sides) - 1
+    q, s4 = q_rec[start[gi]:start[gi + 1]], s4_lag[li, start[gi]:start[gi + 1]]
+    chi0, xi, qf = (float(g[k]["value"][-1][gi]) for k in ("oz_chi0", "oz_xi", "oz_q_fit_max"))
+    if math.isfinite(xi):
+        sel = (q > 0) & (q <= qf * (1 + 1e-12)) & np.isfinite(s4)
+        def sse(c, x):
+            return np.sum(((s4[sel] - c / (1 + (q[sel] * x) ** 2)) / s4[sel]) ** 2)
+        best = sse(chi0, xi)
+        nudged = min(sse(chi0 * f1, xi * f2) for f1 in (0.999, 1, 1.001) for f2 in (0.999, 1, 1.001) if (f1, f2) != (1, 1))
+        check(best <= nudged * (1 + 1e-9), f"s4: OZ fit xi={xi:.4g} chi0={chi0:.4g} over q <= {qf:.3g} is a least-squares minimum")
+        check(float(g["xi"]["value"][-1]) == xi, "s4: the xi summary is the whole box's")
+    else:
+        check(False, "s4: no OZ fit of the whole box")
+
+
 def pair_counts(x, species, L, nb, dr):
     """Pairs i < j per species pair (11, 12, 22) and bin [k dr, (k+1) dr), k < nb, minimum image."""
     d = x[None, :, :] - x[:, None, :]
@@ -399,6 +516,8 @@ def main(path, scene_path):
     text = text.decode() if isinstance(text, bytes) else str(text)
     check(text == open(scene_path).read(), "parameters/scene_toml is the scene file")
     check(int(f.attrs.get("complete", 0)) == 1, "file marked complete")
+    for obs in tomllib.loads(text).get("observables", {}).get("compute", []):
+        check(f"observables/{obs}" in f, f"observables/{obs} recorded (the scene asks for it)")
 
     box = f["particles/all/box"]
     check(int(box.attrs["dimension"]) == 2, "box is 2D")
@@ -455,6 +574,8 @@ def main(path, scene_path):
         check_msd(f, unwrapped, origin_frame, pair_frame, lag, scene)
     if "observables/displacement" in f:
         check_displacement(f, unwrapped, origin_frame, pair_frame, lag, scene)
+    if "observables/s4" in f:
+        check_s4(f, unwrapped, L, origin_frame, pair_frame, lag)
     if "observables/clusters" in f:
         nodes = f["observables/nodes/clusters"]
         check(int(nodes["frames_lost"]["value"][-1]) == 0, "clusters node lost no frame")

@@ -1,5 +1,5 @@
 #!/usr/bin/python3
-"""Replays must reproduce the live results (Q(t), chi4, MSD, P(dx, t), clusters) bit for bit (if the live run lost
+"""Replays must reproduce the live results (Q(t), chi4, MSD, P(dx, t), clusters, S4) bit for bit (if the live run lost
 no frame) and must be identical to each other.
 
 Usage: compare_runs.py LIVE.h5 REPLAY1.h5 REPLAY2.h5
@@ -26,6 +26,9 @@ def final_results(path):
         if "observables/displacement" in f:
             for obs in ("p", "p_err", "gauss_d", "gauss_d_err", "tail_x0", "tail_x0_err", "tail_x_min"):
                 out[f"displacement/{obs}"] = np.atleast_1d(f["observables/displacement"][obs]["value"][-1])
+        if "observables/s4" in f:  # FFTW_ESTIMATE plans: the same arithmetic every run
+            for obs in ("s4", "s4_err", "s4_lag", "oz_xi", "oz_chi0", "a2_xi", "chi4", "tau_alpha"):
+                out[f"s4/{obs}"] = np.atleast_1d(f["observables/s4"][obs]["value"][-1])
         for name, g in f.get("observables/clusters", {}).items():
             for obs in ("neighbour_cutoff", "tau_alpha", "lag", "mean_size_slow", "mean_size_fast", "p_slow",
                         "p_fast", "rg_slow", "rg_fast", "slow_d_f", "slow_kappa", "fast_n0", "fast_sigma"):

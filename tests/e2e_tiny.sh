@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The tiny scene end to end over LCM (sim_node, overlap_node, clusters_node, recorder,
+# The tiny scene end to end over LCM (sim_node, overlap_node, clusters_node, s4_node, recorder,
 # each in a private network namespace), recorded with lcm-logger; the HDF5
 # file is checked against brute-force results from its own frames; then the
 # log is replayed twice through file:// and the Q(t) of the replays must
@@ -14,7 +14,7 @@ bash "$root/launch_scripts/run_scene.sh" "$root/scenes/tiny.toml" --out "$tmp/li
   --url 'udpm://239.255.76.67:7681?ttl=0' --record "$tmp/run.lcmlog" --no-build
 /usr/bin/python3 "$root/tests/check_run.py" "$tmp/live/run.h5" "$root/scenes/tiny.toml"
 [[ -s $tmp/live/overlap.png && -s $tmp/live/chi4.png && -s $tmp/live/msd.png && -s $tmp/live/displacement.png &&
-   -s $tmp/live/clusters.png ]] || { echo "FAIL: no plot"; exit 1; }
+   -s $tmp/live/clusters.png && -s $tmp/live/s4.png ]] || { echo "FAIL: no plot"; exit 1; }
 
 bash "$root/launch_scripts/replay.sh" "$tmp/run.lcmlog" --out "$tmp/replay1" --no-build
 bash "$root/launch_scripts/replay.sh" "$tmp/run.lcmlog" --out "$tmp/replay2" --no-build

@@ -91,6 +91,24 @@ TEST(Scene, SyntaxErrorNamesLine) {
   expect_error("[system]\nn_particles = = 3\n", {"test.toml:2", "not valid TOML"});
 }
 
+TEST(Scene, S4TableIsValidated) {
+  const auto s = parse_scene_text("[s4]\nlags = [1.0, 5]\nq_max = 2\nhalf_width = 6\nsubbox_particles = [64]\n", "ok");
+  EXPECT_EQ(s.s4_lags, (std::vector<double>{1.0, 5.0}));
+  EXPECT_DOUBLE_EQ(s.s4_q_max, 2.0);
+  EXPECT_EQ(s.s4_half_width, 6);
+  EXPECT_EQ(s.s4_subbox_particles, (std::vector<int>{64}));
+  EXPECT_TRUE(parse_scene_text("[s4]\nlags = \"all\"\n", "ok").s4_lags.empty());
+  EXPECT_EQ(dynhet::nodes_for({"overlap", "chi4", "s4"}), (std::vector<std::string>{"overlap_node", "s4_node"}));
+  expect_error("[s4]\nlags = \"tau\"\n", {"s4.lags", "\"all\""});
+  expect_error("[s4]\nlags = [1000.0]\n", {"s4.lags", "outside the scheduled lags"});
+  expect_error("[s4]\nlags = [-1]\n", {"s4.lags", "> 0"});
+  expect_error("[s4]\nq_max = 0\n", {"s4.q_max", "> 0"});
+  expect_error("[s4]\ngrid_spacing = 4.0\n", {"s4.grid_spacing", "too coarse", "pi / q_max"});
+  expect_error("[s4]\nhalf_width = 1\n", {"s4.half_width", "2 <= value <= 16"});
+  expect_error("[s4]\nsubbox_particles = [0]\n", {"s4.subbox_particles", ">= 1"});
+  expect_error("[s4]\nxi = 1\n", {"s4.xi", "unknown key", "q_max"});
+}
+
 TEST(Scene, ClustersTableIsValidated) {
   const auto d = parse_scene_text("", "test.toml");
   EXPECT_LT(d.clusters.lag, 0); // tau_alpha

@@ -146,7 +146,8 @@ S4Grid::S4Grid(const SubboxGrid& grid, double q_max, S4GridParams p) : impl_(std
   s.out = fftw_alloc_complex(nb * s.half2());
   const int dims[2] = {s.m_points, s.m_points};
   s.plan = fftw_plan_many_dft_r2c(2, dims, nb, s.in, nullptr, 1, static_cast<int>(s.points2()), s.out,
-                                  nullptr, 1, static_cast<int>(s.half2()), FFTW_MEASURE);
+                                  nullptr, 1, static_cast<int>(s.half2()),
+                                  p.measure_plan ? FFTW_MEASURE : FFTW_ESTIMATE);
   if (!s.plan) throw std::runtime_error("S4Grid: FFTW could not plan the transform");
 }
 

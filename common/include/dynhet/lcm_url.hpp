@@ -32,6 +32,7 @@ inline constexpr const char* kChanNodeStatus = "DYNHET_NODE_STATUS";
 inline constexpr const char* kChanOverlap = "DYNHET_OVERLAP";
 inline constexpr const char* kChanChi4 = "DYNHET_CHI4";
 inline constexpr const char* kChanMsd = "DYNHET_MSD";
+inline constexpr const char* kChanS4 = "DYNHET_S4";
 inline constexpr const char* kChanClusters = "DYNHET_CLUSTERS";
 inline constexpr const char* kChanDisplacement = "DYNHET_DISPLACEMENT";
 

@@ -66,6 +66,13 @@ struct Scene {
   // [chi4]: target N = <N_r> of each sub-box grid; >= n_particles is the whole box
   std::vector<int> chi4_subbox_particles{25, 100, 400, 1600, 6400, 1 << 30};
 
+  // [s4]: the four-point structure factor S4(q,t) (s4_node)
+  std::vector<double> s4_lags;          // lag times S4 is computed at (nearest scheduled lag); empty: every lag
+  double s4_q_max = 1.0;                // largest |q| (units 1/r1)
+  double s4_grid_spacing = 0.0;         // NUFFT grid spacing h; 0: pi / (2 q_max) (oversampling 2)
+  int s4_half_width = 4;                // Gaussian half-width in grid points
+  std::vector<int> s4_subbox_particles; // sub-box sizes (the whole box is always added); empty: chi4's
+
   // [clusters]: clusters of slow and fast particles (paper sec. 3.3)
   struct Clusters {
     // The lag t of the clusters: < 0 ("tau_alpha") the scheduled lag nearest
@@ -124,7 +131,8 @@ const std::vector<std::string>& known_observables();
 // The node that computes an observable: Q(t), chi4(t), the MSD and P(dx, t)
 // come from the same pass over the displacements of the same (origin, lag)
 // pairs, so one node, "overlap", serves all four (one pass, one copy of the
-// frames).
+// frames). S4(q,t) has its own node, "s4" (an FFT per pair and grid: its own
+// core), and so have the clusters.
 std::string node_of(const std::string& observable);
 // The executables a list of observables needs ("overlap_node", ...), each once.
 std::vector<std::string> nodes_for(const std::vector<std::string>& observables);

@@ -54,6 +54,11 @@ S4Modes s4_modes_direct(const double* pos0, const double* weight, long n, const 
 struct S4GridParams {
   double spacing = 0; // grid spacing h (0: pi / (2 q_max), oversampling R = 2); rounded down to fit ell
   int half_width = 4; // the Gaussian covers 2 half_width points per dimension
+  // FFTW_MEASURE (times candidate plans: best speed, ~0.1-1 s to plan, the
+  // plan and so the last bits may differ between runs) or FFTW_ESTIMATE
+  // (instant, the same plan every time: what a node that must not steal CPU
+  // while frames arrive, and whose replays must match bit for bit, wants).
+  bool measure_plan = true;
 };
 
 class S4Grid {

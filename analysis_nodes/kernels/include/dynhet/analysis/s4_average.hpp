@@ -1,0 +1,63 @@
+// S4(q,t) over time origins (the overline of paper eq. 15) for one sub-box
+// grid, with errors over origins, and the OZ fits (eqs. 18, 20) at a lag
+// with jackknife errors over origins. Each origin's S4(q) is one
+// measurement; origins spaced by more than tau_alpha are independent, so
+// the errors are honest then and lower bounds otherwise.
+#pragma once
+
+#include <vector>
+
+#include "dynhet/analysis/fits.hpp"
+#include "dynhet/analysis/s4.hpp"
+
+namespace dynhet::analysis {
+
+class S4Accumulator {
+public:
+  // The shells (q and vector counts) are those s4_shells gives for the grid.
+  S4Accumulator(int n_origins, int n_lags, std::vector<double> q, std::vector<int> n_vectors);
+
+  // S4(q) of origin k at lag j (s4_shells of that pair).
+  void add(int k, int j, const S4Shells& s);
+
+  struct Mean {
+    std::vector<double> s4, s4_err; // per shell: mean over origins, standard error
+    int n_origins;
+  };
+  // Over the origins measured at lag j, leaving out origin `skip` (-1: none).
+  Mean mean(int j, int skip = -1) const;
+  bool has(int k, int j) const;
+
+  const std::vector<double>& q() const { return q_; }
+  const std::vector<int>& n_vectors() const { return n_vectors_; }
+  int n_origins() const { return n_origins_; }
+
+private:
+  const double* at(int k, int j) const { return s4_.data() + (static_cast<size_t>(k) * n_lags_ + j) * q_.size(); }
+  int n_origins_, n_lags_;
+  std::vector<double> q_;
+  std::vector<int> n_vectors_;
+  std::vector<double> s4_;    // [(k * n_lags + j) * n_shells + shell]
+  std::vector<char> filled_;  // per (k, j)
+};
+
+// The OZ form (eq. 18) and the form with A^2 (q xi)^4 (eq. 20) fitted to the
+// origin mean of S4 at lag j over q xi <= qxi_max (unweighted: relative
+// residuals, since standard errors from a few origins are themselves
+// noisy); the parameter errors are the jackknife over origins (each fit
+// repeated without one origin), NaN with fewer than 3 origins.
+struct S4FitAtLag {
+  OzFit oz, oz_a2; // chi0_err, xi_err, a_err replaced by the jackknife errors
+  int n_origins;
+};
+S4FitAtLag fit_s4_at_lag(const S4Accumulator& acc, int j, double qxi_max = 1.0);
+
+// chi4 of the whole box at one lag, where the sub-box average of eq. (14)
+// has one term: N_tot times the variance over origins of Q(t;t0) (n/(n-1)
+// corrected), with its jackknife error. NaN below 2 (error 3) origins.
+struct ValueErr {
+  double value, err;
+};
+ValueErr whole_box_chi4(const std::vector<double>& q_per_origin, double n_total);
+
+} // namespace dynhet::analysis

@@ -1,0 +1,88 @@
+#include "dynhet/analysis/s4_average.hpp"
+
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+namespace dynhet::analysis {
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+// Jackknife standard error from the n leave-one-out estimates (fits.hpp's
+// jackknife_error), NaN below 3 estimates: S4's errors need at least three
+// origins.
+double jackknife_error_3(const std::vector<double>& x) {
+  return x.size() < 3 ? kNaN : jackknife_error(x);
+}
+
+} // namespace
+
+S4Accumulator::S4Accumulator(int n_origins, int n_lags, std::vector<double> q, std::vector<int> n_vectors)
+    : n_origins_(n_origins), n_lags_(n_lags), q_(std::move(q)), n_vectors_(std::move(n_vectors)),
+      s4_(static_cast<size_t>(n_origins) * n_lags * q_.size(), kNaN),
+      filled_(static_cast<size_t>(n_origins) * n_lags, 0) {}
+
+void S4Accumulator::add(int k, int j, const S4Shells& s) {
+  if (s.s4.size() != q_.size()) throw std::invalid_argument("S4Accumulator: shells of another grid");
+  std::copy(s.s4.begin(), s.s4.end(), s4_.begin() + (static_cast<size_t>(k) * n_lags_ + j) * q_.size());
+  filled_[static_cast<size_t>(k) * n_lags_ + j] = 1;
+}
+
+bool S4Accumulator::has(int k, int j) const { return filled_[static_cast<size_t>(k) * n_lags_ + j] != 0; }
+
+S4Accumulator::Mean S4Accumulator::mean(int j, int skip) const {
+  const size_t ns = q_.size();
+  std::vector<double> sum(ns, 0.0), sum2(ns, 0.0);
+  int n = 0;
+  for (int k = 0; k < n_origins_; ++k) {
+    if (k == skip || !has(k, j)) continue;
+    const double* v = at(k, j);
+    for (size_t s = 0; s < ns; ++s) sum[s] += v[s], sum2[s] += v[s] * v[s];
+    ++n;
+  }
+  Mean m{std::vector<double>(ns, kNaN), std::vector<double>(ns, kNaN), n};
+  for (size_t s = 0; s < ns && n > 0; ++s) {
+    m.s4[s] = sum[s] / n; // the overline of eq. (15)
+    if (n > 1) m.s4_err[s] = std::sqrt(std::max(0.0, (sum2[s] / n - m.s4[s] * m.s4[s]) / (n - 1)));
+  }
+  return m;
+}
+
+S4FitAtLag fit_s4_at_lag(const S4Accumulator& acc, int j, double qxi_max) {
+  const S4Accumulator::Mean all = acc.mean(j);
+  S4FitAtLag out{fit_oz(acc.q(), all.s4, {}, qxi_max), fit_oz_a2(acc.q(), all.s4, {}, qxi_max), all.n_origins};
+  // Leave-one-out fits: chi0, xi (both forms) and A.
+  std::vector<double> chi0, xi, chi0_a2, xi_a2, a;
+  for (int k = 0; k < acc.n_origins(); ++k) {
+    if (!acc.has(k, j)) continue;
+    const std::vector<double> s4 = acc.mean(j, k).s4;
+    const OzFit f = fit_oz(acc.q(), s4, {}, qxi_max), g = fit_oz_a2(acc.q(), s4, {}, qxi_max);
+    chi0.push_back(f.chi0), xi.push_back(f.xi);
+    chi0_a2.push_back(g.chi0), xi_a2.push_back(g.xi), a.push_back(g.a);
+  }
+  out.oz.chi0_err = jackknife_error_3(chi0), out.oz.xi_err = jackknife_error_3(xi);
+  out.oz_a2.chi0_err = jackknife_error_3(chi0_a2), out.oz_a2.xi_err = jackknife_error_3(xi_a2);
+  out.oz_a2.a_err = jackknife_error_3(a);
+  return out;
+}
+
+ValueErr whole_box_chi4(const std::vector<double>& q_per_origin, double n_total) {
+  std::vector<double> q;
+  for (double v : q_per_origin)
+    if (!std::isnan(v)) q.push_back(v);
+  // N_tot times the sample variance of the values other than `skip`.
+  auto chi4 = [&](size_t skip) {
+    double sum = 0, sum2 = 0;
+    size_t n = 0;
+    for (size_t k = 0; k < q.size(); ++k)
+      if (k != skip) sum += q[k], sum2 += q[k] * q[k], ++n;
+    return n > 1 ? n_total * (sum2 - sum * sum / n) / (n - 1) : kNaN;
+  };
+  std::vector<double> loo;
+  for (size_t k = 0; k < q.size(); ++k) loo.push_back(chi4(k));
+  return {chi4(q.size()), jackknife_error_3(loo)};
+}
+
+} // namespace dynhet::analysis

@@ -1,0 +1,200 @@
+// s4_node: the four-point structure factor S4(q,t) (paper eqs. 15-16) and
+// the correlation length xi, live from the frames on DYNHET_FRAME, published
+// on DYNHET_S4 at most once a second and at the end.
+//
+// For each (origin, lag) pair it uses, the node weighs every particle by
+// w_i = theta(a - |r_i(t0+t) - r_i(t0)|) (the first listed cutoff a) and
+// computes W_r(q) on every sub-box grid (the [s4] sizes, by default chi4's,
+// and always the whole box) by the Gaussian NUFFT on FFTW grids
+// (kernels/s4.cpp), then S4 per |q| shell. Lags: every scheduled lag by
+// default (the grid costs a few ms per pair at N = 10^4, so S4(q,t) and
+// xi(t) come at every t), or the scheduled lags nearest the times in
+// s4.lags (to bound the cost at N = 10^5, ~70 ms per pair for six grids).
+// The fits with jackknife errors and the chi4 comparison are made at t_s4,
+// the computed lag nearest the node's own running tau_alpha (Q(t) from the
+// same weights, W(q = 0) of the whole box; the paper evaluates S4 at
+// tau_alpha); before Q(t) crosses 1/e, at the last lag with data.
+//
+// Memory: the origin frames some later used lag still needs, 16 N bytes
+// each: at most (largest used lag) / origin_spacing + 1 of them; the S4
+// shells of every (origin, lag, grid), a few hundred doubles per pair; and
+// the FFT grids, 16 (L/h)^2 bytes per grid (h the grid spacing).
+//
+// Usage: s4_node [--lcm-url URL] [--publish-url URL] (as overlap_node)
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <memory>
+#include <numeric>
+#include <string>
+
+#include "dynhet/analysis/displacement.hpp"
+#include "dynhet/analysis/overlap.hpp"
+#include "dynhet/analysis/s4.hpp"
+#include "dynhet/analysis/s4_average.hpp"
+#include "dynhet/analysis/timescales.hpp"
+#include "dynhet/s4_t.hpp"
+#include "dynhet/scene.hpp"
+#include "frame_node.hpp"
+
+namespace {
+
+namespace an = dynhet::analysis;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+constexpr double kQxiMax = 1.0; // fits over q xi <= 1, as the paper's small-q OZ regime
+
+// The sub-box grids of S4: the listed sizes, nested as chi4's (so that S4
+// at q = 0 is chi4 of the same grid), each side once, fine to coarse, and
+// the whole box.
+std::vector<an::SubboxGrid> s4_grids(long n, double box, const std::vector<int>& sizes) {
+  std::vector<an::SubboxGrid> g = an::nested_subbox_grids(n, box, sizes);
+  g.push_back(an::SubboxGrid{1, box, double(n)});
+  std::sort(g.begin(), g.end(), [](const auto& a, const auto& b) { return a.per_side > b.per_side; });
+  g.erase(std::unique(g.begin(), g.end(), [](const auto& a, const auto& b) { return a.per_side == b.per_side; }),
+          g.end());
+  return g;
+}
+
+class S4Node : public dynhet::FrameNode {
+public:
+  S4Node(lcm::LCM& out, int64_t run_filter) : FrameNode(out, run_filter, "s4") {}
+
+private:
+  void start(const dynhet::run_info_t& m) override {
+    const dynhet::Scene scene = dynhet::parse_scene_text(m.scene_toml, "the run's scene");
+    cutoff_ = m.cutoff_a.at(0);
+    q_max_ = scene.s4_q_max;
+    const std::vector<int> sizes = scene.s4_subbox_particles.empty()
+                                       ? std::vector<int>(m.chi4_subbox_particles.begin(), m.chi4_subbox_particles.end())
+                                       : scene.s4_subbox_particles;
+    // The lags used: all, or the scheduled ones nearest the listed times.
+    slot_.assign(m.n_lags, -1);
+    for (int j = 0; j < m.n_lags; ++j)
+      if (scene.s4_lags.empty()) slot_[j] = 0;
+    for (double t : scene.s4_lags) slot_[an::nearest_lag(m.lag_time, t)] = 0;
+    for (int j = 0; j < m.n_lags; ++j)
+      if (slot_[j] == 0) slot_[j] = static_cast<int>(lags_.size()), lags_.push_back(m.lag_time[j]);
+    q_acc_ = std::make_unique<an::OverlapAccumulator>(m.n_origins, m.lag_time);
+    const std::vector<double> none;
+    for (const an::SubboxGrid& g : s4_grids(m.n_particles, m.box_length, sizes)) {
+      grids_.push_back(g);
+      fft_.push_back(std::make_unique<an::S4Grid>(g, q_max_, an::S4GridParams{scene.s4_grid_spacing, scene.s4_half_width, false}));
+      // The shells of this grid (from zero weights: only q and the vector counts matter).
+      const an::S4Shells shells = an::s4_shells(fft_.back()->modes(none.data(), none.data(), 0));
+      acc_.emplace_back(m.n_origins, static_cast<int>(lags_.size()), shells.q, shells.n_vectors);
+    }
+    std::fprintf(stderr, "s4_node: a=%g, q <= %g, %zu of %d lags, grids (m: points):", cutoff_, q_max_,
+                 lags_.size(), m.n_lags);
+    for (size_t g = 0; g < grids_.size(); ++g) std::fprintf(stderr, " %d: %d", grids_[g].per_side, fft_[g]->points());
+    std::fprintf(stderr, "\n");
+  }
+
+  bool uses_lag(int j) const override { return slot_[j] >= 0; }
+
+  void on_pair(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) override {
+    const long n = info().n_particles;
+    d2_.resize(n);
+    for (long i = 0; i < n; ++i)
+      d2_[i] = std::pow(f.position[2 * i] - pos0[2 * i], 2) + std::pow(f.position[2 * i + 1] - pos0[2 * i + 1], 2);
+    an::overlap_weights(d2_.data(), n, cutoff_, w_); // w_i = theta(a - |dr_i|)
+    const double q = std::accumulate(w_.begin(), w_.end(), 0.0) / n; // Q(t;t0) = W(0) of the whole box
+    q_acc_->add(k, j, &q, 1);
+    for (size_t g = 0; g < grids_.size(); ++g)
+      acc_[g].add(k, slot_[j], an::s4_shells(fft_[g]->modes(pos0.data(), w_.data(), n)));
+  }
+
+  // The computed lag nearest tau_alpha (in ln t), else the last one with data.
+  int fit_slot(double tau_alpha) const {
+    if (std::isfinite(tau_alpha)) return an::nearest_lag(lags_, tau_alpha);
+    for (int l = static_cast<int>(lags_.size()) - 1; l >= 0; --l)
+      if (acc_[0].mean(l).n_origins > 0) return l;
+    return 0;
+  }
+
+  void publish_results(bool final) override {
+    // Fits with jackknife errors are some ms: at most once a second.
+    if (!final && Clock::now() - last_publish_ < std::chrono::seconds(1)) return;
+    last_publish_ = Clock::now();
+    dynhet::s4_t m{};
+    stamp(m, final);
+    m.cutoff_a = cutoff_, m.q_max = q_max_, m.qxi_max = kQxiMax;
+    m.tau_alpha = q_acc_->result().tau_alpha;
+    const int l = fit_slot(m.tau_alpha);
+    m.lag_index = l, m.t_s4 = lags_[l];
+    m.lag_time = lags_;
+    for (size_t g = 0; g < grids_.size(); ++g) add_grid(m, g, l);
+    m.n_origins = acc_.back().mean(l).n_origins;
+    const size_t whole = grids_.size() - 1;
+    m.xi = m.oz_xi[whole], m.xi_err = m.oz_xi_err[whole], m.chi0 = m.oz_chi0[whole], m.chi0_err = m.oz_chi0_err[whole];
+    m.chi4_box = m.chi4[whole], m.chi4_box_err = m.chi4_err[whole];
+    // S4(q) and the OZ fit at every computed lag.
+    for (size_t t = 0; t < lags_.size(); ++t)
+      for (size_t g = 0; g < grids_.size(); ++g) {
+        const std::vector<double> s4 = acc_[g].mean(static_cast<int>(t)).s4;
+        m.s4_lag.insert(m.s4_lag.end(), s4.begin(), s4.end());
+        const an::OzFit f = an::fit_oz(acc_[g].q(), s4, {}, kQxiMax);
+        m.xi_lag.push_back(f.xi), m.chi0_lag.push_back(f.chi0);
+      }
+    m.n_grids = static_cast<int32_t>(grids_.size());
+    m.n_values = static_cast<int32_t>(m.q.size());
+    m.n_lags = static_cast<int32_t>(lags_.size());
+    m.n_lag_values = static_cast<int32_t>(m.s4_lag.size());
+    m.n_lag_fits = static_cast<int32_t>(m.xi_lag.size());
+    if (out().publish(dynhet::kChanS4, &m) != 0)
+      std::fprintf(stderr, "s4_node: could not publish S4 (%d bytes)\n", m.getEncodedSize());
+    if (final)
+      std::fprintf(stderr, "s4_node: t_s4=%.4g (tau_alpha %.4g), whole box xi=%.4g +- %.2g chi0=%.4g +- %.2g, chi4=%.4g +- %.2g (%d origins)\n",
+                   m.t_s4, m.tau_alpha, m.xi, m.xi_err, m.chi0, m.chi0_err, m.chi4_box, m.chi4_box_err, m.n_origins);
+  }
+
+  // Grid g's shells, fits and chi4 at computed lag l.
+  void add_grid(dynhet::s4_t& m, size_t g, int l) const {
+    const an::S4Accumulator& a = acc_[g];
+    const an::S4Accumulator::Mean mean = a.mean(l);
+    m.subbox_particles.push_back(grids_[g].mean_particles);
+    m.subbox_per_side.push_back(grids_[g].per_side);
+    m.grid_spacing.push_back(fft_[g]->spacing());
+    m.grid_points.push_back(fft_[g]->points());
+    m.n_shells.push_back(static_cast<int32_t>(a.q().size()));
+    m.q.insert(m.q.end(), a.q().begin(), a.q().end());
+    m.shell_vectors.insert(m.shell_vectors.end(), a.n_vectors().begin(), a.n_vectors().end());
+    m.s4.insert(m.s4.end(), mean.s4.begin(), mean.s4.end());
+    m.s4_err.insert(m.s4_err.end(), mean.s4_err.begin(), mean.s4_err.end());
+    const an::S4FitAtLag f = an::fit_s4_at_lag(a, l, kQxiMax);
+    m.oz_chi0.push_back(f.oz.chi0), m.oz_chi0_err.push_back(f.oz.chi0_err);
+    m.oz_xi.push_back(f.oz.xi), m.oz_xi_err.push_back(f.oz.xi_err);
+    m.oz_q_fit_max.push_back(f.oz.q_fit_max), m.oz_n_fit.push_back(f.oz.n);
+    m.a2_chi0.push_back(f.oz_a2.chi0), m.a2_chi0_err.push_back(f.oz_a2.chi0_err);
+    m.a2_xi.push_back(f.oz_a2.xi), m.a2_xi_err.push_back(f.oz_a2.xi_err);
+    m.a2_a.push_back(f.oz_a2.a), m.a2_a_err.push_back(f.oz_a2.a_err);
+    m.a2_q_fit_max.push_back(f.oz_a2.q_fit_max), m.a2_n_fit.push_back(f.oz_a2.n);
+    // chi4 at the same lag: S4 at q = 0 is eq. (14) for sub-boxes (W_r(0) = Q_r);
+    // the whole box has no q = 0 shell: N_tot var(Q) over origins.
+    if (grids_[g].per_side > 1) {
+      m.chi4.push_back(mean.s4[0]), m.chi4_err.push_back(mean.s4_err[0]);
+    } else {
+      const int j = static_cast<int>(std::find(slot_.begin(), slot_.end(), l) - slot_.begin());
+      std::vector<double> q(info().n_origins);
+      for (int k = 0; k < info().n_origins; ++k) q[k] = q_acc_->q(k, j);
+      const an::ValueErr c = an::whole_box_chi4(q, info().n_particles);
+      m.chi4.push_back(c.value), m.chi4_err.push_back(c.err);
+    }
+  }
+
+  double cutoff_ = 0, q_max_ = 1;
+  std::vector<int> slot_;     // per scheduled lag: index among the computed lags, or -1
+  std::vector<double> lags_;  // the computed lags
+  std::vector<an::SubboxGrid> grids_;
+  std::vector<std::unique_ptr<an::S4Grid>> fft_;
+  std::vector<an::S4Accumulator> acc_; // per grid
+  std::unique_ptr<an::OverlapAccumulator> q_acc_; // Q(t;t0) of the whole box, for tau_alpha and chi4
+  std::vector<double> d2_, w_;
+  Clock::time_point last_publish_{};
+};
+
+} // namespace
+
+int main(int argc, char** argv) {
+  return dynhet::node_main<S4Node>("s4_node", "dynhet s4_node: S4(q,t), xi and chi0 from frames on LCM", argc, argv);
+}
