@@ -33,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "dynhet/model.hpp"
 #include "dynhet/analysis/clusters.hpp"
 #include "dynhet/analysis/fits.hpp"
 #include "dynhet/analysis/overlap.hpp"
@@ -107,7 +108,7 @@ private:
       throw std::runtime_error(std::string("cannot read the scene's [clusters] table: ") + e.what());
     }
     n_ = m.n_particles, box_ = m.box_length;
-    species_.assign(m.species.begin(), m.species.end());
+    species_ = dynhet::species_by_rule(m.n_particles, m.n_small);
     gr_r_max_ = std::min(spec_.gr_r_max, box_ / 2);
     if (spec_.neighbour_cutoffs.size() == 3)
       cut_ = an::NeighbourCutoffs{{spec_.neighbour_cutoffs[0], spec_.neighbour_cutoffs[1], spec_.neighbour_cutoffs[2]}};

@@ -19,6 +19,7 @@
 #include <memory>
 #include <string>
 
+#include "dynhet/model.hpp"
 #include "dynhet/analysis/chi4.hpp"
 #include "dynhet/analysis/displacement.hpp"
 #include "dynhet/analysis/fits.hpp"
@@ -108,7 +109,7 @@ private:
     spec_.grids = an::nested_subbox_grids(m.n_particles, m.box_length, m.chi4_subbox_particles);
     spec_.cutoffs = m.cutoff_a;
     std::sort(spec_.cutoffs.begin(), spec_.cutoffs.end()); // the pass wants them ascending
-    species_.assign(m.species.begin(), m.species.end());
+    species_ = dynhet::species_by_rule(m.n_particles, m.n_small);
     for (const auto& g : spec_.grids)
       for (size_t c = 0; c < spec_.cutoffs.size(); ++c) chi4_acc_.emplace_back(m.n_origins, m.lag_time, g);
   }

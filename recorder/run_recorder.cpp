@@ -2,6 +2,8 @@
 
 #include <cstdio>
 
+#include "dynhet/model.hpp"
+
 namespace dynhet {
 
 namespace {
@@ -51,7 +53,10 @@ bool RunRecorder::on_run(const run_info_t &m) {
 
 void RunRecorder::write_run_info(const run_info_t &m) {
   guarded("parameters", [&] { writer_->write_parameters(m.scene_toml); });
-  guarded("particles", [&] { writer_->set_particles("all", m.box_length, m.species); });
+  guarded("particles", [&] {
+    const auto sp = dynhet::species_by_rule(m.n_particles, m.n_small);
+    writer_->set_particles("all", m.box_length, std::vector<int32_t>(sp.begin(), sp.end()));
+  });
   guarded("run info", [&] {
     const std::string p = "parameters/run_info";
     writer_->set_attribute(p, "run_id", m.run_id);

@@ -60,7 +60,7 @@ dynhet::run_info_t make_run_info(const dynhet::Scene& sc, const dynhet::engine::
   m.packing_fraction = sc.packing_fraction;
   m.restitution = sc.restitution;
   for (int k = 0; k < 2; ++k) m.radius[k] = e.radius(k), m.mass[k] = e.mass(k);
-  m.species.assign(e.species().begin(), e.species().end());
+  m.n_small = static_cast<int32_t>(dynhet::small_count(e.size()));
   m.frame_time = s.frame_time;
   m.n_frames = static_cast<int32_t>(m.frame_time.size());
   m.origin_frame = s.origin_frame;

@@ -31,7 +31,7 @@ dynhet::run_info_t run_info() {
   m.restitution = 0.9;
   m.radius[0] = 1, m.radius[1] = 1.43;
   m.mass[0] = 1, m.mass[1] = 1.43 * 1.43;
-  m.species = {0, 1, 0, 1};
+  m.n_small = 2;
   m.frame_time = {100, 100.5, 101};
   m.n_frames = 3;
   m.origin_frame = {0};
@@ -186,7 +186,7 @@ TEST(RunRecorder, CompleteRunIsWrittenAndMarkedComplete) {
   EXPECT_EQ(h5read::shape(f, "/particles/all/position/value"), (Shape{3, 4, 2}));
   const auto pos = h5read::read<double>(f, "/particles/all/position/value");
   EXPECT_EQ(pos[8 + 5], 3.25); // frame 1, particle 2, y: 1 + 2 + 0.25
-  EXPECT_EQ(h5read::read<int32_t>(f, "/particles/all/species"), (std::vector<int32_t>{0, 1, 0, 1}));
+  EXPECT_EQ(h5read::read<int32_t>(f, "/particles/all/species"), (std::vector<int32_t>{0, 0, 1, 1}));
   EXPECT_EQ(h5read::read_string(f, "/parameters/scene_toml"), run_info().scene_toml);
   std::remove(path.c_str());
 }

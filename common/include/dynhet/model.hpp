@@ -1,7 +1,10 @@
 // The paper's model in reduced units: r1 = 1, m1 = 1, m ~ r^2, 50:50.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <vector>
 
 namespace dynhet {
 
@@ -28,6 +31,13 @@ inline Model make_model(long n, double phi, double radius_ratio) {
 
 // Species of particle i: first half small (0), second half large (1).
 inline int species_of(long i, long n) { return i < n - n / 2 ? 0 : 1; }
+inline long small_count(long n) { return n - n / 2; }
+// Species by particle id for particles 0 .. n_small-1 small, the rest large.
+inline std::vector<std::uint8_t> species_by_rule(long n, long n_small) {
+  std::vector<std::uint8_t> s(static_cast<size_t>(n), 1);
+  std::fill(s.begin(), s.begin() + std::min(n, n_small), 0);
+  return s;
+}
 
 // Henderson's contact value for hard disks, g(sigma) = (1 - 7phi/16)/(1-phi)^2.
 inline double henderson_contact_value(double phi) {
