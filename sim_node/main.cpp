@@ -236,6 +236,21 @@ int main(int argc, char** argv) {
                  static_cast<long long>(run_id), eng.size(), scene.packing_fraction, scene.restitution,
                  eng.box_length(), p.driving && scene.restitution < 1 ? "on" : "off", p.kick_rate);
 
+    // The run info first, and again every 2 s, also while compressing (which
+    // takes minutes at N = 10^5 and more): nodes and recorder then know the
+    // run from the start and watch the sim's status instead of waiting blind.
+    const dynhet::FrameSchedule sched = dynhet::make_schedule(scene.schedule, scene.equilibration_time);
+    const double t_end = scene.equilibration_time + scene.production_time;
+    dynhet::run_info_t info = make_run_info(scene, eng, sched, run_id);
+    auto last_info = Clock::now();
+    auto publish_info = [&] {
+      info.utime = utime_now();
+      lcm.publish(dynhet::kChanRun, &info);
+      last_info = Clock::now();
+    };
+    publish_info();
+    rep.msg().frames_total = info.n_frames;
+
     const auto t_wall = Clock::now();
     if (!resume_path.empty()) {
       eng.restore(resumed.state);
@@ -247,23 +262,14 @@ int main(int argc, char** argv) {
       rep.msg().phase_end_time = 0;
       eng.prepare([&](double) {
         rep.update(eng, -1);
+        if (seconds_since(last_info) > 2.0) publish_info();
         if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
       });
       std::fprintf(stderr, "\nsim_node: compressed to phi=%.4f in %.1f s, max overlap %.2g\n",
                    eng.packing_fraction(), seconds_since(t_wall), std::max(0.0, eng.max_overlap()));
     }
 
-    const dynhet::FrameSchedule sched = dynhet::make_schedule(scene.schedule, scene.equilibration_time);
-    const double t_end = scene.equilibration_time + scene.production_time;
-    dynhet::run_info_t info = make_run_info(scene, eng, sched, run_id);
-    rep.msg().frames_total = info.n_frames;
     rep.msg().frames_published = resumed.next_frame;
-    auto last_info = Clock::now();
-    auto publish_info = [&] {
-      info.utime = utime_now();
-      lcm.publish(dynhet::kChanRun, &info);
-      last_info = Clock::now();
-    };
     publish_info();
 
     // Synchronised times k * interval (k counted from t = 0), the same in a
