@@ -123,8 +123,8 @@ private:
     msd_small_[kj] = pass_.msd_small;
     if (want_msd_) {
       // The instantaneous fastest and slowest subsets of this pair.
-      const an::ExtremeMsd all = an::msd_extremes(d2_.data(), species_.data(), n, msd_spec_.fraction_all, -1, select_);
-      const an::ExtremeMsd small = an::msd_extremes(d2_.data(), species_.data(), n, msd_spec_.fraction_small, 0, select_);
+      const auto [all, small] = an::msd_extremes_all_small(d2_.data(), species_.data(), n, msd_spec_.fraction_all,
+                                                           msd_spec_.fraction_small, select_);
       msd_extreme_[0][kj] = all.fast, msd_extreme_[1][kj] = all.slow;
       msd_extreme_[2][kj] = small.fast, msd_extreme_[3][kj] = small.slow;
     }

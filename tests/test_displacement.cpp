@@ -193,3 +193,102 @@ TEST(Displacement, ExtremeSubsetsWithAReusedBufferMatchASortedList) {
       EXPECT_NEAR(e.fast, std::accumulate(v.end() - k, v.end(), 0.0) / k, 1e-12 * v.back());
     }
 }
+
+namespace {
+
+// Fastest and slowest means of a set by a full sort: the reference.
+ExtremeMsd sorted_extremes(const std::vector<double>& d2, const std::vector<std::uint8_t>& species,
+                           double fraction, int which) {
+  std::vector<double> v;
+  for (size_t i = 0; i < d2.size(); ++i)
+    if (which < 0 || species[i] == which) v.push_back(d2[i]);
+  std::sort(v.begin(), v.end());
+  const long m = static_cast<long>(v.size());
+  if (m == 0) return {NAN, NAN, 0};
+  const long k = std::min(m, std::max(1L, std::lround(fraction * m)));
+  return {std::accumulate(v.end() - k, v.end(), 0.0) / k, std::accumulate(v.begin(), v.begin() + k, 0.0) / k, k};
+}
+
+// Both entry points (one set; all + small in one pass) against the sort,
+// with one reused buffer. Returns the number of whole-set fallbacks.
+int expect_extremes_match_sort(const std::vector<double>& d2, const std::vector<std::uint8_t>& species,
+                               double f_all, double f_small, std::vector<double>& buffer, const char* what) {
+  const long n = static_cast<long>(d2.size());
+  const ExtremeMsd ref[2] = {sorted_extremes(d2, species, f_all, -1), sorted_extremes(d2, species, f_small, 0)};
+  const ExtremeMsdAllSmall both = msd_extremes_all_small(d2.data(), species.data(), n, f_all, f_small, buffer);
+  const ExtremeMsd one[2] = {msd_extremes(d2.data(), species.data(), n, f_all, -1, buffer),
+                             msd_extremes(d2.data(), species.data(), n, f_small, 0, buffer)};
+  const ExtremeMsd pair[2] = {both.all, both.small};
+  int fallbacks = 0;
+  for (int s = 0; s < 2; ++s)
+    for (const ExtremeMsd& e : {pair[s], one[s]}) {
+      const double tol = 1e-13 * std::max({std::abs(ref[s].fast), std::abs(ref[s].slow), 1e-300});
+      EXPECT_EQ(e.count, ref[s].count) << what << " set " << s;
+      if (ref[s].count == 0) {
+        EXPECT_TRUE(std::isnan(e.fast) && std::isnan(e.slow)) << what;
+        continue;
+      }
+      EXPECT_NEAR(e.fast, ref[s].fast, tol) << what << " set " << s;
+      EXPECT_NEAR(e.slow, ref[s].slow, tol) << what << " set " << s;
+      fallbacks += e.full_selections;
+    }
+  return fallbacks;
+}
+
+} // namespace
+
+TEST(Displacement, SampledExtremesMatchASortOnTheNodesDistribution) {
+  // Large enough for the sampled path; Gaussian displacements as in a run.
+  const System s = random_system(30001, 120.0, 0.8, 11);
+  std::vector<double> d2(s.n), buffer;
+  for (long i = 0; i < s.n; ++i)
+    d2[i] = std::pow(s.pt[2 * i] - s.p0[2 * i], 2) + std::pow(s.pt[2 * i + 1] - s.p0[2 * i + 1], 2);
+  EXPECT_EQ(expect_extremes_match_sort(d2, s.species, 0.1, 0.2, buffer, "gaussian"), 0); // no fallback here
+  for (const double f : {1e-6, 0.001, 0.3, 0.5, 0.7, 1.0}) // k = 1, k = n/2, overlapping subsets, k = n
+    expect_extremes_match_sort(d2, s.species, f, f, buffer, "fractions");
+}
+
+TEST(Displacement, SampledExtremesFallBackWhereTheSampleMisleads) {
+  std::vector<double> buffer;
+  std::mt19937_64 gen(5);
+  std::uniform_real_distribution<double> u(0, 1);
+  for (const long n : {1L, 2L, 7L, 4095L, 4096L, 4097L, 20000L}) {
+    std::vector<std::uint8_t> species(n);
+    for (long i = 0; i < n; ++i) species[i] = i % 3 == 0; // small ones not in one block
+    // All equal: every value is a tie of the bound.
+    std::vector<double> d2(n, 0.25);
+    expect_extremes_match_sort(d2, species, 0.1, 0.2, buffer, "all equal");
+    // Few distinct values: wide runs of ties across the bounds.
+    for (long i = 0; i < n; ++i) d2[i] = std::floor(4 * u(gen)) * 0.5;
+    expect_extremes_match_sort(d2, species, 0.1, 0.2, buffer, "ties");
+    expect_extremes_match_sort(d2, species, 1e-9, 0.5, buffer, "ties, k = 1 and n/2");
+  }
+  // Adversarial for a strided sample: values that the sampled positions see
+  // as large (the rest tiny), or as tiny (the rest large), and a periodic
+  // pattern; the bands then miss the bounds and the whole set is redone.
+  const long n = 50000;
+  const long samples = std::clamp(static_cast<long>(8 * std::sqrt(double(n))), 256L, 8192L);
+  std::vector<std::uint8_t> species(n);
+  for (long i = 0; i < n; ++i) species[i] = i < n / 2 ? 0 : 1;
+  int fallbacks = 0;
+  for (int pattern = 0; pattern < 3; ++pattern) {
+    std::vector<double> d2(n);
+    for (long i = 0; i < n; ++i) d2[i] = pattern == 2 ? (i % 97) * 0.01 : 1e-3 * u(gen);
+    for (long j = 0; j < samples; ++j) {
+      const long i = static_cast<long>((2 * j + 1) * static_cast<double>(n) / (2 * samples));
+      if (pattern == 0) d2[i] = 10 + u(gen);
+      if (pattern == 1) d2[i] = 1e-9 * u(gen);
+    }
+    if (pattern == 1)
+      for (long i = 0; i < n; ++i) d2[i] = d2[i] < 1e-8 ? d2[i] : 5 + u(gen);
+    fallbacks += expect_extremes_match_sort(d2, species, 0.1, 0.2, buffer, "adversarial");
+  }
+  EXPECT_GT(fallbacks, 0); // the fallback did run
+  // Heavy tails (exponential in log), where a few values dominate the sums.
+  std::vector<double> d2(n);
+  for (long i = 0; i < n; ++i) d2[i] = std::exp(30 * (u(gen) - 0.5));
+  expect_extremes_match_sort(d2, species, 0.1, 0.2, buffer, "heavy tail");
+  // No small particles at all.
+  std::vector<std::uint8_t> large(n, 1);
+  expect_extremes_match_sort(d2, large, 0.1, 0.2, buffer, "no small");
+}

@@ -111,16 +111,32 @@ void displacement_pass(const double* pos0, const double* pos_t, const std::uint8
 // 20% of small ones (paper, fig. MSD). "Instantaneous": the subsets are
 // chosen anew for every (origin, lag) pair, by the particles' own |dr|^2
 // over that lag; each holds round(fraction * set size) particles (at least
-// one). Exact: selection by nth_element in `buffer` (reused: no allocation
-// once it has grown to the set's size).
+// one). Exact: the same subsets as a full sort (up to ties, so the same
+// sums to roundoff). From 4096 particles on, a strided sample of about
+// 8 sqrt(n) values brackets each subset's bound; one pass over d2 sums the
+// values surely inside a subset and copies the band around each bound into
+// `buffer`, and nth_element runs on the bands only. A side whose bound the
+// band turns out not to hold (the counts say so) is redone for its set by
+// nth_element on a copy of the whole set, as are sets under 4096 particles.
+// `buffer` is reused: no allocation once it has grown.
 struct ExtremeMsd {
   double fast, slow;
-  long count; // particles in each subset
+  long count;              // particles in each subset
+  int full_selections = 0; // 1 if the set needed the whole-set fallback (diagnostic)
 };
 ExtremeMsd msd_extremes(const double* d2, const std::uint8_t* species, long n, double fraction,
                         int which_species, std::vector<double>& buffer);
 ExtremeMsd msd_extremes(const double* d2, const std::uint8_t* species, long n, double fraction,
                         int which_species = -1);
+
+// The two sets the overlap node publishes, all particles and small ones
+// (species 0), in one pass over d2: the same results as two calls above.
+struct ExtremeMsdAllSmall {
+  ExtremeMsd all, small;
+};
+ExtremeMsdAllSmall msd_extremes_all_small(const double* d2, const std::uint8_t* species, long n,
+                                          double fraction_all, double fraction_small,
+                                          std::vector<double>& buffer);
 
 // theta(a - |dr_i|) for every particle: the weights of W_r(q,t), eq. (16).
 void overlap_weights(const double* d2, long n, double cutoff_a, std::vector<double>& weight);
