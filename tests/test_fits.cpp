@@ -48,6 +48,24 @@ TEST(Fits, OverlapFormWithNoiseWithinItsErrors) {
   EXPECT_LT(f.beta_err, 0.02);
 }
 
+TEST(Fits, OverlapFormIgnoresLagsWithoutSpread) {
+  // At the shortest lags every origin gives Q = 1 exactly, so the error over
+  // origins is 0 up to roundoff (4e-16 in an N = 10^5 run). Weighted by
+  // 1/err^2 those lags would own the fit (it ran off to beta = -4e5, tau0 = 0
+  // there); they must count like the best-measured of the other lags.
+  // Data: a short-time plateau Q = 1 the form does not have, then the form.
+  const std::vector<double> t = log_lags(0.05, 20.0, 6);
+  std::vector<double> q, e;
+  for (double x : t) {
+    const bool plateau = x < 0.12;
+    q.push_back(plateau ? 1.0 : 1 / (std::pow(x / 2.5, 1.4) + 1));
+    e.push_back(plateau ? 4e-16 : 0.002);
+  }
+  const OverlapFit f = fit_overlap(t, q, e);
+  EXPECT_NEAR(f.beta, 1.4, 0.05);
+  EXPECT_NEAR(f.tau0, 2.5, 0.05);
+}
+
 TEST(Fits, OrnsteinZernikeOnExactData) {
   std::vector<double> q, s, s2;
   for (int k = 1; k <= 40; ++k) {

@@ -148,6 +148,17 @@ OverlapFit fit_overlap(const std::vector<double>& t, const std::vector<double>& 
     if (q[j] > 0.02 && q[j] < 0.98) lx.push_back(std::log(t[j])), ly.push_back(std::log(1 / q[j] - 1));
   }
   OverlapFit out{kNaN, kNaN, kNaN, kNaN, kNaN, static_cast<int>(ts.size())};
+  // A lag where every origin gives the same Q (Q = 1 at the shortest lags)
+  // has an error of 0 up to roundoff: weighted by 1/err^2 it would own the
+  // fit. Such errors (below 1e-9 of the largest) count as the smallest of
+  // the others; with no other, the fit is unweighted.
+  if (!q_err.empty()) {
+    const double big = *std::max_element(es.begin(), es.end());
+    double floor = kNaN;
+    for (double e : es)
+      if (e > 1e-9 * big && !(e >= floor)) floor = e;
+    for (double& e : es) e = std::isfinite(floor) ? std::max(e, floor) : 1.0;
+  }
   const LinearFit lin = linear_fit(lx, ly);
   if (ts.size() < 3 || !std::isfinite(lin.slope) || lin.slope <= 0) return out;
   Eigen::VectorXd p0(2);
@@ -163,6 +174,7 @@ OverlapFit fit_overlap(const std::vector<double>& t, const std::vector<double>& 
       },
       p0);
   const double s = scale(f, !q_err.empty());
+  if (!(f.p[0] > 0) || !std::isfinite(f.p[1])) return out; // ran away: no fit (NaN)
   out.beta = f.p[0], out.beta_err = error_of(f, 0, s);
   out.tau0 = std::exp(f.p[1]), out.tau0_err = out.tau0 * error_of(f, 1, s);
   out.chi2 = f.chi2;
