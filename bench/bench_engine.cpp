@@ -12,8 +12,6 @@
 #include <filesystem>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
-#include <sstream>
 #include <string>
 #include <vector>
 
@@ -25,14 +23,6 @@
 #include "dynhet/stats.hpp"
 
 namespace {
-
-long rss_kib() {
-  std::ifstream f("/proc/self/status");
-  std::string line;
-  while (std::getline(f, line))
-    if (line.rfind("VmRSS:", 0) == 0) return std::stol(line.substr(6));
-  return 0;
-}
 
 double seconds(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -99,7 +89,6 @@ int main(int argc, char** argv) {
               "T_sd");
   for (long n : ns)
     for (double phi : phis) {
-      const long rss0 = rss_kib();
       dynhet::engine::Params p = dynhet::engine::paper_params(n, phi, eps, driven);
       p.seed = 1;
       dynhet::engine::Engine e(p);
@@ -140,7 +129,7 @@ int main(int argc, char** argv) {
         std::printf("%9ld %6.3f  failed: %s\n", n, phi, ex.what());
         continue;
       }
-      const double bytes = (rss_kib() - rss0) * 1024.0 / n;
+      const double bytes = double(e.memory_bytes()) / n; // the engine's arrays
       const double e0 = e.kinetic_energy_per_particle();
       // Short warm-up to learn the collision rate, then the timed run.
       e.run_until(1.0);

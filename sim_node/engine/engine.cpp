@@ -557,6 +557,12 @@ double Engine::min_gap_ratio() const {
   return best;
 }
 
+size_t Engine::memory_bytes() const {
+  auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
+  return b(part_) + b(species_by_id_) + b(id_) + b(slot_of_) + b(image_x_) + b(image_y_) + b(last_collision_) +
+         b(event_) + b(cells_) + b(cell_x_) + b(cell_y_) + cal_.bytes();
+}
+
 double Engine::max_overlap() const { return 1.0 - min_gap_ratio(); }
 
 } // namespace dynhet::engine

@@ -22,6 +22,7 @@ public:
     for (int i = 0; i < size_; ++i) node_[size_ + i].leaf = i;
     for (int v = size_ - 1; v >= 1; --v) node_[v] = pick(node_[2 * v], node_[2 * v + 1]);
   }
+  size_t bytes() const { return node_.capacity() * sizeof(Node); }
   int top() const { return node_[1].leaf; }
   double top_time() const { return node_[1].time; }
   double time(int leaf) const { return node_[size_ + leaf].time; }

@@ -114,6 +114,8 @@ public:
 
   double time() const { return offset_ + now_; }
   long size() const { return n_; }
+  // Bytes held by the engine's arrays (their capacities), for the benchmark.
+  size_t memory_bytes() const;
   double box_length() const { return box_; }
   double packing_fraction() const;
   double radius(int species) const { return radius_[species]; }
