@@ -2,23 +2,29 @@
 // the correlation length xi, live from the frames on DYNHET_FRAME, published
 // on DYNHET_S4 at most once a second and at the end.
 //
-// For each (origin, lag) pair it uses, the node weighs every particle by
-// w_i = theta(a - |r_i(t0+t) - r_i(t0)|) (the first listed cutoff a) and
-// computes W_r(q) on every sub-box grid (the [s4] sizes, by default chi4's,
-// and always the whole box) by the Gaussian NUFFT on FFTW grids
-// (kernels/s4.cpp), then S4 per |q| shell. Lags: every scheduled lag by
+// For each (origin, lag) pair it uses, the node computes the displacements
+// |r_i(t0+t) - r_i(t0)|^2 once, and for every cutoff a of the scene weighs
+// every particle by w_i = theta(a - |dr_i|) and computes W_r(q) on every
+// sub-box grid (the [s4] sizes, by default chi4's, and always the whole
+// box) by the Gaussian NUFFT on FFTW grids (kernels/s4.cpp), then S4 per |q|
+// shell: one pass over the frames for all cutoffs. The grids (FFTW plans
+// and buffers) are shared by the cutoffs: only the weights and the
+// transforms are per cutoff, so the cost per pair is the number of cutoffs
+// times that of one. One message per cutoff (cutoff_a says which). Lags: every scheduled lag by
 // default (the grid costs a few ms per pair at N = 10^4, so S4(q,t) and
 // xi(t) come at every t), or the scheduled lags nearest the times in
 // s4.lags (to bound the cost at N = 10^5, ~70 ms per pair for six grids).
-// The fits with jackknife errors and the chi4 comparison are made at t_s4,
-// the computed lag nearest the node's own running tau_alpha (Q(t) from the
-// same weights, W(q = 0) of the whole box; the paper evaluates S4 at
-// tau_alpha); before Q(t) crosses 1/e, at the last lag with data.
+// The fits with jackknife errors and the chi4 comparison are made, per
+// cutoff, at t_s4, the computed lag nearest that cutoff's running tau_alpha
+// of the node's own (Q(t) from the same weights, W(q = 0) of the whole box;
+// the paper evaluates S4 at tau_alpha); before Q(t) crosses 1/e, at the last
+// lag with data.
 //
 // Memory: the origin frames some later used lag still needs, 16 N bytes
 // each: at most (largest used lag) / origin_spacing + 1 of them; the S4
-// shells of every (origin, lag, grid), a few hundred doubles per pair; and
-// the FFT grids, 16 (L/h)^2 bytes per grid (h the grid spacing).
+// shells of every (cutoff, origin, lag, grid), a few hundred doubles per
+// pair and cutoff; and the FFT grids, 16 (L/h)^2 bytes per grid (h the grid
+// spacing), one set for all cutoffs.
 //
 // Usage: s4_node [--lcm-url URL] [--publish-url URL] (as overlap_node)
 #include <algorithm>
@@ -63,7 +69,6 @@ public:
 private:
   void start(const dynhet::run_info_t& m) override {
     const dynhet::Scene scene = dynhet::parse_scene_text(m.scene_toml, "the run's scene");
-    cutoff_ = m.cutoff_a.at(0);
     q_max_ = scene.s4_q_max;
     const std::vector<int> sizes = scene.s4_subbox_particles.empty()
                                        ? std::vector<int>(m.chi4_subbox_particles.begin(), m.chi4_subbox_particles.end())
@@ -75,17 +80,18 @@ private:
     for (double t : scene.s4_lags) slot_[an::nearest_lag(m.lag_time, t)] = 0;
     for (int j = 0; j < m.n_lags; ++j)
       if (slot_[j] == 0) slot_[j] = static_cast<int>(lags_.size()), lags_.push_back(m.lag_time[j]);
-    q_acc_ = std::make_unique<an::OverlapAccumulator>(m.n_origins, m.lag_time);
+    for (double a : m.cutoff_a) cuts_.push_back(Cutoff{a, {}, std::make_unique<an::OverlapAccumulator>(m.n_origins, m.lag_time)});
     const std::vector<double> none;
     for (const an::SubboxGrid& g : s4_grids(m.n_particles, m.box_length, sizes)) {
       grids_.push_back(g);
       fft_.push_back(std::make_unique<an::S4Grid>(g, q_max_, an::S4GridParams{scene.s4_grid_spacing, scene.s4_half_width, false}));
       // The shells of this grid (from zero weights: only q and the vector counts matter).
       const an::S4Shells shells = an::s4_shells(fft_.back()->modes(none.data(), none.data(), 0));
-      acc_.emplace_back(m.n_origins, static_cast<int>(lags_.size()), shells.q, shells.n_vectors);
+      for (Cutoff& c : cuts_) c.acc.emplace_back(m.n_origins, static_cast<int>(lags_.size()), shells.q, shells.n_vectors);
     }
-    std::fprintf(stderr, "s4_node: a=%g, q <= %g, %zu of %d lags, grids (m: points):", cutoff_, q_max_,
-                 lags_.size(), m.n_lags);
+    std::fprintf(stderr, "s4_node: a =");
+    for (const Cutoff& c : cuts_) std::fprintf(stderr, " %g", c.a);
+    std::fprintf(stderr, ", q <= %g, %zu of %d lags, grids (m: points):", q_max_, lags_.size(), m.n_lags);
     for (size_t g = 0; g < grids_.size(); ++g) std::fprintf(stderr, " %d: %d", grids_[g].per_side, fft_[g]->points());
     std::fprintf(stderr, "\n");
   }
@@ -97,18 +103,29 @@ private:
     d2_.resize(n);
     for (long i = 0; i < n; ++i)
       d2_[i] = std::pow(f.position[2 * i] - pos0[2 * i], 2) + std::pow(f.position[2 * i + 1] - pos0[2 * i + 1], 2);
-    an::overlap_weights(d2_.data(), n, cutoff_, w_); // w_i = theta(a - |dr_i|)
-    const double q = std::accumulate(w_.begin(), w_.end(), 0.0) / n; // Q(t;t0) = W(0) of the whole box
-    q_acc_->add(k, j, &q, 1);
-    for (size_t g = 0; g < grids_.size(); ++g)
-      acc_[g].add(k, slot_[j], an::s4_shells(fft_[g]->modes(pos0.data(), w_.data(), n)));
+    // Per cutoff: the weights and the transforms, on the grids (plans and
+    // buffers) all cutoffs share; d2 is the same for every cutoff.
+    for (Cutoff& c : cuts_) {
+      an::overlap_weights(d2_.data(), n, c.a, w_); // w_i = theta(a - |dr_i|)
+      const double q = std::accumulate(w_.begin(), w_.end(), 0.0) / n; // Q(t;t0) = W(0) of the whole box
+      c.q_acc->add(k, j, &q, 1);
+      for (size_t g = 0; g < grids_.size(); ++g)
+        c.acc[g].add(k, slot_[j], an::s4_shells(fft_[g]->modes(pos0.data(), w_.data(), n)));
+    }
   }
 
+  // What the node keeps per cutoff a: S4 per grid and Q(t;t0) of the whole box.
+  struct Cutoff {
+    double a;
+    std::vector<an::S4Accumulator> acc;            // per grid
+    std::unique_ptr<an::OverlapAccumulator> q_acc; // Q(t;t0) of the whole box, for tau_alpha and chi4
+  };
+
   // The computed lag nearest tau_alpha (in ln t), else the last one with data.
-  int fit_slot(double tau_alpha) const {
+  int fit_slot(const Cutoff& c, double tau_alpha) const {
     if (std::isfinite(tau_alpha)) return an::nearest_lag(lags_, tau_alpha);
     for (int l = static_cast<int>(lags_.size()) - 1; l >= 0; --l)
-      if (acc_[0].mean(l).n_origins > 0) return l;
+      if (c.acc[0].mean(l).n_origins > 0) return l;
     return 0;
   }
 
@@ -116,24 +133,29 @@ private:
     // Fits with jackknife errors are some ms: at most once a second.
     if (!final && Clock::now() - last_publish_ < std::chrono::seconds(1)) return;
     last_publish_ = Clock::now();
+    for (const Cutoff& c : cuts_) publish_cutoff(c, final);
+  }
+
+  // One message: cutoff c's S4, fits and chi4.
+  void publish_cutoff(const Cutoff& c, bool final) {
     dynhet::s4_t m{};
     stamp(m, final);
-    m.cutoff_a = cutoff_, m.q_max = q_max_, m.qxi_max = kQxiMax;
-    m.tau_alpha = q_acc_->result().tau_alpha;
-    const int l = fit_slot(m.tau_alpha);
+    m.cutoff_a = c.a, m.q_max = q_max_, m.qxi_max = kQxiMax;
+    m.tau_alpha = c.q_acc->result().tau_alpha;
+    const int l = fit_slot(c, m.tau_alpha);
     m.lag_index = l, m.t_s4 = lags_[l];
     m.lag_time = lags_;
-    for (size_t g = 0; g < grids_.size(); ++g) add_grid(m, g, l);
-    m.n_origins = acc_.back().mean(l).n_origins;
+    for (size_t g = 0; g < grids_.size(); ++g) add_grid(m, c, g, l);
+    m.n_origins = c.acc.back().mean(l).n_origins;
     const size_t whole = grids_.size() - 1;
     m.xi = m.oz_xi[whole], m.xi_err = m.oz_xi_err[whole], m.chi0 = m.oz_chi0[whole], m.chi0_err = m.oz_chi0_err[whole];
     m.chi4_box = m.chi4[whole], m.chi4_box_err = m.chi4_err[whole];
     // S4(q) and the OZ fit at every computed lag.
     for (size_t t = 0; t < lags_.size(); ++t)
       for (size_t g = 0; g < grids_.size(); ++g) {
-        const std::vector<double> s4 = acc_[g].mean(static_cast<int>(t)).s4;
+        const std::vector<double> s4 = c.acc[g].mean(static_cast<int>(t)).s4;
         m.s4_lag.insert(m.s4_lag.end(), s4.begin(), s4.end());
-        const an::OzFit f = an::fit_oz(acc_[g].q(), s4, {}, kQxiMax);
+        const an::OzFit f = an::fit_oz(c.acc[g].q(), s4, {}, kQxiMax);
         m.xi_lag.push_back(f.xi), m.chi0_lag.push_back(f.chi0);
       }
     m.n_grids = static_cast<int32_t>(grids_.size());
@@ -144,13 +166,13 @@ private:
     if (out().publish(dynhet::kChanS4, &m) != 0)
       std::fprintf(stderr, "s4_node: could not publish S4 (%d bytes)\n", m.getEncodedSize());
     if (final)
-      std::fprintf(stderr, "s4_node: t_s4=%.4g (tau_alpha %.4g), whole box xi=%.4g +- %.2g chi0=%.4g +- %.2g, chi4=%.4g +- %.2g (%d origins)\n",
-                   m.t_s4, m.tau_alpha, m.xi, m.xi_err, m.chi0, m.chi0_err, m.chi4_box, m.chi4_box_err, m.n_origins);
+      std::fprintf(stderr, "s4_node: a=%g t_s4=%.4g (tau_alpha %.4g), whole box xi=%.4g +- %.2g chi0=%.4g +- %.2g, chi4=%.4g +- %.2g (%d origins)\n",
+                   m.cutoff_a, m.t_s4, m.tau_alpha, m.xi, m.xi_err, m.chi0, m.chi0_err, m.chi4_box, m.chi4_box_err, m.n_origins);
   }
 
-  // Grid g's shells, fits and chi4 at computed lag l.
-  void add_grid(dynhet::s4_t& m, size_t g, int l) const {
-    const an::S4Accumulator& a = acc_[g];
+  // Grid g's shells, fits and chi4 of cutoff c at computed lag l.
+  void add_grid(dynhet::s4_t& m, const Cutoff& c, size_t g, int l) const {
+    const an::S4Accumulator& a = c.acc[g];
     const an::S4Accumulator::Mean mean = a.mean(l);
     m.subbox_particles.push_back(grids_[g].mean_particles);
     m.subbox_per_side.push_back(grids_[g].per_side);
@@ -176,20 +198,19 @@ private:
     } else {
       const int j = static_cast<int>(std::find(slot_.begin(), slot_.end(), l) - slot_.begin());
       std::vector<double> q(info().n_origins);
-      for (int k = 0; k < info().n_origins; ++k) q[k] = q_acc_->q(k, j);
+      for (int k = 0; k < info().n_origins; ++k) q[k] = c.q_acc->q(k, j);
       const an::ValueErr c = an::whole_box_chi4(q, info().n_particles);
       m.chi4.push_back(c.value), m.chi4_err.push_back(c.err);
     }
   }
 
-  double cutoff_ = 0, q_max_ = 1;
+  double q_max_ = 1;
   std::vector<int> slot_;     // per scheduled lag: index among the computed lags, or -1
   std::vector<double> lags_;  // the computed lags
   std::vector<an::SubboxGrid> grids_;
-  std::vector<std::unique_ptr<an::S4Grid>> fft_;
-  std::vector<an::S4Accumulator> acc_; // per grid
-  std::unique_ptr<an::OverlapAccumulator> q_acc_; // Q(t;t0) of the whole box, for tau_alpha and chi4
-  std::vector<double> d2_, w_;
+  std::vector<std::unique_ptr<an::S4Grid>> fft_; // per grid, shared by the cutoffs
+  std::vector<Cutoff> cuts_;                     // per cutoff of the scene, in its order
+  std::vector<double> d2_, w_;                   // per pair, reused (w_: one cutoff at a time)
   Clock::time_point last_publish_{};
 };
 

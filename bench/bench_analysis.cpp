@@ -8,7 +8,7 @@
 // relative error over the |q| <= q_max shells) for several grid spacings;
 // clusters with R_g.
 // Usage: bench_analysis [--n 100000] [--phi 0.76] [--reps 20] [--q-max 1]
-//   [--sections pass,s4,clusters]
+//   [--sections pass,s4,clusters] (or s4_node: s4_node's cost per pair only)
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -275,27 +275,37 @@ void bench_s4(const Frames& f, double q_max, int reps) {
 
 // What s4_node spends per (origin, lag) pair with the default [s4]
 // parameters: S4 on every grid of the default chi4 sizes (nested) and the
-// whole box, each against its direct sum.
+// whole box, each against its direct sum, for one cutoff (a = 0.6) and for
+// two (0.6 and 1.0) as the node does them: d2 once per pair, then per cutoff
+// the weights and the transforms on the same grids (plans and buffers).
 void bench_s4_node(const Frames& f, double q_max, int reps) {
   std::vector<double> d2(f.n), w;
   for (long i = 0; i < f.n; ++i)
     d2[i] = std::pow(f.pt[2 * i] - f.p0[2 * i], 2) + std::pow(f.pt[2 * i + 1] - f.p0[2 * i + 1], 2);
-  an::overlap_weights(d2.data(), f.n, 0.6, w);
   std::vector<an::SubboxGrid> grids = an::nested_subbox_grids(f.n, f.box, {25, 100, 400, 1600, 6400});
   grids.push_back(an::SubboxGrid{1, f.box, double(f.n)});
   std::vector<std::unique_ptr<an::S4Grid>> fft;
-  double err = 0;
-  for (const auto& g : grids) {
-    fft.push_back(std::make_unique<an::S4Grid>(g, q_max));
-    const an::S4Shells ref = an::s4_shells(an::s4_modes_direct(f.p0.data(), w.data(), f.n, g, q_max));
-    err = std::max(err, max_rel_error(an::s4_shells(fft.back()->modes(f.p0.data(), w.data(), f.n)), ref));
+  for (const auto& g : grids) fft.push_back(std::make_unique<an::S4Grid>(g, q_max));
+  for (const std::vector<double>& cutoffs : {std::vector<double>{0.6}, std::vector<double>{0.6, 1.0}}) {
+    double err = 0;
+    for (double a : cutoffs) {
+      an::overlap_weights(d2.data(), f.n, a, w);
+      for (size_t g = 0; g < grids.size(); ++g) {
+        const an::S4Shells ref = an::s4_shells(an::s4_modes_direct(f.p0.data(), w.data(), f.n, grids[g], q_max));
+        err = std::max(err, max_rel_error(an::s4_shells(fft[g]->modes(f.p0.data(), w.data(), f.n)), ref));
+      }
+    }
+    const Timing t = time_calls(reps, [&] {
+      for (double a : cutoffs) {
+        an::overlap_weights(d2.data(), f.n, a, w);
+        for (auto& g : fft) an::s4_shells(g->modes(f.p0.data(), w.data(), f.n));
+      }
+    });
+    std::printf("# s4_node per pair, %zu grids (default chi4 sizes + whole box, R = 2, hw 4), %zu cutoff%s "
+                "(a = %g%s): %.1f ms (min; median %.1f), max rel error %.1e\n",
+                grids.size(), cutoffs.size(), cutoffs.size() > 1 ? "s" : "", cutoffs[0],
+                cutoffs.size() > 1 ? ", 1" : "", 1e3 * t.min, 1e3 * t.median, err);
   }
-  const Timing t = time_calls(reps, [&] {
-    for (auto& g : fft) an::s4_shells(g->modes(f.p0.data(), w.data(), f.n));
-  });
-  std::printf("# s4_node per pair, %zu grids (default chi4 sizes + whole box, R = 2, hw 4): %.1f ms (min; median "
-              "%.1f), max rel error %.1e\n",
-              grids.size(), 1e3 * t.min, 1e3 * t.median, err);
 }
 
 // Clusters as clusters_node does them: g_ab and the neighbour graph once per
@@ -353,16 +363,17 @@ int main(int argc, char** argv) {
   app.add_option("--phi", phi, "packing fraction (sets the box)");
   app.add_option("--reps", reps, "repetitions per timing (median)");
   app.add_option("--q-max", q_max, "largest |q| of S4");
-  app.add_option("--sections", sections, "which tables: pass,s4,clusters");
+  app.add_option("--sections", sections, "which tables: pass,s4,clusters (s4: the spacing table and s4_node's "
+                                         "cost; s4_node: the latter only)");
   CLI11_PARSE(app, argc, argv);
   const Frames f = make_frames(n, phi, 1);
   std::printf("# dynhet analysis kernels, one core (thread CPU time); N=%ld, phi=%.2f, box=%.1f; min and "
               "median of %d runs\n",
               n, phi, f.box, reps);
-  auto wanted = [&](const char* s) { return sections.find(s) != std::string::npos; };
+  auto wanted = [&](const std::string& s) { return ("," + sections + ",").find("," + s + ",") != std::string::npos; };
   if (wanted("pass")) bench_pass(f, reps);
   if (wanted("s4")) bench_s4(f, q_max, std::max(3, reps / 4));
-  if (wanted("s4")) bench_s4_node(f, q_max, std::max(3, reps / 4));
+  if (wanted("s4") || wanted("s4_node")) bench_s4_node(f, q_max, std::max(3, reps / 4));
   if (wanted("clusters")) bench_clusters(f, std::max(3, reps / 4));
   return 0;
 }

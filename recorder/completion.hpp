@@ -23,13 +23,12 @@ public:
 
   void sim_phase(const std::string &phase, const std::string &message);
   void node_state(const std::string &node, const std::string &state);
-  // A final result of `observable` ("overlap", "chi4", "clusters") for one
-  // cutoff, or of one with a single final result ("msd" and "displacement",
-  // which do not depend on the cutoff, and "s4", for the first cutoff only;
-  // cutoff ignored).
+  // A final result of `observable` ("overlap", "chi4", "clusters", "s4") for
+  // one cutoff, or of one with a single final result ("msd" and
+  // "displacement", which do not depend on the cutoff; cutoff ignored).
   void final_result(const std::string &observable, double cutoff_a) { finals_.insert(final_label(observable, cutoff_a)); }
   static std::string final_label(const std::string &observable, double cutoff_a) {
-    return observable == "msd" || observable == "displacement" || observable == "s4"
+    return observable == "msd" || observable == "displacement"
                ? observable
                : observable + " " + cutoff_label(cutoff_a);
   }

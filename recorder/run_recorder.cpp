@@ -236,30 +236,33 @@ bool RunRecorder::on_s4(const s4_t &m) {
   return true;
 }
 
-// s4/: fixed lag_time (the computed lags) and, per grid, subbox_particles,
-// subbox_per_side, grid_spacing, grid_points, n_shells; per shell value q,
-// shell_vectors (grid g's shells follow grid g-1's). Per record: s4,
-// s4_err (records, values) at t_s4; s4_lag (records, lags * values);
-// xi_lag, chi0_lag (records, lags * grids); oz_*, a2_*, chi4, chi4_err
-// (records, grids); scalars tau_alpha, t_s4, lag_index, n_origins, xi,
-// xi_err, chi0, chi0_err, chi4_box, chi4_box_err.
+// s4/a<cutoff>/: fixed lag_time (the computed lags) and, per grid,
+// subbox_particles, subbox_per_side, grid_spacing, grid_points, n_shells;
+// per shell value q, shell_vectors (grid g's shells follow grid g-1's). Per
+// record: s4, s4_err (records, values) at t_s4; s4_lag (records, lags *
+// values); xi_lag, chi0_lag (records, lags * grids); oz_*, a2_*, chi4,
+// chi4_err (records, grids); scalars tau_alpha, t_s4, lag_index, n_origins,
+// xi, xi_err, chi0, chi0_err, chi4_box, chi4_box_err.
 void RunRecorder::write_s4(const s4_t &m) {
-  if (!s4_started_) {
-    writer_->write_fixed("s4/lag_time", m.lag_time);
-    writer_->write_fixed("s4/subbox_particles", m.subbox_particles);
-    writer_->write_fixed("s4/subbox_per_side", m.subbox_per_side);
-    writer_->write_fixed("s4/grid_spacing", m.grid_spacing);
-    writer_->write_fixed("s4/grid_points", m.grid_points);
-    writer_->write_fixed("s4/n_shells", m.n_shells);
-    writer_->write_fixed("s4/q", m.q);
-    writer_->write_fixed("s4/shell_vectors", m.shell_vectors);
-    writer_->set_attribute("observables/s4/", "cutoff_a", m.cutoff_a);
-    writer_->set_attribute("observables/s4/", "q_max", m.q_max);
-    writer_->set_attribute("observables/s4/", "qxi_max", m.qxi_max);
-    writer_->set_attribute("observables/s4/", "layout",
+  const std::string label = cutoff_label(m.cutoff_a);
+  const std::string base = "s4/" + label + "/";
+  if (!s4_started_[label]) {
+    writer_->write_fixed(base + "lag_time", m.lag_time);
+    writer_->write_fixed(base + "subbox_particles", m.subbox_particles);
+    writer_->write_fixed(base + "subbox_per_side", m.subbox_per_side);
+    writer_->write_fixed(base + "grid_spacing", m.grid_spacing);
+    writer_->write_fixed(base + "grid_points", m.grid_points);
+    writer_->write_fixed(base + "n_shells", m.n_shells);
+    writer_->write_fixed(base + "q", m.q);
+    writer_->write_fixed(base + "shell_vectors", m.shell_vectors);
+    const std::string g = "observables/" + base;
+    writer_->set_attribute(g, "cutoff_a", m.cutoff_a);
+    writer_->set_attribute(g, "q_max", m.q_max);
+    writer_->set_attribute(g, "qxi_max", m.qxi_max);
+    writer_->set_attribute(g, "layout",
                            "s4[record][value], grid g's shells after grid g-1's; s4_lag[record][lag * n_values + "
                            "value]; xi_lag, chi0_lag[record][lag * n_grids + grid]");
-    s4_started_ = true;
+    s4_started_[label] = true;
   }
   if (m.n_values <= 0) return;
   const int64_t step = m.frame_index;
@@ -272,15 +275,15 @@ void RunRecorder::write_s4(const s4_t &m) {
       {"a2_xi", &m.a2_xi},     {"a2_xi_err", &m.a2_xi_err},     {"a2_a", &m.a2_a},
       {"a2_a_err", &m.a2_a_err}, {"a2_q_fit_max", &m.a2_q_fit_max}, {"chi4", &m.chi4},
       {"chi4_err", &m.chi4_err}};
-  for (const auto &[name, v] : arrays) writer_->append_observable(std::string("s4/") + name, step, t, *v);
-  writer_->append_observable("s4/oz_n_fit", step, t, m.oz_n_fit);
-  writer_->append_observable("s4/a2_n_fit", step, t, m.a2_n_fit);
+  for (const auto &[name, v] : arrays) writer_->append_observable(base + name, step, t, *v);
+  writer_->append_observable(base + "oz_n_fit", step, t, m.oz_n_fit);
+  writer_->append_observable(base + "a2_n_fit", step, t, m.a2_n_fit);
   const std::pair<const char *, double> scalars[] = {
       {"tau_alpha", m.tau_alpha}, {"t_s4", m.t_s4}, {"xi", m.xi}, {"xi_err", m.xi_err}, {"chi0", m.chi0},
       {"chi0_err", m.chi0_err}, {"chi4_box", m.chi4_box}, {"chi4_box_err", m.chi4_box_err}};
-  for (const auto &[name, v] : scalars) writer_->append_observable(std::string("s4/") + name, step, t, &v, 1);
-  writer_->append_observable("s4/lag_index", step, t, &m.lag_index, 1);
-  writer_->append_observable("s4/n_origins", step, t, &m.n_origins, 1);
+  for (const auto &[name, v] : scalars) writer_->append_observable(base + name, step, t, &v, 1);
+  writer_->append_observable(base + "lag_index", step, t, &m.lag_index, 1);
+  writer_->append_observable(base + "n_origins", step, t, &m.n_origins, 1);
 }
 
 bool RunRecorder::on_clusters(const clusters_t &m) {

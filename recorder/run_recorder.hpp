@@ -10,7 +10,7 @@
 //   sim/<field>            {step = collisions + kicks, time = sim time}
 //   nodes/<node>/<field>   {step = frames handled, time = wall s since the first node status}
 //   overlap/a<cutoff>/<field> {step = frame index, time = sim time}, lag_time
-//   chi4/a<cutoff>/..., msd/..., s4/... likewise (s4: see write_s4)
+//   chi4/a<cutoff>/..., s4/a<cutoff>/..., msd/... likewise (s4: see write_s4)
 //   clusters/a<cutoff>/<field> likewise, with lag_time, r and the size bins
 //   msd/<field>, displacement/<field> likewise (one each per run), with
 //   lag_time (msd) and x, the bin centres (displacement)
@@ -105,10 +105,10 @@ private:
   std::map<std::string, Node> nodes_;
   std::map<std::string, bool> overlap_started_; // by cutoff label
   std::map<std::string, bool> chi4_started_;    // by cutoff label
+  std::map<std::string, bool> s4_started_;      // by cutoff label
   std::map<std::string, bool> clusters_started_, clusters_r_written_, clusters_bins_written_;
   std::map<std::string, bool> overlap_t0_written_;
   bool msd_started_ = false, displacement_started_ = false;
-  bool s4_started_ = false;
   std::optional<int64_t> node_clock_zero_;      // utime of the first node status
   int write_errors_ = 0;
 

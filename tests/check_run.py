@@ -278,13 +278,14 @@ def s4_shells_brute(x0, w, L, m, q_max, n_total):
     return np.array(out_q), np.array(out_v), out_d
 
 
-def check_s4(f, unwrapped, L, origin_frame, pair_frame, sched_lag):
-    """S4(q,t) of every grid at every computed lag against the exact direct
-    sum from the recorded frames, within the error the NUFFT grid may make
-    (the kernel's stated bound, a worst case); chi4 at t_s4 against the
+def check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, sched_lag):
+    """S4(q,t) of one cutoff (group g = observables/s4/<name>), every grid at
+    every computed lag, against the exact direct sum from the recorded frames
+    with that cutoff's weights, within the error the NUFFT grid may make (the
+    kernel's stated bound, a worst case); chi4 at t_s4 against the
     brute-force chi4; the OZ fit at t_s4 a least-squares minimum."""
-    g = f["observables/s4"]
     a = float(g.attrs["cutoff_a"])
+    check(name == f"a{a:g}", f"s4 {name}: the group is named after its cutoff a = {a:g}")
     q_max = float(g.attrs["q_max"])
     n = unwrapped.shape[1]
     sides, n_shells = g["subbox_per_side"][()], g["n_shells"][()]
@@ -320,19 +321,19 @@ def check_s4(f, unwrapped, L, origin_frame, pair_frame, sched_lag):
             same_q = np.allclose(q_rec[start[gi]:start[gi + 1]], qb, rtol=1e-12)
             ok = same_q and np.all((np.abs(rec - bf) <= tol) | (np.isnan(rec) & np.isnan(bf)))
             if not ok:
-                check(False, f"s4 m={m} t={t:.3g}: S4 {rec} vs direct sum {bf} (tolerance {tol})")
+                check(False, f"s4 {name} m={m} t={t:.3g}: S4 {rec} vs direct sum {bf} (tolerance {tol})")
                 return
             fin = np.isfinite(bf) & (bf > 0)
             worst = max(worst, np.max(np.abs(rec[fin] - bf[fin]) / bf[fin]))
-    check(True, f"s4: every grid and lag within the grid's error bound of the direct sum (max rel diff {worst:.2g})")
+    check(True, f"s4 {name}: every grid and lag within the grid's error bound of the direct sum (max rel diff {worst:.2g})")
     # The lag of the fits: nearest the node's tau_alpha, which is the overlap node's for this cutoff.
     tau = float(g["tau_alpha"]["value"][-1])
     tau_ov = float(f[f"observables/overlap/a{a:g}/tau_alpha"]["value"][-1])
-    check(abs(tau - tau_ov) <= 1e-9 * tau_ov, f"s4: tau_alpha {tau:.6g} is the overlap node's")
+    check(abs(tau - tau_ov) <= 1e-9 * tau_ov, f"s4 {name}: tau_alpha {tau:.6g} is the overlap node's")
     t_s4 = float(g["t_s4"]["value"][-1])
-    check(t_s4 == lags[np.argmin(np.abs(np.log(lags / tau)))], f"s4: fits at t = {t_s4:.4g}, the lag nearest tau_alpha")
+    check(t_s4 == lags[np.argmin(np.abs(np.log(lags / tau)))], f"s4 {name}: fits at t = {t_s4:.4g}, the lag nearest tau_alpha")
     li = int(g["lag_index"]["value"][-1])
-    check(np.array_equal(g["s4"]["value"][-1], s4_lag[li], equal_nan=True), "s4: S4 at t_s4 is its row of s4_lag")
+    check(np.array_equal(g["s4"]["value"][-1], s4_lag[li], equal_nan=True), f"s4 {name}: S4 at t_s4 is its row of s4_lag")
     # chi4 at t_s4: S4 at q = 0 for sub-boxes (checked above, shell 0), N var(Q) for the whole box.
     j = int(np.argmin(np.abs(np.log(sched_lag / t_s4))))
     chi4 = g["chi4"]["value"][-1]
@@ -340,9 +341,9 @@ def check_s4(f, unwrapped, L, origin_frame, pair_frame, sched_lag):
         if m == 1:
             q = [np.mean(np.hypot(*(unwrapped[pair_frame[k][j]] - unwrapped[of]).T) < a) for k, of in enumerate(origin_frame)]
             bf = n * np.var(q, ddof=1)
-            check(abs(chi4[gi] - bf) <= 1e-9 * bf, f"s4: whole-box chi4 {chi4[gi]:.5g} = N var(Q) over origins")
+            check(abs(chi4[gi] - bf) <= 1e-9 * bf, f"s4 {name}: whole-box chi4 {chi4[gi]:.5g} = N var(Q) over origins")
         else:
-            check(chi4[gi] == s4_lag[li, start[gi]], f"s4 m={m}: chi4 at t_s4 is S4 at q = 0")
+            check(chi4[gi] == s4_lag[li, start[gi]], f"s4 {name} m={m}: chi4 at t_s4 is S4 at q = 0")
     # OZ fit of the whole box: a least-squares minimum of the relative residuals over its range.
     gi = len(sides) - 1
     q, s4 = q_rec[start[gi]:start[gi + 1]], s4_lag[li, start[gi]:start[gi + 1]]
@@ -353,10 +354,10 @@ def check_s4(f, unwrapped, L, origin_frame, pair_frame, sched_lag):
             return np.sum(((s4[sel] - c / (1 + (q[sel] * x) ** 2)) / s4[sel]) ** 2)
         best = sse(chi0, xi)
         nudged = min(sse(chi0 * f1, xi * f2) for f1 in (0.999, 1, 1.001) for f2 in (0.999, 1, 1.001) if (f1, f2) != (1, 1))
-        check(best <= nudged * (1 + 1e-9), f"s4: OZ fit xi={xi:.4g} chi0={chi0:.4g} over q <= {qf:.3g} is a least-squares minimum")
-        check(float(g["xi"]["value"][-1]) == xi, "s4: the xi summary is the whole box's")
+        check(best <= nudged * (1 + 1e-9), f"s4 {name}: OZ fit xi={xi:.4g} chi0={chi0:.4g} over q <= {qf:.3g} is a least-squares minimum")
+        check(float(g["xi"]["value"][-1]) == xi, f"s4 {name}: the xi summary is the whole box's")
     else:
-        check(False, "s4: no OZ fit of the whole box")
+        check(False, f"s4 {name}: no OZ fit of the whole box")
 
 
 def pair_counts(x, species, L, nb, dr):
@@ -574,8 +575,11 @@ def main(path, scene_path):
         check_msd(f, unwrapped, origin_frame, pair_frame, lag, scene)
     if "observables/displacement" in f:
         check_displacement(f, unwrapped, origin_frame, pair_frame, lag, scene)
-    if "observables/s4" in f:
-        check_s4(f, unwrapped, L, origin_frame, pair_frame, lag)
+    if "observables/s4" in f:  # one group per cutoff, each against the direct sum with its own weights
+        cutoffs = sorted(f"a{a:g}" for a in f["observables/schedule/cutoff_a"][()])
+        check(sorted(f["observables/s4"].keys()) == cutoffs, f"s4: one group per cutoff {cutoffs}")
+        for name, g in f["observables/s4"].items():
+            check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, lag)
     if "observables/clusters" in f:
         nodes = f["observables/nodes/clusters"]
         check(int(nodes["frames_lost"]["value"][-1]) == 0, "clusters node lost no frame")

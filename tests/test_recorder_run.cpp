@@ -74,13 +74,19 @@ dynhet::node_status_t node(double wall_s, const std::string &state, int whole) {
   return m;
 }
 
-dynhet::overlap_t overlap(double a, bool final, int frame) {
-  dynhet::overlap_t m{};
+// What every result message of cutoff a at frame `frame` says about itself.
+template <class Msg> Msg result(double a, bool final, int frame) {
+  Msg m{};
   m.run_id = kRun;
   m.sim_time = 100 + 0.5 * frame;
   m.frame_index = frame;
   m.is_final = final;
   m.cutoff_a = a;
+  return m;
+}
+
+dynhet::overlap_t overlap(double a, bool final, int frame) {
+  auto m = result<dynhet::overlap_t>(a, final, frame);
   m.subbox_per_side = 1;
   m.subbox_particles = 4;
   m.n_lags = 2;
@@ -209,6 +215,73 @@ TEST(RunRecorder, MissingResultsAreNamed) {
             "timeout; overlap a1.8: no final result; frames: 1 of 3 lost by the recorder");
   EXPECT_EQ(Attr(f, "/", "frames_lost_recorder").values<int32_t>(), std::vector<int32_t>{1});
   EXPECT_EQ(h5read::shape(f, "/particles/all/position/value"), (Shape{2, 4, 2}));
+  std::remove(path.c_str());
+}
+
+// One S4 message of cutoff a: two grids (m = 2 and the whole box), two shells each, two lags.
+dynhet::s4_t s4(double a, bool final, int frame) {
+  auto m = result<dynhet::s4_t>(a, final, frame);
+  m.q_max = 1;
+  m.qxi_max = 1;
+  m.tau_alpha = NAN;
+  m.t_s4 = 1;
+  m.lag_index = 1;
+  m.n_origins = 1;
+  m.xi = a, m.chi0 = 2 * a;
+  m.n_grids = 2;
+  m.subbox_particles = {1, 4};
+  m.subbox_per_side = {2, 1};
+  m.grid_spacing = {1.5, 1.5};
+  m.grid_points = {4, 8};
+  m.n_shells = {2, 2};
+  for (auto *v : {&m.oz_chi0, &m.oz_chi0_err, &m.oz_xi, &m.oz_xi_err, &m.oz_q_fit_max, &m.a2_chi0, &m.a2_chi0_err,
+                  &m.a2_xi, &m.a2_xi_err, &m.a2_a, &m.a2_a_err, &m.a2_q_fit_max, &m.chi4, &m.chi4_err})
+    *v = {a, a};
+  m.oz_n_fit = {0, 2}, m.a2_n_fit = {0, 2};
+  m.n_values = 4;
+  m.q = {0, 1.2, 0.6, 1.2};
+  m.shell_vectors = {1, 8, 4, 8};
+  m.s4 = {a, a, NAN, a}, m.s4_err = {0, 0, NAN, 0};
+  m.n_lags = 2;
+  m.lag_time = {0.5, 1};
+  m.n_lag_values = 8;
+  m.s4_lag.assign(8, a);
+  m.n_lag_fits = 4;
+  m.xi_lag.assign(4, a), m.chi0_lag.assign(4, a);
+  return m;
+}
+
+// S4 depends on the cutoff: one group and one final result per cutoff, as overlap, chi4 and clusters.
+TEST(RunRecorder, S4IsRecordedPerCutoff) {
+  const std::string path = temp_file("s4");
+  dynhet::RunRecorder rec(path, "test");
+  auto info = run_info();
+  info.observables = {"s4"};
+  info.keep_frames = false;
+  ASSERT_TRUE(rec.on_run(info));
+  rec.on_sim_status(sim(1.0, "done", 101));
+  auto n = node(1.1, "done", 3);
+  n.node = "s4";
+  rec.on_node_status(n);
+  for (double a : {0.6, 1.8}) EXPECT_TRUE(rec.on_s4(s4(a, false, 1)));
+  EXPECT_TRUE(rec.on_s4(s4(0.6, true, 2)));
+  EXPECT_FALSE(rec.completion().settled()); // a1.8 has no final S4 yet
+  EXPECT_EQ(rec.completion().missing(), std::vector<std::string>{"s4 a1.8: no final result"});
+  EXPECT_TRUE(rec.on_s4(s4(1.8, true, 2)));
+  EXPECT_TRUE(rec.completion().settled());
+  EXPECT_TRUE(rec.finish().empty());
+
+  h5read::File f(path);
+  for (double a : {0.6, 1.8}) {
+    const std::string g = "/observables/s4/" + dynhet::cutoff_label(a);
+    EXPECT_EQ(Attr(f, g, "cutoff_a").values<double>(), std::vector<double>{a});
+    EXPECT_EQ(h5read::read<double>(f, g + "/lag_time"), (std::vector<double>{0.5, 1}));
+    EXPECT_EQ(h5read::read<int32_t>(f, g + "/subbox_per_side"), (std::vector<int32_t>{2, 1}));
+    EXPECT_EQ(h5read::shape(f, g + "/s4_lag/value"), (Shape{2, 8}));
+    EXPECT_EQ(h5read::shape(f, g + "/oz_xi/value"), (Shape{2, 2}));
+    EXPECT_EQ(h5read::read<double>(f, g + "/xi/value"), (std::vector<double>{a, a}));
+    EXPECT_EQ(h5read::read<int64_t>(f, g + "/chi0/step"), (std::vector<int64_t>{1, 2}));
+  }
   std::remove(path.c_str());
 }
 
