@@ -94,7 +94,8 @@ int main(int argc, char** argv) {
       dynhet::engine::Engine e(p);
       auto t0 = std::chrono::steady_clock::now();
       const std::string cached =
-          cache.empty() ? "" : cache + "/state_n" + std::to_string(n) + "_phi" + std::to_string(phi) + ".h5";
+          cache.empty() ? "" : cache + "/state_n" + std::to_string(n) + "_phi" + std::to_string(phi) +
+                                  (driven ? "_driven_eps" + std::to_string(eps) : "") + ".h5";
       double prep = -1; // -1: read from the cache
       try {
         const long k = tile_from > 0 ? std::lround(std::sqrt(double(n) / tile_from)) : 0;
