@@ -76,9 +76,15 @@ start() { # name, then the command; waits for its "ready" line
 
 echo "run_scene: $scene -> $out (bus $bus, $url)" >&2
 if [[ -n $record ]]; then
+  rm -f "$record"
   lcm-logger --lcm-url="$url" --force "$record" >"$out/lcm-logger.log" 2>&1 &
   logger_pid=$!
-  sleep 0.3
+  # lcm-logger says nothing when it is ready: it opens the log, then joins
+  # the bus. Wait for the file (a loaded machine can take a second), then a
+  # little more; a frame it missed would make the log, not the run, short.
+  for _ in $(seq 100); do [[ -e $record ]] && break; sleep 0.1; done
+  [[ -e $record ]] || { echo "run_scene: lcm-logger did not start:" >&2; cat "$out/lcm-logger.log" >&2; exit 1; }
+  sleep 0.5
 fi
 start recorder "$bin/recorder" --out "$out/run.h5"
 for n in $nodes; do start "$n" "$bin/$n"; done

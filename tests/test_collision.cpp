@@ -87,3 +87,25 @@ TEST(Calendar, TopIsAlwaysTheEarliestLeaf) {
     ASSERT_EQ(cal.top_time(), t[best]);
   }
 }
+
+TEST(Calendar, TiesGoToTheLowerLeafForEverySize) {
+  // Times from a few values (many ties), sizes around powers of 4; the top
+  // must be the earliest time and, among equal times, the lowest leaf
+  // (that order makes runs reproducible).
+  std::mt19937_64 gen(5);
+  for (int n : {1, 2, 3, 4, 5, 15, 16, 17, 63, 64, 65, 257, 1025}) {
+    Calendar cal;
+    cal.reset(n, kNever);
+    std::vector<double> t(n, kNever);
+    for (int step = 0; step < 20 * n + 100; ++step) {
+      const int leaf = static_cast<int>(gen() % n);
+      t[leaf] = (gen() % 5 == 0) ? kNever : static_cast<double>(gen() % 4);
+      cal.set(leaf, t[leaf]);
+      const int best = static_cast<int>(std::min_element(t.begin(), t.end()) - t.begin());
+      if (t[best] == kNever) continue;
+      ASSERT_EQ(cal.top(), best) << "n=" << n << " step=" << step;
+      ASSERT_EQ(cal.top_time(), t[best]);
+      ASSERT_EQ(cal.time(leaf), t[leaf]);
+    }
+  }
+}
