@@ -79,15 +79,18 @@ if [[ -n $record ]]; then
   rm -f "$record"
   lcm-logger --lcm-url="$url" --force "$record" >"$out/lcm-logger.log" 2>&1 &
   logger_pid=$!
-  # lcm-logger says nothing when it is ready: it opens the log, then joins
-  # the bus. Wait for the file (a loaded machine can take a second), then a
-  # little more; a frame it missed would make the log, not the run, short.
-  for _ in $(seq 100); do [[ -e $record ]] && break; sleep 0.1; done
-  [[ -e $record ]] || { echo "run_scene: lcm-logger did not start:" >&2; cat "$out/lcm-logger.log" >&2; exit 1; }
-  sleep 0.5
 fi
 start recorder "$bin/recorder" --out "$out/run.h5"
 for n in $nodes; do start "$n" "$bin/$n"; done
+if [[ -n $record ]]; then
+  # lcm-logger says nothing when it is ready. The nodes publish their status
+  # every second from the start: once the log holds anything (it is flushed
+  # every 0.1 s), the logger is on the bus and the sim may start. (Without
+  # this wait a loaded machine could start the sim before the logger had
+  # joined, and the log, not the run, missed the first frames.)
+  for _ in $(seq 150); do [[ -s $record ]] && break; sleep 0.1; done
+  [[ -s $record ]] || { echo "run_scene: lcm-logger records nothing:" >&2; cat "$out/lcm-logger.log" >&2; exit 1; }
+fi
 
 # The sim in the foreground (its progress line goes to the terminal and
 # sim_node.log).

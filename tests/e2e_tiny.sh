@@ -7,7 +7,7 @@
 set -euo pipefail
 root=$1 build=$2
 tmp=$(mktemp -d)
-trap 'rm -rf "$tmp"' EXIT
+trap 'rc=$?; ((rc)) && { echo "e2e: lcm-logger said:"; cat "$tmp/live/lcm-logger.log"; }; rm -rf "$tmp"' EXIT
 export BUILD_DIR=$build
 
 bash "$root/launch_scripts/run_scene.sh" "$root/scenes/tiny.toml" --out "$tmp/live" \
