@@ -77,7 +77,9 @@ start() { # name, then the command; waits for its "ready" line
 echo "run_scene: $scene -> $out (bus $bus, $url)" >&2
 if [[ -n $record ]]; then
   rm -f "$record"
-  lcm-logger --lcm-url="$url" --force "$record" >"$out/lcm-logger.log" 2>&1 &
+  # Ahead of the other processes where allowed (root): a starved lcm-logger
+  # drops what overflows its 30-message subscription queue.
+  nice -n -5 lcm-logger --lcm-url="$url" --force "$record" >"$out/lcm-logger.log" 2>&1 &
   logger_pid=$!
 fi
 start recorder "$bin/recorder" --out "$out/run.h5"
