@@ -185,10 +185,8 @@ private:
         m.subbox_per_side.push_back(spec_.grids[g].per_side);
         const auto& v = whole ? r.chi4_pooled : r.chi4;
         m.chi4.insert(m.chi4.end(), v.begin(), v.end());
-        if (whole)
-          m.chi4_err.insert(m.chi4_err.end(), nj, std::numeric_limits<double>::quiet_NaN());
-        else
-          m.chi4_err.insert(m.chi4_err.end(), r.chi4_err.begin(), r.chi4_err.end());
+        const auto& e = whole ? r.chi4_pooled_err : r.chi4_err;
+        m.chi4_err.insert(m.chi4_err.end(), e.begin(), e.end());
         m.chi4_peak.push_back(r.chi4_peak);
         m.tau4.push_back(r.tau4);
       }

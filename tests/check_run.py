@@ -241,6 +241,14 @@ def check_chi4(f, unwrapped, L, origin_frame, pair_frame):
                 chi = per_origin[:, :, 1].mean(axis=0)
             err = np.max(np.abs(chi - rec[gi]) / np.maximum(np.abs(chi), 1e-12))
             check(err < 1e-9, f"chi4 {name} m={m}: equals brute force (max rel diff {err:.2g})")
+            if m == 1 and len(origin_frame) >= 3:  # jackknife over origins of N var(Q)
+                q = per_origin[:, :, 0]
+                k = len(q)
+                loo = np.array([n * np.delete(q, i, axis=0).var(axis=0, ddof=1) for i in range(k)])
+                jk = np.sqrt((k - 1) / k * ((loo - loo.mean(axis=0)) ** 2).sum(axis=0))
+                got = g["chi4_err"]["value"][-1].reshape(len(sides), n_lags)[gi]
+                d = np.max(np.abs(jk - got) / np.maximum(jk, 1e-12))
+                check(d < 1e-6, f"chi4 {name} whole box: its jackknife error equals brute force (max rel diff {d:.2g})")
 
 
 def s4_shells_brute(x0, w, L, m, q_max, n_total):

@@ -114,6 +114,10 @@ TEST(Chi4, WholeBoxUsesTheVarianceOverOrigins) {
     EXPECT_NEAR(r.chi4[j], 0.0, 1e-12);
     const double f = (j + 1) / 3.0; // sample variance of {0.5, 0.6, 0.7} f is 0.01 f^2
     EXPECT_NEAR(r.chi4_pooled[j], 100 * 0.01 * f * f, 1e-12);
+    // Jackknife by hand: leaving out 0.5, 0.6 or 0.7 leaves sample variances
+    // 0.005, 0.02, 0.005 (times f^2), so N var = 0.5, 2, 0.5 f^2; their mean
+    // is f^2 and sqrt((n-1)/n sum (x - mean)^2) = sqrt(2/3 * 1.5) f^2 = f^2.
+    EXPECT_NEAR(r.chi4_pooled_err[j], f * f, 1e-12);
   }
   EXPECT_FALSE(std::isnan(r.chi4_peak));
   EXPECT_DOUBLE_EQ(r.tau4, 4.0); // grows to the last lag: the peak is at the end

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 
+#include "dynhet/analysis/fits.hpp"
 #include "dynhet/analysis/timescales.hpp"
 
 namespace dynhet::analysis {
@@ -24,6 +25,7 @@ Chi4Accumulator::Result Chi4Accumulator::result() const {
   const double nb = double(grid_.per_side) * grid_.per_side, big_n = grid_.mean_particles;
   Result r;
   r.chi4.assign(nj, kNaN), r.chi4_err.assign(nj, kNaN), r.chi4_pooled.assign(nj, kNaN);
+  r.chi4_pooled_err.assign(nj, kNaN);
   r.n_origins.assign(nj, 0);
   for (size_t j = 0; j < nj; ++j) {
     double sum = 0, sum_sq = 0, t1 = 0, t2 = 0;
@@ -41,6 +43,17 @@ Chi4Accumulator::Result Chi4Accumulator::result() const {
     if (n > 1) r.chi4_err[j] = std::sqrt(std::max(0.0, (sum_sq / n - r.chi4[j] * r.chi4[j]) / (n - 1)));
     const double boxes = n * nb;
     if (boxes > 1) r.chi4_pooled[j] = big_n * (t2 - t1 * t1 / boxes) / (boxes - 1);
+    if (n >= 3) {
+      std::vector<double> loo; // the pooled estimate without origin k
+      const double b = (n - 1) * nb;
+      for (int k = 0; k < n_origins_; ++k) {
+        const double s1 = s1_[index(k, static_cast<int>(j))], s2 = s2_[index(k, static_cast<int>(j))];
+        if (std::isnan(s1)) continue;
+        const double u1 = t1 - s1, u2 = t2 - s2;
+        loo.push_back(big_n * (u2 - u1 * u1 / b) / (b - 1));
+      }
+      r.chi4_pooled_err[j] = jackknife_error(loo);
+    }
   }
   const Peak p = find_peak(lag_, nb > 1 ? r.chi4 : r.chi4_pooled); // chi4^P at tau4
   r.chi4_peak = p.y, r.tau4 = p.t;

@@ -24,6 +24,9 @@ public:
     // the n/(n-1) correction): what chi4 means for the whole box (one
     // sub-box), where the within-origin variance is zero.
     std::vector<double> chi4_pooled;
+    // Its jackknife error over origins (leave one origin out; NaN with
+    // fewer than 3 origins).
+    std::vector<double> chi4_pooled_err;
     std::vector<int> n_origins;
     double chi4_peak, tau4; // chi4^P and tau4 (of chi4, or of chi4_pooled for one sub-box)
   };
