@@ -352,8 +352,7 @@ void Engine::place_random(double scale) {
     bool placed = false;
     for (int attempt = 0; attempt < 100000 && !placed; ++attempt) {
       const double x = rng_.uniform() * box_, y = rng_.uniform() * box_;
-      const int cx = std::min(nc_ - 1, static_cast<int>(x / cw_));
-      const int cy = std::min(nc_ - 1, static_cast<int>(y / cw_));
+      const int cx = cell_coord(x), cy = cell_coord(y);
       placed = true;
       for (int dy = -1; dy <= 1 && placed; ++dy)
         for (int dx = -1; dx <= 1 && placed; ++dx) {
