@@ -8,6 +8,7 @@
 // Rates are per second of this thread's CPU time, so that another process on
 // the machine does not change them (wall time is printed too).
 #include <chrono>
+#include <cstring>
 #include <ctime>
 #include <filesystem>
 #include <cmath>
@@ -66,7 +67,8 @@ int main(int argc, char** argv) {
   std::vector<long> ns{10000, 100000};
   std::vector<double> phis{0.60, 0.70, 0.78, 0.805};
   double coll_per_particle = 50, eps = 1.0, sync = 50.0;
-  bool driven = false;
+  bool driven = false, fingerprint = false;
+  double skin = dynhet::engine::Params{}.skin;
   std::string cache;
   long tile_from = 0;
   app.add_option("--n", ns, "particle numbers")->delimiter(',');
@@ -79,18 +81,23 @@ int main(int argc, char** argv) {
                  "keep compressed states here (HDF5 checkpoints) and start from them next time");
   app.add_option("--tile-from", tile_from,
                  "start N = k^2 B from the compressed state of B particles tiled k x k");
+  app.add_option("--skin", skin, "neighbour-list skin in small radii (0: automatic, from phi)");
+  app.add_flag("--fingerprint", fingerprint,
+               "after each row, print a hash of the final positions and the event counts: a change "
+               "that must not alter the trajectory keeps them");
   CLI11_PARSE(app, argc, argv);
 
   std::printf("# dynhet engine, one core; eps=%g, %s; timed over %g collisions per particle, "
               "synchronised every %g; rates per CPU second\n", eps, driven ? "driven" : "undriven",
               coll_per_particle, sync);
   std::printf("%9s %6s %9s %10s %10s %10s %10s %10s %9s %9s %8s %11s %8s %8s\n", "N", "phi", "prep_s", "coll/s",
-              "kicks/s", "cross/s", "stale/s", "events/s", "ns/coll", "B/part", "wall_s", "dE/E", "T_mean",
+              "kicks/s", "rebuild/s", "stale/s", "events/s", "ns/coll", "B/part", "wall_s", "dE/E", "T_mean",
               "T_sd");
   for (long n : ns)
     for (double phi : phis) {
       dynhet::engine::Params p = dynhet::engine::paper_params(n, phi, eps, driven);
       p.seed = 1;
+      p.skin = skin;
       dynhet::engine::Engine e(p);
       auto t0 = std::chrono::steady_clock::now();
       const std::string cached =
@@ -157,11 +164,24 @@ int main(int argc, char** argv) {
       const double wall = seconds(t0), cpu = cpu_seconds() - cpu0;
       const auto c1 = e.counters();
       const double coll = double(c1.collisions - c0.collisions), kicks = double(c1.kicks - c0.kicks);
-      const double cross = double(c1.cell_crossings - c0.cell_crossings), stale = double(c1.stale - c0.stale);
+      const double cross = double(c1.rebuilds - c0.rebuilds), stale = double(c1.stale - c0.stale);
       std::printf("%9ld %6.3f %9.2f %10.3g %10.3g %10.3g %10.3g %10.3g %9.1f %9.0f %8.1f %11.2e %8.4f %8.4f\n", n,
                   phi, prep, coll / cpu, kicks / cpu, cross / cpu, stale / cpu, (coll + kicks + cross + stale) / cpu,
                   1e9 * cpu / coll, bytes, wall,
                   eps == 1.0 && !driven ? e.kinetic_energy_per_particle() / e0 - 1 : NAN, temp.mean(), t_sd);
+      if (fingerprint) {
+        std::vector<double> xy;
+        e.unwrapped_positions(xy);
+        uint64_t h = 1469598103934665603ull; // FNV-1a over the bytes
+        for (const double v : xy) {
+          uint64_t b;
+          std::memcpy(&b, &v, sizeof b);
+          for (int k = 0; k < 8; ++k) h = (h ^ ((b >> (8 * k)) & 0xff)) * 1099511628211ull;
+        }
+        std::printf("#   fingerprint %016llx after %lld collisions, %lld kicks at t = %.17g\n",
+                    static_cast<unsigned long long>(h), static_cast<long long>(c1.collisions),
+                    static_cast<long long>(c1.kicks), e.time());
+      }
       std::fflush(stdout);
     }
   return 0;

@@ -76,7 +76,7 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
     put_attr(f, "kick_in", s.kick_in);
     put_attr(f, "collisions", s.counters.collisions);
     put_attr(f, "kicks", s.counters.kicks);
-    put_attr(f, "cell_crossings", s.counters.cell_crossings);
+    put_attr(f, "list_rebuilds", s.counters.rebuilds);
     put_attr(f, "stale", s.counters.stale);
     put_attr(f, "tc", s.counters.tc);
     put_attr(f, "virial", s.counters.virial);
@@ -116,7 +116,8 @@ Checkpoint read_checkpoint(const std::string& path) {
   s.kick_in = get_double(f, "kick_in");
   s.counters.collisions = get_int(f, "collisions");
   s.counters.kicks = get_int(f, "kicks");
-  s.counters.cell_crossings = get_int(f, "cell_crossings");
+  // Checkpoints from before the neighbour lists counted cell crossings instead.
+  s.counters.rebuilds = H5Aexists(f.id(), "list_rebuilds") > 0 ? get_int(f, "list_rebuilds") : 0;
   s.counters.stale = get_int(f, "stale");
   s.counters.tc = get_int(f, "tc");
   s.counters.virial = get_double(f, "virial");

@@ -14,6 +14,7 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
   if (n_ < 2) throw std::invalid_argument("engine: need at least 2 particles");
   const Model m = make_model(n_, p.packing_fraction, p.radius_ratio);
   box_ = m.box_length;
+  half_box_ = 0.5 * box_;
   for (int s = 0; s < 2; ++s) {
     radius_[s] = m.radius[s];
     mass_[s] = m.mass[s];
@@ -24,11 +25,21 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
   slot_of_.resize(n_);
   for (long i = 0; i < n_; ++i) id_[i] = slot_of_[i] = static_cast<int32_t>(i);
 
-  // Cells at least as wide as the largest contact distance, at least 3 a side.
-  nc_ = static_cast<int>(std::floor(box_ / (2.0 * std::max(radius_[0], radius_[1]))));
-  if (nc_ < 3)
+  if (!(p.skin >= 0) || !std::isfinite(p.skin))
+    throw std::invalid_argument("engine: the neighbour-list skin must be positive (or 0 for automatic), not " +
+                                std::to_string(p.skin));
+  list_margin_ = 1e-12 * box_;
+  const double widest = 2.0 * std::max(radius_[0], radius_[1]) + 2 * list_margin_;
+  skin_ = (p.skin > 0 ? p.skin : auto_skin(p.packing_fraction)) * radius_[0];
+  // An automatic skin narrows to let a small box hold 3 cells.
+  if (p.skin == 0) skin_ = std::max(0.0, std::min(skin_, 0.999 * (box_ / 3 - widest)));
+  // Cells over list centres at least as wide as the largest contact
+  // distance plus the skin, at least 3 a side.
+  nc_ = static_cast<int>(std::floor(box_ / (widest + skin_)));
+  if (nc_ < 3 || !(skin_ > 0))
     throw std::invalid_argument("engine: box of side " + std::to_string(box_) +
-                                " holds fewer than 3 cells; use more particles");
+                                " holds fewer than 3 cells of the largest contact distance plus the skin; "
+                                "use more particles or a thinner skin");
   cw_ = box_ / nc_;
 
   part_.assign(n_, Particle{0, 0, 0, 0, 0, kNever, 0, 0});
@@ -36,7 +47,9 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
   image_x_.assign(n_, 0);
   image_y_.assign(n_, 0);
   last_collision_.assign(n_, -kNever);
-  event_.assign(n_, Event{-1, kCross, 0});
+  event_.assign(n_, Event{-1, kRebuild, 0});
+  centre_.assign(n_, Centre{0, 0});
+  nbr_.assign(static_cast<size_t>(n_) * nbr_stride_, 0);
   kick_leaf_ = static_cast<int>(n_);
   cal_.reset(static_cast<int>(n_) + 1, kNever);
 }
@@ -108,11 +121,91 @@ void Engine::reorder() {
   build_cells();
 }
 
-void Engine::image_shift(int i, int j, double& sx, double& sy) const {
-  const int dx = cell_x_[j] - cell_x_[i];
-  const int dy = cell_y_[j] - cell_y_[i];
-  sx = dx > 1 ? -box_ : (dx < -1 ? box_ : 0.0);
-  sy = dy > 1 ? -box_ : (dy < -1 ? box_ : 0.0);
+// ---------------------------------------------------------------- lists
+
+void Engine::list_push(int i, int j) {
+  if (list(i)[0] == nbr_stride_ - 1) grow_lists();
+  int32_t* l = list(i);
+  l[++l[0]] = j;
+}
+
+void Engine::list_remove(int i, int j) {
+  int32_t* l = list(i);
+  int k = 1;
+  while (l[k] != j) ++k;
+  l[k] = l[l[0]--];
+}
+
+void Engine::grow_lists() {
+  const int old = nbr_stride_;
+  nbr_stride_ *= 2;
+  std::vector<int32_t, BigArrayAlloc<int32_t>> bigger(static_cast<size_t>(n_) * nbr_stride_, 0);
+  for (size_t i = 0; i < static_cast<size_t>(n_); ++i)
+    std::copy(&nbr_[i * old], &nbr_[i * old] + nbr_[i * old] + 1, &bigger[i * nbr_stride_]);
+  nbr_.swap(bigger);
+}
+
+bool Engine::near(int i, int j) const {
+  const double dx = min_image(centre_[i].x - centre_[j].x), dy = min_image(centre_[i].y - centre_[j].y);
+  const double reach = list_scale_ * (radius_[part_[i].species] + radius_[part_[j].species]) + skin_ + list_margin_;
+  return dx * dx + dy * dy <= reach * reach;
+}
+
+void Engine::wrap(int i) {
+  Particle& a = part_[i];
+  if (a.x >= box_) a.x -= box_, ++image_x_[i];
+  else if (a.x < 0) a.x += box_, --image_x_[i];
+  if (a.y >= box_) a.y -= box_, ++image_y_[i];
+  else if (a.y < 0) a.y += box_, --image_y_[i];
+}
+
+void Engine::build_lists() {
+  for (long i = 0; i < n_; ++i) {
+    wrap(static_cast<int>(i));
+    centre_[i] = Centre{part_[i].x, part_[i].y};
+    list(static_cast<int>(i))[0] = 0;
+  }
+  build_cells(); // over the centres
+  for (long il = 0; il < n_; ++il) {
+    const int i = static_cast<int>(il);
+    const int cx = cell_x_[i], cy = cell_y_[i];
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx) {
+        const int32_t* c = cell((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_);
+        for (int k = 1; k <= c[0]; ++k) {
+          const int j = c[k];
+          if (j > i && near(i, j)) list_push(i, j), list_push(j, i);
+        }
+      }
+  }
+}
+
+// i (synchronised) has reached the edge of its skin: it leaves its old
+// neighbours' lists, takes its position as its centre and lists everyone
+// whose centre is near, in both directions.
+void Engine::rebuild(int i) {
+  wrap(i);
+  {
+    const int32_t* l = list(i);
+    for (int k = 1; k <= l[0]; ++k) list_remove(l[k], i);
+  }
+  list(i)[0] = 0;
+  centre_[i] = Centre{part_[i].x, part_[i].y};
+  const int cx = cell_coord(centre_[i].x), cy = cell_coord(centre_[i].y);
+  if (cx != cell_x_[i] || cy != cell_y_[i]) {
+    cell_remove(i);
+    cell_insert(i, cx, cy);
+  }
+  for (int dy = -1; dy <= 1; ++dy)
+    for (int dx = -1; dx <= 1; ++dx) {
+      const int32_t* c = cell((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_);
+      for (int k = 1; k <= c[0]; ++k) {
+        const int j = c[k];
+        if (j != i && near(i, j)) list_push(i, j), list_push(j, i);
+      }
+    }
+  ++count_.rebuilds;
+  predict(i);
 }
 
 // ---------------------------------------------------------------- events
@@ -125,65 +218,41 @@ void Engine::sync(int i) {
   a.t = now_;
 }
 
-// Next event of particle i (synchronised to now): leaving its cell, or the
-// earliest collision with a particle of the 3x3 cells around it. A neighbour
+// Next event of particle i (synchronised to now): reaching the edge of its
+// skin, or the earliest collision with a particle of its list. A neighbour
 // for which the collision with i comes before its own next event takes it.
-// The candidates are gathered first and their cache lines requested all at
-// once: at large N each is a cache miss, and waiting for them one by one
-// would cost most of the time.
+// The neighbours' cache lines are requested all at once before any is
+// read: at large N each is a miss, and waiting for them one by one would
+// cost most of the time.
 void Engine::predict(int i) {
   const Particle& a = part_[i];
-  const int cx = cell_x_[i], cy = cell_y_[i];
+  const int32_t* l = list(i);
+  const int m = l[0];
+  for (int k = 1; k <= m; ++k) __builtin_prefetch(&part_[l[k]]);
 
-  // Leaving the cell: direction 0 (+x), 1 (-x), 2 (+y), 3 (-y).
+  // Leaving the disc of radius skin / 2 around the centre: the positive
+  // root of |d + v t|^2 = R^2, d = r - c, in the cancellation-free form.
   double best = kNever;
-  Event ev{-1, kCross, 0};
-  if (a.vx > 0) best = ((cx + 1) * cw_ - a.x) / a.vx, ev.partner = 0;
-  if (a.vx < 0) best = (cx * cw_ - a.x) / a.vx, ev.partner = 1;
-  if (a.vy != 0) {
-    const double ty = a.vy > 0 ? ((cy + 1) * cw_ - a.y) / a.vy : (cy * cw_ - a.y) / a.vy;
-    if (ty < best) best = ty, ev.partner = a.vy > 0 ? 2 : 3;
-  }
-  best = std::max(best, 0.0);
-
-  // Candidates and the periodic shift of each (index into sx[], sy[]).
-  constexpr int kMax = 512;
-  int32_t cand[kMax];
-  uint8_t shift[kMax];
-  int nc = 0;
-  double sxs[3], sys[3];
-  int nxs[3];
-  for (int d = 0; d < 3; ++d) {
-    const int x = cx + d - 1;
-    nxs[d] = x < 0 ? x + nc_ : (x >= nc_ ? x - nc_ : x);
-    sxs[d] = x < 0 ? -box_ : (x >= nc_ ? box_ : 0.0);
-    const int y = cy + d - 1;
-    sys[d] = y < 0 ? -box_ : (y >= nc_ ? box_ : 0.0);
-  }
-  for (int dy = 0; dy < 3; ++dy) {
-    const int y = cy + dy - 1, ny = y < 0 ? y + nc_ : (y >= nc_ ? y - nc_ : y);
-    for (int dx = 0; dx < 3; ++dx) {
-      const int32_t* c = cell(nxs[dx], ny);
-      const int m = c[0];
-      if (nc + m > kMax) throw std::logic_error("engine: more than 512 neighbour candidates");
-      for (int k = 1; k <= m; ++k) {
-        const int j = c[k];
-        __builtin_prefetch(&part_[j]);
-        cand[nc] = j;
-        shift[nc++] = static_cast<uint8_t>(3 * dy + dx);
-      }
+  {
+    const double dx = a.x - centre_[i].x, dy = a.y - centre_[i].y;
+    const double R = 0.5 * skin_;
+    const double b = dx * a.vx + dy * a.vy, v2 = a.vx * a.vx + a.vy * a.vy, c = dx * dx + dy * dy - R * R;
+    if (c >= 0) {
+      best = 0; // at the edge already (roundoff)
+    } else if (v2 > 0) {
+      const double root = std::sqrt(b * b - v2 * c);
+      best = b > 0 ? -c / (b + root) : (root - b) / v2;
     }
   }
+  Event ev{-1, kRebuild, 0};
 
   const double sig_i = radius_[a.species];
   const double sc = scale();
-  for (int k = 0; k < nc; ++k) {
-    const int j = cand[k];
-    if (j == i) continue;
+  for (int k = 1; k <= m; ++k) {
+    const int j = l[k];
     const Particle& b = part_[j];
-    const double sx = sxs[shift[k] % 3], sy = sys[shift[k] / 3];
     const double bdt = now_ - b.t;
-    const double ddx = a.x - (b.x + b.vx * bdt + sx), ddy = a.y - (b.y + b.vy * bdt + sy);
+    const double ddx = min_image(a.x - (b.x + b.vx * bdt)), ddy = min_image(a.y - (b.y + b.vy * bdt));
     const double rsum = sig_i + radius_[b.species];
     const double dt = pair_collision_time(ddx, ddy, a.vx - b.vx, a.vy - b.vy, sc * rsum, grow_ * rsum);
     if (dt == kNever) continue;
@@ -199,7 +268,13 @@ void Engine::predict(int i) {
 }
 
 // Every particle's event predicted again (the next kick stays).
+// Lists are built afresh for radii up to list_scale_: while compressing, a
+// round lasts at most one time unit (prepare()), so the radii reached by its
+// end; then 1.
 void Engine::clear_events() {
+  for (long i = 0; i < n_; ++i) sync(static_cast<int>(i));
+  list_scale_ = grow_ > 0 ? std::min(1.0, scale0_ + grow_ * (now_ + 1.0)) : scale0_;
+  build_lists();
   for (long i = 0; i < n_; ++i) set_event_time(static_cast<int>(i), kNever);
   for (long i = 0; i < n_; ++i) predict(static_cast<int>(i));
 }
@@ -207,8 +282,6 @@ void Engine::clear_events() {
 void Engine::collide(int i, int j) {
   sync(i);
   sync(j);
-  double sx, sy;
-  image_shift(i, j, sx, sy);
   Particle &a = part_[i], &b = part_[j];
   double eps = eps_;
   if (p_.tc > 0 && eps < 1.0 &&
@@ -217,7 +290,7 @@ void Engine::collide(int i, int j) {
     ++count_.tc;
   }
   last_collision_[i] = last_collision_[j] = now_;
-  const double impulse = collide_pair(a.x - (b.x + sx), a.y - (b.y + sy), mass_of(static_cast<int>(i)),
+  const double impulse = collide_pair(min_image(a.x - b.x), min_image(a.y - b.y), mass_of(static_cast<int>(i)),
                                       mass_of(j), eps, a.vx, a.vy, b.vx, b.vy, growth(i, j));
   count_.virial += sigma(i, j) * impulse;
   ++part_[i].coll;
@@ -225,29 +298,6 @@ void Engine::collide(int i, int j) {
   ++count_.collisions;
   predict(i);
   predict(j);
-}
-
-void Engine::cross(int i, int dir) {
-  sync(i);
-  Particle& a = part_[i];
-  int cx = cell_x_[i], cy = cell_y_[i];
-  switch (dir) {
-  case 0:
-    if (++cx == nc_) cx = 0, a.x -= box_, ++image_x_[i];
-    break;
-  case 1:
-    if (--cx < 0) cx = nc_ - 1, a.x += box_, --image_x_[i];
-    break;
-  case 2:
-    if (++cy == nc_) cy = 0, a.y -= box_, ++image_y_[i];
-    break;
-  default:
-    if (--cy < 0) cy = nc_ - 1, a.y += box_, --image_y_[i];
-  }
-  cell_remove(i);
-  cell_insert(i, cx, cy);
-  ++count_.cell_crossings;
-  predict(i);
 }
 
 // Driving (paper, section 2): a random pair gets opposite momenta
@@ -310,8 +360,9 @@ bool Engine::run_until(double t_abs, int64_t max_events) {
       continue;
     }
     const Event e = event_[leaf];
-    if (e.type == kCross) {
-      cross(leaf, e.partner);
+    if (e.type == kRebuild) {
+      sync(leaf);
+      rebuild(leaf);
     } else if (part_[e.partner].coll != e.partner_seen) {
       ++count_.stale;
       sync(leaf);
@@ -532,6 +583,9 @@ void Engine::unwrapped_positions(std::vector<double>& xy) const {
   }
 }
 
+// Cells hold the list centres, each within skin / 2 of its particle and
+// at least the largest contact distance plus the skin wide: every pair
+// closer than its contact distance sits in neighbouring cells.
 double Engine::min_gap_ratio() const {
   double best = kNever;
   for (long i = 0; i < n_; ++i) {
@@ -540,15 +594,13 @@ double Engine::min_gap_ratio() const {
     const int cx = cell_x_[i], cy = cell_y_[i];
     for (int dy = -1; dy <= 1; ++dy)
       for (int dx = -1; dx <= 1; ++dx) {
-        const double sx = cx + dx < 0 ? -box_ : (cx + dx >= nc_ ? box_ : 0.0);
-        const double sy = cy + dy < 0 ? -box_ : (cy + dy >= nc_ ? box_ : 0.0);
         const int32_t* c = cell((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_);
         for (int k = 1; k <= c[0]; ++k) {
           const int j = c[k];
           if (j <= i) continue;
           const auto& b = part_[j];
-          const double ddx = ax - (b.x + b.vx * (now_ - b.t) + sx);
-          const double ddy = ay - (b.y + b.vy * (now_ - b.t) + sy);
+          const double ddx = min_image(ax - (b.x + b.vx * (now_ - b.t)));
+          const double ddy = min_image(ay - (b.y + b.vy * (now_ - b.t)));
           best = std::min(best, std::sqrt(ddx * ddx + ddy * ddy) / sigma(static_cast<int>(i), j));
         }
       }
@@ -559,7 +611,7 @@ double Engine::min_gap_ratio() const {
 size_t Engine::memory_bytes() const {
   auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return b(part_) + b(species_by_id_) + b(id_) + b(slot_of_) + b(image_x_) + b(image_y_) + b(last_collision_) +
-         b(event_) + b(cells_) + b(cell_x_) + b(cell_y_) + cal_.bytes();
+         b(event_) + b(cells_) + b(cell_x_) + b(cell_y_) + b(nbr_) + b(centre_) + cal_.bytes();
 }
 
 double Engine::max_overlap() const { return 1.0 - min_gap_ratio(); }

@@ -2,11 +2,17 @@
 //
 // State as flat arrays; each particle carries its own clock (position at
 // its local time t, advanced only when the particle takes part in an
-// event). Neighbours come from a cell grid of width >= the largest contact
-// distance, so an event costs O(1) work plus an O(log N) calendar update.
-// Each particle holds one event (a collision with a partner, or leaving its
-// cell); a collision predicted with partner j is stale once j's collision
-// counter has moved on, and is then predicted again when it comes up.
+// event). Neighbours come from per-particle neighbour lists with a skin
+// (Donev, Torquato and Stillinger, J. Comput. Phys. 202, 737 (2005)): the
+// list of i was built when i stood at its centre c_i and holds every j with
+// |c_i - c_j| <= sigma_ij + skin; while each stays within skin / 2 of its
+// centre, no pair outside the lists can touch. Lists are symmetric. Leaving
+// that disc is i's "rebuild" event: only i's list is rebuilt, from a cell
+// grid over the centres. An event costs O(1) work plus an O(log N)
+// calendar update. Each particle holds one event (a collision with a
+// partner, or its rebuild); a collision predicted with partner j is stale
+// once j's collision counter has moved on, and is then predicted again
+// when it comes up.
 #pragma once
 
 #include <algorithm>
@@ -33,7 +39,20 @@ struct Params {
   // TC model against inelastic collapse: a collision within tc of either
   // particle's previous collision is elastic. 0: off.
   double tc = 0.0;
+  // Width of the neighbour-list skin, in small radii (the small radius is
+  // the unit of length); 0 picks auto_skin(packing_fraction). Only speed
+  // depends on it (bench_engine --skin).
+  double skin = 0;
 };
+
+// Fastest skin at N = 10^4 (bench_engine --skin, docs/engine.md): 1.5
+// small radii up to phi = 0.70, 0.7 from phi = 0.78, linear between. Denser
+// packings rattle in smaller cages, so a thinner skin is left as rarely.
+inline double auto_skin(double phi) {
+  if (phi <= 0.70) return 1.5;
+  if (phi >= 0.78) return 0.7;
+  return 1.5 + (phi - 0.70) / 0.08 * (0.7 - 1.5);
+}
 
 // The paper's system: radius ratio 1.43, kicks (if driven) at the Enskog
 // frequency with Henderson's contact value.
@@ -50,7 +69,7 @@ inline Params paper_params(long n, double phi, double eps, bool driven) {
 struct Counters {
   int64_t collisions = 0;
   int64_t kicks = 0;
-  int64_t cell_crossings = 0;
+  int64_t rebuilds = 0; // neighbour lists rebuilt one at a time (particle left its skin)
   int64_t stale = 0; // events found outdated and predicted again
   int64_t tc = 0;    // collisions made elastic by the TC model
   // Collision virial sum over collisions of sigma_ij * J_ij, J the normal
@@ -135,7 +154,7 @@ public:
   double min_gap_ratio() const;
 
 private:
-  enum EventType : int8_t { kCollision, kCross };
+  enum EventType : int8_t { kCollision, kRebuild };
   // What predicting a collision reads of a neighbour, in one cache line.
   struct alignas(64) Particle {
     double x, y, vx, vy, t; // position (in the box) at local time t, velocity
@@ -144,17 +163,19 @@ private:
     uint8_t species;
   };
   struct Event {
-    int32_t partner;       // collision partner, or direction of the cell crossing 0..3
+    int32_t partner;       // collision partner (-1 for a rebuild)
     EventType type;
     uint64_t partner_seen; // partner's collision counter when this was predicted
   };
 
   void build_cells();
+  void build_lists(); // every list afresh, centres at the positions now (all synchronised)
   void clear_events();
   void predict(int i);
   void sync(int i);
   void collide(int i, int j);
-  void cross(int i, int dir);
+  void rebuild(int i); // i left its skin: new centre, new list
+  void wrap(int i);    // back into the box, counting the image
   void kick();
   void rebase();
   // Contact distance now, and its growth rate (compression only).
@@ -175,12 +196,19 @@ private:
   const int32_t* cell(int cx, int cy) const {
     return &cells_[static_cast<size_t>(cell_index(cx, cy)) * cell_stride_];
   }
+  int32_t* list(int i) { return &nbr_[static_cast<size_t>(i) * nbr_stride_]; }
+  const int32_t* list(int i) const { return &nbr_[static_cast<size_t>(i) * nbr_stride_]; }
+  void list_push(int i, int j);
+  void list_remove(int i, int j);
+  void grow_lists();
+  // Whether the centres of i and j are close enough to be listed.
+  bool near(int i, int j) const;
+  // Nearest periodic image of a separation component.
+  double min_image(double d) const { return d > half_box_ ? d - box_ : (d < -half_box_ ? d + box_ : d); }
   void cell_insert(int i, int cx, int cy);
   void cell_remove(int i);
   void clear_cells();
   void grow_cells(); // twice the capacity per cell, contents and their order kept
-  // Shift to add to j's position so that it is the image next to i.
-  void image_shift(int i, int j, double& sx, double& sy) const;
   void place_random(double scale);
   // Renumbers the storage slots in cell order (ties by particle id), so
   // that neighbours sit close in memory; then rebuilds the cells.
@@ -188,7 +216,7 @@ private:
 
   Params p_;
   long n_;
-  double box_;
+  double box_, half_box_;
   double radius_[2], mass_[2];
   // Radii are scale() * radius_; scale() = scale0_ + grow_ * now_ grows
   // only while compressing.
@@ -204,11 +232,22 @@ private:
   std::vector<double> last_collision_; // internal time of each particle's last collision (TC model)
   std::vector<Event, BigArrayAlloc<Event>> event_;
 
+  // Neighbour lists: i's is nbr_[i * nbr_stride_ ...], its count then the
+  // slots of its neighbours, one cache line while it holds up to 15.
+  std::vector<int32_t, BigArrayAlloc<int32_t>> nbr_;
+  int nbr_stride_ = 16;
+  struct Centre {
+    double x, y;
+  };
+  std::vector<Centre> centre_;
+  double skin_;         // absolute
+  double list_scale_ = 1; // radii scale the lists hold for (below 1 only while compressing)
+  double list_margin_;  // roundoff allowance in the list criterion
+
   int nc_ = 0;   // cells per side
   double cw_ = 0; // cell width
-  // Cells as fixed-capacity arrays, not linked lists, so that predicting
-  // reads a cell's members in one cache line and can fetch all neighbours at
-  // once: cell c is cells_[c * cell_stride_ ...], first its count, then the
+  // Cells over the list centres, as fixed-capacity arrays, not linked
+  // lists: cell c is cells_[c * cell_stride_ ...], first its count, then the
   // slots of its particles. cell_x_, cell_y_ are each particle's cell.
   std::vector<int32_t, BigArrayAlloc<int32_t>> cells_;
   int cell_stride_ = 16; // one cache line: a count and up to 15 members
