@@ -27,9 +27,14 @@ public:
     size_t width = 1, internal = 0;
     while (width < static_cast<size_t>(n_leaves)) internal += width, width *= 4;
     first_leaf_ = kRoot + internal;
-    node_.assign(first_leaf_ + width, Node{never, 0});
-    for (size_t i = 0; i < width; ++i) node_[first_leaf_ + i].leaf = static_cast<int32_t>(i);
-    for (size_t p = first_leaf_; p-- > kRoot;) node_[p] = pick_children(p);
+    // Only the leaves in use are stored (rounded up to a group of four):
+    // an internal node whose children would all lie beyond them stays
+    // "never" and is never on a leaf's path.
+    const size_t leaves = (static_cast<size_t>(n_leaves) + 3) / 4 * 4;
+    node_.assign(first_leaf_ + leaves, Node{never, 0});
+    for (size_t i = 0; i < leaves; ++i) node_[first_leaf_ + i].leaf = static_cast<int32_t>(i);
+    for (size_t p = first_leaf_; p-- > kRoot;)
+      node_[p] = 4 * p - 8 < node_.size() ? pick_children(p) : Node{never, static_cast<int32_t>(leaves)};
   }
   size_t bytes() const { return node_.capacity() * sizeof(Node); }
   int top() const { return node_[kRoot].leaf; }

@@ -92,7 +92,7 @@ struct State {
   double time = 0;
   double kick_in = 0; // time until the next kick; infinite if not driven
   std::vector<double> x, y, vx, vy;
-  std::vector<double> last_collision; // minus the time since each particle's last collision
+  std::vector<double> last_collision; // minus the time since each particle's last collision (TC model on; else -inf)
   std::vector<int32_t> image_x, image_y;
   std::vector<uint64_t> collision_count;
   uint64_t rng[4] = {0, 0, 0, 0};
@@ -229,7 +229,7 @@ private:
   std::vector<uint8_t> species_by_id_;
   std::vector<int32_t> id_, slot_of_;
   std::vector<int32_t> image_x_, image_y_;
-  std::vector<double> last_collision_; // internal time of each particle's last collision (TC model)
+  std::vector<double> last_collision_; // internal time of each particle's last collision; kept only with the TC model on
   std::vector<Event, BigArrayAlloc<Event>> event_;
 
   // Neighbour lists: i's is nbr_[i * nbr_stride_ ...], its count then the
