@@ -90,8 +90,8 @@ int main(int argc, char** argv) {
   std::printf("# dynhet engine, one core; eps=%g, %s; timed over %g collisions per particle, "
               "synchronised every %g; rates per CPU second\n", eps, driven ? "driven" : "undriven",
               coll_per_particle, sync);
-  std::printf("%9s %6s %9s %10s %10s %10s %10s %10s %9s %9s %8s %11s %8s %8s\n", "N", "phi", "prep_s", "coll/s",
-              "kicks/s", "rebuild/s", "stale/s", "events/s", "ns/coll", "B/part", "wall_s", "dE/E", "T_mean",
+  std::printf("%9s %6s %9s %10s %10s %10s %10s %10s %9s %9s %5s %8s %11s %8s %8s\n", "N", "phi", "prep_s", "coll/s",
+              "kicks/s", "rebuild/s", "stale/s", "events/s", "ns/coll", "B/part", "nbrs", "wall_s", "dE/E", "T_mean",
               "T_sd");
   for (long n : ns)
     for (double phi : phis) {
@@ -165,9 +165,9 @@ int main(int argc, char** argv) {
       const auto c1 = e.counters();
       const double coll = double(c1.collisions - c0.collisions), kicks = double(c1.kicks - c0.kicks);
       const double cross = double(c1.rebuilds - c0.rebuilds), stale = double(c1.stale - c0.stale);
-      std::printf("%9ld %6.3f %9.2f %10.3g %10.3g %10.3g %10.3g %10.3g %9.1f %9.0f %8.1f %11.2e %8.4f %8.4f\n", n,
+      std::printf("%9ld %6.3f %9.2f %10.3g %10.3g %10.3g %10.3g %10.3g %9.1f %9.0f %5.2f %8.1f %11.2e %8.4f %8.4f\n", n,
                   phi, prep, coll / cpu, kicks / cpu, cross / cpu, stale / cpu, (coll + kicks + cross + stale) / cpu,
-                  1e9 * cpu / coll, bytes, wall,
+                  1e9 * cpu / coll, bytes, e.mean_neighbours(), wall,
                   eps == 1.0 && !driven ? e.kinetic_energy_per_particle() / e0 - 1 : NAN, temp.mean(), t_sd);
       if (fingerprint) {
         std::vector<double> xy;

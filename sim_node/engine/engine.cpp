@@ -614,6 +614,12 @@ double Engine::min_gap_ratio() const {
   return best;
 }
 
+double Engine::mean_neighbours() const {
+  double sum = 0;
+  for (long i = 0; i < n_; ++i) sum += list(static_cast<int>(i))[0];
+  return sum / n_;
+}
+
 size_t Engine::memory_bytes() const {
   auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return b(part_) + b(species_by_id_) + b(id_) + b(slot_of_) + b(image_x_) + b(image_y_) + b(last_collision_) +

@@ -133,6 +133,8 @@ public:
 
   double time() const { return offset_ + now_; }
   long size() const { return n_; }
+  // Mean length of the neighbour lists, for the benchmark.
+  double mean_neighbours() const;
   // Bytes held by the engine's arrays (their capacities), for the benchmark.
   size_t memory_bytes() const;
   double box_length() const { return box_; }
