@@ -224,11 +224,16 @@ void Engine::sync(int i) {
 // The neighbours' cache lines are requested all at once before any is
 // read: at large N each is a miss, and waiting for them one by one would
 // cost most of the time.
+void Engine::prefetch_neighbours(int i) const {
+  const int32_t* l = list(i);
+  for (int k = 1; k <= l[0]; ++k) __builtin_prefetch(&part_[l[k]]);
+}
+
 void Engine::predict(int i) {
   const Particle& a = part_[i];
   const int32_t* l = list(i);
   const int m = l[0];
-  for (int k = 1; k <= m; ++k) __builtin_prefetch(&part_[l[k]]);
+  prefetch_neighbours(i);
 
   // Leaving the disc of radius skin / 2 around the centre: the positive
   // root of |d + v t|^2 = R^2, d = r - c, in the cancellation-free form.
@@ -296,6 +301,7 @@ void Engine::collide(int i, int j) {
   ++part_[i].coll;
   ++part_[j].coll;
   ++count_.collisions;
+  prefetch_neighbours(j); // arriving while i's prediction computes
   predict(i);
   predict(j);
 }
@@ -359,12 +365,17 @@ bool Engine::run_until(double t_abs, int64_t max_events) {
       kick();
       continue;
     }
-    const Event e = event_[leaf];
-    // Lines the event will need, requested before the first is waited for.
+    // Lines the event will need, requested before the first is waited for:
+    // the particle, its list and its calendar path, then, once the event
+    // says who the partner is, the same for the partner.
+    __builtin_prefetch(&part_[leaf]);
     __builtin_prefetch(&nbr_[static_cast<size_t>(leaf) * nbr_stride_]);
+    cal_.prefetch_path(leaf);
+    const Event e = event_[leaf];
     if (e.partner >= 0) {
       __builtin_prefetch(&part_[e.partner]);
       __builtin_prefetch(&nbr_[static_cast<size_t>(e.partner) * nbr_stride_]);
+      cal_.prefetch_path(e.partner);
     }
     if (e.type == kRebuild) {
       sync(leaf);

@@ -43,11 +43,14 @@ public:
   // A time that comes earlier climbs while it wins; one that comes later is
   // replayed only where the leaf was the winner. Either loop stops at the
   // first node that does not change.
+  // Requests the lines of a leaf's path to the root (those a set() of it
+  // will read), all at once rather than one miss after another.
+  void prefetch_path(int leaf) const {
+    for (size_t q = first_leaf_ + leaf; q > kRoot; q = q / 4 + 2) __builtin_prefetch(&node_[q]);
+  }
   void set(int leaf, double t) {
     size_t p = first_leaf_ + leaf;
-    // The path to the root is known in advance: request its lines at once
-    // rather than one miss after another.
-    for (size_t q = p / 4 + 2; q > kRoot; q = q / 4 + 2) __builtin_prefetch(&node_[q]);
+    prefetch_path(leaf);
     const double old = node_[p].time;
     node_[p].time = t;
     if (t <= old) {

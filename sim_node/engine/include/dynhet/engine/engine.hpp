@@ -174,6 +174,7 @@ private:
   void build_lists(); // every list afresh, centres at the positions now (all synchronised)
   void clear_events();
   void predict(int i);
+  void prefetch_neighbours(int i) const;
   void sync(int i);
   void collide(int i, int j);
   void rebuild(int i); // i left its skin: new centre, new list
