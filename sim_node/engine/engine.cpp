@@ -370,11 +370,13 @@ bool Engine::run_until(double t_abs, int64_t max_events) {
     // says who the partner is, the same for the partner.
     __builtin_prefetch(&part_[leaf]);
     __builtin_prefetch(&nbr_[static_cast<size_t>(leaf) * nbr_stride_]);
+    __builtin_prefetch(&centre_[leaf]);
     cal_.prefetch_path(leaf);
     const Event e = event_[leaf];
     if (e.partner >= 0) {
       __builtin_prefetch(&part_[e.partner]);
       __builtin_prefetch(&nbr_[static_cast<size_t>(e.partner) * nbr_stride_]);
+      __builtin_prefetch(&centre_[e.partner]);
       cal_.prefetch_path(e.partner);
     }
     if (e.type == kRebuild) {
