@@ -42,12 +42,11 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
                                 "use more particles or a thinner skin");
   cw_ = box_ / nc_;
 
-  part_.assign(n_, Particle{0, 0, 0, 0, 0, kNever, 0, 0});
+  part_.assign(n_, Particle{0, 0, 0, 0, 0, kNever, 0, 0, kRebuild, 0});
   for (long i = 0; i < n_; ++i) part_[i].species = species_by_id_[i];
   image_x_.assign(n_, 0);
   image_y_.assign(n_, 0);
   last_collision_.assign(n_, -kNever);
-  event_.assign(n_, Event{-1, kRebuild, 0});
   centre_.assign(n_, Centre{0, 0});
   nbr_.assign(static_cast<size_t>(n_) * nbr_stride_, 0);
   kick_leaf_ = static_cast<int>(n_);
@@ -249,7 +248,8 @@ void Engine::predict(int i) {
       best = b > 0 ? -c / (b + root) : (root - b) / v2;
     }
   }
-  Event ev{-1, kRebuild, 0};
+  int32_t partner = kRebuild;
+  uint32_t partner_seen = 0;
 
   const double sig_i = radius_[a.species];
   const double sc = scale();
@@ -262,13 +262,15 @@ void Engine::predict(int i) {
     const double dt = pair_collision_time(ddx, ddy, a.vx - b.vx, a.vy - b.vy, sc * rsum, grow_ * rsum);
     if (dt == kNever) continue;
     const double t = now_ + dt;
-    if (dt < best) best = dt, ev = Event{j, kCollision, b.coll};
+    if (dt < best) best = dt, partner = j, partner_seen = seen(b.coll);
     if (t < b.event_time) {
-      event_[j] = Event{i, kCollision, a.coll};
+      part_[j].partner = i;
+      part_[j].partner_seen = seen(a.coll);
       set_event_time(j, t);
     }
   }
-  event_[i] = ev;
+  part_[i].partner = partner;
+  part_[i].partner_seen = partner_seen;
   set_event_time(i, now_ + best);
 }
 
@@ -366,28 +368,26 @@ bool Engine::run_until(double t_abs, int64_t max_events) {
       continue;
     }
     // Lines the event will need, requested before the first is waited for:
-    // the particle, its list and its calendar path, then, once the event
-    // says who the partner is, the same for the partner.
-    __builtin_prefetch(&part_[leaf]);
+    // the list, centre and calendar path of the particle, then, once its
+    // line says who the partner is, the same for the partner.
     __builtin_prefetch(&nbr_[static_cast<size_t>(leaf) * nbr_stride_]);
     __builtin_prefetch(&centre_[leaf]);
     cal_.prefetch_path(leaf);
-    const Event e = event_[leaf];
-    if (e.partner >= 0) {
-      __builtin_prefetch(&part_[e.partner]);
-      __builtin_prefetch(&nbr_[static_cast<size_t>(e.partner) * nbr_stride_]);
-      __builtin_prefetch(&centre_[e.partner]);
-      cal_.prefetch_path(e.partner);
-    }
-    if (e.type == kRebuild) {
+    const int partner = part_[leaf].partner;
+    if (partner == kRebuild) {
       sync(leaf);
       rebuild(leaf);
-    } else if (part_[e.partner].coll != e.partner_seen) {
+      continue;
+    }
+    __builtin_prefetch(&nbr_[static_cast<size_t>(partner) * nbr_stride_]);
+    __builtin_prefetch(&centre_[partner]);
+    cal_.prefetch_path(partner);
+    if (seen(part_[partner].coll) != part_[leaf].partner_seen) {
       ++count_.stale;
       sync(leaf);
       predict(leaf);
     } else {
-      collide(leaf, e.partner);
+      collide(leaf, partner);
     }
   }
   return false;
@@ -558,7 +558,8 @@ void Engine::restore(const State& s) {
   now_ = 0;
   events_since_rebase_ = 0;
   for (long i = 0; i < n_; ++i) {
-    part_[i] = Particle{s.x[i], s.y[i], s.vx[i], s.vy[i], 0.0, kNever, s.collision_count[i], species_by_id_[i]};
+    part_[i] = Particle{s.x[i], s.y[i], s.vx[i], s.vy[i], 0.0, kNever, s.collision_count[i], species_by_id_[i],
+                        kRebuild, 0};
     last_collision_[i] = s.last_collision[i];
   }
   image_x_ = s.image_x;
@@ -636,7 +637,7 @@ double Engine::mean_neighbours() const {
 size_t Engine::memory_bytes() const {
   auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return b(part_) + b(species_by_id_) + b(id_) + b(slot_of_) + b(image_x_) + b(image_y_) + b(last_collision_) +
-         b(event_) + b(cells_) + b(cell_x_) + b(cell_y_) + b(nbr_) + b(centre_) + cal_.bytes();
+         b(cells_) + b(cell_x_) + b(cell_y_) + b(nbr_) + b(centre_) + cal_.bytes();
 }
 
 double Engine::max_overlap() const { return 1.0 - min_gap_ratio(); }

@@ -156,19 +156,24 @@ public:
   double min_gap_ratio() const;
 
 private:
-  enum EventType : int8_t { kCollision, kRebuild };
-  // What predicting a collision reads of a neighbour, in one cache line.
+  // What predicting a collision reads of a neighbour, and what its own
+  // event needs, in one cache line: an event coming up costs one miss for
+  // the particle, not two.
   struct alignas(64) Particle {
     double x, y, vx, vy, t; // position (in the box) at local time t, velocity
     double event_time;      // its next event (a copy of its calendar leaf)
-    uint64_t coll;          // collision counter (also counts kicks): staleness of predictions
-    uint8_t species;
+    uint64_t coll : 63;     // collision counter (also counts kicks): staleness of predictions
+    uint64_t species : 1;
+    // The next event: a collision with `partner`, or (partner < 0) the
+    // rebuild of its list. `partner_seen` is the low 32 bits of the
+    // partner's counter when it was predicted: the prediction is stale once
+    // they differ. (It would pass as current only if the partner made a
+    // multiple of 2^32 = 4.3e9 collisions in between.)
+    int32_t partner;
+    uint32_t partner_seen;
   };
-  struct Event {
-    int32_t partner;       // collision partner (-1 for a rebuild)
-    EventType type;
-    uint64_t partner_seen; // partner's collision counter when this was predicted
-  };
+  static constexpr int32_t kRebuild = -1;
+  static uint32_t seen(uint64_t coll) { return static_cast<uint32_t>(coll); }
 
   void build_cells();
   void build_lists(); // every list afresh, centres at the positions now (all synchronised)
@@ -233,7 +238,6 @@ private:
   std::vector<int32_t> id_, slot_of_;
   std::vector<int32_t> image_x_, image_y_;
   std::vector<double> last_collision_; // internal time of each particle's last collision; kept only with the TC model on
-  std::vector<Event, BigArrayAlloc<Event>> event_;
 
   // Neighbour lists: i's is nbr_[i * nbr_stride_ ...], its count then the
   // slots of its neighbours, one cache line while it holds up to 15.
