@@ -184,25 +184,46 @@ void Engine::build_lists() {
 // whose centre is near, in both directions.
 void Engine::rebuild(int i) {
   wrap(i);
+  const int cx = cell_coord(part_[i].x), cy = cell_coord(part_[i].y);
+  // Every line this needs is a miss at large N: the old neighbours' lists
+  // and the 9 cells are requested first, then the candidates' centres and
+  // particles, each group before any of it is waited for.
+  int cells[9]; // as indices: inserting i below may reallocate the cells
+  for (int dy = 0; dy < 3; ++dy)
+    for (int dx = 0; dx < 3; ++dx) {
+      const int x = cx + dx - 1, y = cy + dy - 1;
+      cells[3 * dy + dx] =
+          cell_index(x < 0 ? x + nc_ : (x >= nc_ ? x - nc_ : x), y < 0 ? y + nc_ : (y >= nc_ ? y - nc_ : y));
+      __builtin_prefetch(&cells_[static_cast<size_t>(cells[3 * dy + dx]) * cell_stride_]);
+    }
   {
     const int32_t* l = list(i);
+    for (int k = 1; k <= l[0]; ++k) __builtin_prefetch(list(l[k]));
     for (int k = 1; k <= l[0]; ++k) list_remove(l[k], i);
   }
   list(i)[0] = 0;
   centre_[i] = Centre{part_[i].x, part_[i].y};
-  const int cx = cell_coord(centre_[i].x), cy = cell_coord(centre_[i].y);
   if (cx != cell_x_[i] || cy != cell_y_[i]) {
     cell_remove(i);
     cell_insert(i, cx, cy);
   }
-  for (int dy = -1; dy <= 1; ++dy)
-    for (int dx = -1; dx <= 1; ++dx) {
-      const int32_t* c = cell((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_);
-      for (int k = 1; k <= c[0]; ++k) {
-        const int j = c[k];
-        if (j != i && near(i, j)) list_push(i, j), list_push(j, i);
-      }
+  constexpr int kMax = 512;
+  int32_t cand[kMax];
+  int nc = 0;
+  for (const int ci : cells) {
+    const int32_t* c = &cells_[static_cast<size_t>(ci) * cell_stride_];
+    if (nc + c[0] > kMax) throw std::logic_error("engine: more than 512 list candidates");
+    for (int k = 1; k <= c[0]; ++k) {
+      const int j = c[k];
+      __builtin_prefetch(&centre_[j]);
+      __builtin_prefetch(&part_[j]);
+      cand[nc++] = j;
     }
+  }
+  for (int k = 0; k < nc; ++k) {
+    const int j = cand[k];
+    if (j != i && near(i, j)) list_push(i, j), list_push(j, i);
+  }
   ++count_.rebuilds;
   predict(i);
 }
