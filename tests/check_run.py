@@ -568,10 +568,22 @@ def main(path, scene_path):
         same = np.allclose(tau_t0, tau_t0_bf, rtol=1e-9, atol=0, equal_nan=True)
         check(same, f"{name}: tau_alpha(t0) per origin equals brute force")
         beta, tau0 = float(g["beta"]["value"][-1]), float(g["tau0"]["value"][-1])
-        # The fit (unweighted here: early lags have zero error) is a least-squares
-        # minimum: nudging either parameter by 0.1% does not lower the residual.
+        # The fit is a least-squares minimum of the node's objective: nudging
+        # either parameter by 0.1% does not lower the residual. The node weights
+        # by the recorded errors if every lag has a positive one, errors below
+        # 1e-9 of the largest (Q = 1 at every origin) raised to the smallest
+        # other; else it does not weight.
+        q_err = g["q_err"]["value"][-1]
+        use = np.isfinite(q_rec) & (lag > 0)
+        e = q_err[use]
+        if np.all(np.isfinite(e) & (e > 0)):
+            real = e[e > 1e-9 * e.max()]
+            e = np.maximum(e, real.min()) if len(real) else np.ones_like(e)
+        else:
+            e = np.ones_like(e)
+
         def sse(b_, t_):
-            return np.sum((q_bf - 1 / ((lag / t_) ** b_ + 1)) ** 2)
+            return np.sum(((q_rec[use] - 1 / ((lag[use] / t_) ** b_ + 1)) / e) ** 2)
         best = sse(beta, tau0)
         nudged = min(sse(beta * f1, tau0 * f2) for f1 in (0.999, 1, 1.001) for f2 in (0.999, 1, 1.001)
                      if (f1, f2) != (1, 1))
