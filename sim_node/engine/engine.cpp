@@ -339,6 +339,14 @@ void Engine::kick() {
   int b = static_cast<int>(rng_.below(n_ - 1));
   if (b >= a) ++b;
   const int i = slot_of_[a], j = slot_of_[b]; // drawn by particle id
+  // Two particles anywhere in memory: everything both will need is
+  // requested before either is read.
+  for (const int s : {i, j}) {
+    __builtin_prefetch(&part_[s]);
+    __builtin_prefetch(&nbr_[static_cast<size_t>(s) * nbr_stride_]);
+    __builtin_prefetch(&centre_[s]);
+    cal_.prefetch_path(s);
+  }
   double kx, ky;
   rng_.normal_pair(kx, ky);
   const double p = kick_amplitude(eps_, mass_[0], mass_[1]);
