@@ -48,7 +48,7 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
   image_y_.assign(n_, 0);
   last_collision_.assign(n_, -kNever);
   centre_.assign(n_, Centre{0, 0});
-  nbr_.assign(static_cast<size_t>(n_) * nbr_stride_, 0);
+  nbr_.reset(static_cast<size_t>(n_));
   kick_leaf_ = static_cast<int>(n_);
   cal_.reset(static_cast<int>(n_) + 1, kNever);
 }
@@ -62,33 +62,23 @@ double Engine::packing_fraction() const {
 // ---------------------------------------------------------------- cells
 
 void Engine::cell_insert(int i, int cx, int cy) {
-  if (cell(cx, cy)[0] == cell_stride_ - 1) grow_cells();
-  int32_t* c = cell(cx, cy);
-  c[++c[0]] = i;
+  cells_.push(cell_index(cx, cy), i);
   cell_x_[i] = cx;
   cell_y_[i] = cy;
 }
 
-// Swaps the last member into i's place: the order within a cell depends only
-// on the sequence of inserts and removals, not on the capacity.
-void Engine::cell_remove(int i) {
-  int32_t* c = cell(cell_x_[i], cell_y_[i]);
-  int k = 1;
-  while (c[k] != i) ++k;
-  c[k] = c[c[0]--];
-}
+void Engine::cell_remove(int i) { cells_.remove(cell_index(cell_x_[i], cell_y_[i]), i); }
 
-void Engine::grow_cells() {
-  const int old = cell_stride_;
-  cell_stride_ *= 2;
-  std::vector<int32_t, BigArrayAlloc<int32_t>> bigger(static_cast<size_t>(nc_) * nc_ * cell_stride_, 0);
-  for (size_t c = 0; c < static_cast<size_t>(nc_) * nc_; ++c)
-    std::copy(&cells_[c * old], &cells_[c * old] + cells_[c * old] + 1, &bigger[c * cell_stride_]);
-  cells_.swap(bigger);
+void Engine::cells_around(int cx, int cy, int out[9]) const {
+  for (int dy = 0; dy < 3; ++dy)
+    for (int dx = 0; dx < 3; ++dx) {
+      const int x = cx + dx - 1, y = cy + dy - 1;
+      out[3 * dy + dx] = cell_index(x < 0 ? x + nc_ : (x >= nc_ ? x - nc_ : x), y < 0 ? y + nc_ : (y >= nc_ ? y - nc_ : y));
+    }
 }
 
 void Engine::clear_cells() {
-  cells_.assign(static_cast<size_t>(nc_) * nc_ * cell_stride_, 0);
+  cells_.reset(static_cast<size_t>(nc_) * nc_);
   cell_x_.assign(n_, 0);
   cell_y_.assign(n_, 0);
 }
@@ -122,28 +112,6 @@ void Engine::reorder() {
 
 // ---------------------------------------------------------------- lists
 
-void Engine::list_push(int i, int j) {
-  if (list(i)[0] == nbr_stride_ - 1) grow_lists();
-  int32_t* l = list(i);
-  l[++l[0]] = j;
-}
-
-void Engine::list_remove(int i, int j) {
-  int32_t* l = list(i);
-  int k = 1;
-  while (l[k] != j) ++k;
-  l[k] = l[l[0]--];
-}
-
-void Engine::grow_lists() {
-  const int old = nbr_stride_;
-  nbr_stride_ *= 2;
-  std::vector<int32_t, BigArrayAlloc<int32_t>> bigger(static_cast<size_t>(n_) * nbr_stride_, 0);
-  for (size_t i = 0; i < static_cast<size_t>(n_); ++i)
-    std::copy(&nbr_[i * old], &nbr_[i * old] + nbr_[i * old] + 1, &bigger[i * nbr_stride_]);
-  nbr_.swap(bigger);
-}
-
 bool Engine::near(int i, int j) const {
   const double dx = min_image(centre_[i].x - centre_[j].x), dy = min_image(centre_[i].y - centre_[j].y);
   const double reach = list_scale_ * (radius_[part_[i].species] + radius_[part_[j].species]) + skin_ + list_margin_;
@@ -162,20 +130,18 @@ void Engine::build_lists() {
   for (long i = 0; i < n_; ++i) {
     wrap(static_cast<int>(i));
     centre_[i] = Centre{part_[i].x, part_[i].y};
-    list(static_cast<int>(i))[0] = 0;
+    nbr_.clear(i);
   }
   build_cells(); // over the centres
   for (long il = 0; il < n_; ++il) {
     const int i = static_cast<int>(il);
-    const int cx = cell_x_[i], cy = cell_y_[i];
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int32_t* c = cell((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_);
-        for (int k = 1; k <= c[0]; ++k) {
-          const int j = c[k];
-          if (j > i && near(i, j)) list_push(i, j), list_push(j, i);
-        }
-      }
+    int around[9];
+    cells_around(cell_x_[i], cell_y_[i], around);
+    for (const int ci : around) {
+      const int32_t* c = cells_.row(ci);
+      for (int k = 1; k <= c[0]; ++k)
+        if (c[k] > i && near(i, c[k])) link(i, c[k]);
+    }
   }
 }
 
@@ -189,19 +155,14 @@ void Engine::rebuild(int i) {
   // and the 9 cells are requested first, then the candidates' centres and
   // particles, each group before any of it is waited for.
   int cells[9]; // as indices: inserting i below may reallocate the cells
-  for (int dy = 0; dy < 3; ++dy)
-    for (int dx = 0; dx < 3; ++dx) {
-      const int x = cx + dx - 1, y = cy + dy - 1;
-      cells[3 * dy + dx] =
-          cell_index(x < 0 ? x + nc_ : (x >= nc_ ? x - nc_ : x), y < 0 ? y + nc_ : (y >= nc_ ? y - nc_ : y));
-      __builtin_prefetch(&cells_[static_cast<size_t>(cells[3 * dy + dx]) * cell_stride_]);
-    }
+  cells_around(cx, cy, cells);
+  for (const int ci : cells) cells_.prefetch(ci);
   {
     const int32_t* l = list(i);
-    for (int k = 1; k <= l[0]; ++k) __builtin_prefetch(list(l[k]));
-    for (int k = 1; k <= l[0]; ++k) list_remove(l[k], i);
+    for (int k = 1; k <= l[0]; ++k) nbr_.prefetch(l[k]);
+    for (int k = 1; k <= l[0]; ++k) nbr_.remove(l[k], i);
   }
-  list(i)[0] = 0;
+  nbr_.clear(i);
   centre_[i] = Centre{part_[i].x, part_[i].y};
   if (cx != cell_x_[i] || cy != cell_y_[i]) {
     cell_remove(i);
@@ -211,7 +172,7 @@ void Engine::rebuild(int i) {
   int32_t cand[kMax];
   int nc = 0;
   for (const int ci : cells) {
-    const int32_t* c = &cells_[static_cast<size_t>(ci) * cell_stride_];
+    const int32_t* c = cells_.row(ci);
     if (nc + c[0] > kMax) throw std::logic_error("engine: more than 512 list candidates");
     for (int k = 1; k <= c[0]; ++k) {
       const int j = c[k];
@@ -222,7 +183,7 @@ void Engine::rebuild(int i) {
   }
   for (int k = 0; k < nc; ++k) {
     const int j = cand[k];
-    if (j != i && near(i, j)) list_push(i, j), list_push(j, i);
+    if (j != i && near(i, j)) link(i, j);
   }
   ++count_.rebuilds;
   predict(i);
@@ -343,7 +304,7 @@ void Engine::kick() {
   // requested before either is read.
   for (const int s : {i, j}) {
     __builtin_prefetch(&part_[s]);
-    __builtin_prefetch(&nbr_[static_cast<size_t>(s) * nbr_stride_]);
+    nbr_.prefetch(s);
     __builtin_prefetch(&centre_[s]);
     cal_.prefetch_path(s);
   }
@@ -399,7 +360,7 @@ bool Engine::run_until(double t_abs, int64_t max_events) {
     // Lines the event will need, requested before the first is waited for:
     // the list, centre and calendar path of the particle, then, once its
     // line says who the partner is, the same for the partner.
-    __builtin_prefetch(&nbr_[static_cast<size_t>(leaf) * nbr_stride_]);
+    nbr_.prefetch(leaf);
     __builtin_prefetch(&centre_[leaf]);
     cal_.prefetch_path(leaf);
     const int partner = part_[leaf].partner;
@@ -408,7 +369,7 @@ bool Engine::run_until(double t_abs, int64_t max_events) {
       rebuild(leaf);
       continue;
     }
-    __builtin_prefetch(&nbr_[static_cast<size_t>(partner) * nbr_stride_]);
+    nbr_.prefetch(partner);
     __builtin_prefetch(&centre_[partner]);
     cal_.prefetch_path(partner);
     if (seen(part_[partner].coll) != part_[leaf].partner_seen) {
@@ -453,21 +414,20 @@ void Engine::place_random(double scale) {
       const double x = rng_.uniform() * box_, y = rng_.uniform() * box_;
       const int cx = cell_coord(x), cy = cell_coord(y);
       placed = true;
-      for (int dy = -1; dy <= 1 && placed; ++dy)
-        for (int dx = -1; dx <= 1 && placed; ++dx) {
-          const int32_t* c = cell((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_);
-          for (int k = 1; k <= c[0]; ++k) {
-            const int j = c[k];
-            double ddx = x - part_[j].x, ddy = y - part_[j].y;
-            ddx -= box_ * std::round(ddx / box_);
-            ddy -= box_ * std::round(ddy / box_);
-            const double s = sigma(static_cast<int>(i), j);
-            if (ddx * ddx + ddy * ddy < s * s) {
-              placed = false;
-              break;
-            }
+      int around[9];
+      cells_around(cx, cy, around);
+      for (int a = 0; a < 9 && placed; ++a) {
+        const int32_t* c = cells_.row(around[a]);
+        for (int k = 1; k <= c[0]; ++k) {
+          const int j = c[k];
+          const double ddx = min_image(x - part_[j].x), ddy = min_image(y - part_[j].y);
+          const double s = sigma(static_cast<int>(i), j);
+          if (ddx * ddx + ddy * ddy < s * s) {
+            placed = false;
+            break;
           }
         }
+      }
       if (placed) {
         Particle& p = part_[i];
         p.x = x, p.y = y, p.vx = p.vy = p.t = 0;
@@ -640,19 +600,19 @@ double Engine::min_gap_ratio() const {
   for (long i = 0; i < n_; ++i) {
     const auto& a = part_[i];
     const double ax = a.x + a.vx * (now_ - a.t), ay = a.y + a.vy * (now_ - a.t);
-    const int cx = cell_x_[i], cy = cell_y_[i];
-    for (int dy = -1; dy <= 1; ++dy)
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int32_t* c = cell((cx + dx + nc_) % nc_, (cy + dy + nc_) % nc_);
-        for (int k = 1; k <= c[0]; ++k) {
-          const int j = c[k];
-          if (j <= i) continue;
-          const auto& b = part_[j];
-          const double ddx = min_image(ax - (b.x + b.vx * (now_ - b.t)));
-          const double ddy = min_image(ay - (b.y + b.vy * (now_ - b.t)));
-          best = std::min(best, std::sqrt(ddx * ddx + ddy * ddy) / sigma(static_cast<int>(i), j));
-        }
+    int around[9];
+    cells_around(cell_x_[i], cell_y_[i], around);
+    for (const int ci : around) {
+      const int32_t* c = cells_.row(ci);
+      for (int k = 1; k <= c[0]; ++k) {
+        const int j = c[k];
+        if (j <= i) continue;
+        const auto& b = part_[j];
+        const double ddx = min_image(ax - (b.x + b.vx * (now_ - b.t)));
+        const double ddy = min_image(ay - (b.y + b.vy * (now_ - b.t)));
+        best = std::min(best, std::sqrt(ddx * ddx + ddy * ddy) / sigma(static_cast<int>(i), j));
       }
+    }
   }
   return best;
 }
@@ -666,7 +626,7 @@ double Engine::mean_neighbours() const {
 size_t Engine::memory_bytes() const {
   auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return b(part_) + b(species_by_id_) + b(id_) + b(slot_of_) + b(image_x_) + b(image_y_) + b(last_collision_) +
-         b(cells_) + b(cell_x_) + b(cell_y_) + b(nbr_) + b(centre_) + cal_.bytes();
+         cells_.bytes() + b(cell_x_) + b(cell_y_) + nbr_.bytes() + b(centre_) + cal_.bytes();
 }
 
 double Engine::max_overlap() const { return 1.0 - min_gap_ratio(); }

@@ -24,6 +24,7 @@
 #include "dynhet/engine/calendar.hpp"
 #include "dynhet/engine/memory.hpp"
 #include "dynhet/engine/rng.hpp"
+#include "dynhet/engine/rows.hpp"
 #include "dynhet/model.hpp"
 
 namespace dynhet::engine {
@@ -200,15 +201,10 @@ private:
   int cell_index(int cx, int cy) const { return cy * nc_ + cx; }
   // Cell (cx, cy) of a position in the box.
   int cell_coord(double x) const { return std::clamp(static_cast<int>(x / cw_), 0, nc_ - 1); }
-  int32_t* cell(int cx, int cy) { return &cells_[static_cast<size_t>(cell_index(cx, cy)) * cell_stride_]; }
-  const int32_t* cell(int cx, int cy) const {
-    return &cells_[static_cast<size_t>(cell_index(cx, cy)) * cell_stride_];
-  }
-  int32_t* list(int i) { return &nbr_[static_cast<size_t>(i) * nbr_stride_]; }
-  const int32_t* list(int i) const { return &nbr_[static_cast<size_t>(i) * nbr_stride_]; }
-  void list_push(int i, int j);
-  void list_remove(int i, int j);
-  void grow_lists();
+  // The 3 x 3 cells around (cx, cy), periodic, row by row from (-1, -1).
+  void cells_around(int cx, int cy, int out[9]) const;
+  const int32_t* list(int i) const { return nbr_.row(static_cast<size_t>(i)); }
+  void link(int i, int j) { nbr_.push(i, j), nbr_.push(j, i); } // i and j list each other
   // Whether the centres of i and j are close enough to be listed.
   bool near(int i, int j) const;
   // Nearest periodic image of a separation component.
@@ -216,7 +212,6 @@ private:
   void cell_insert(int i, int cx, int cy);
   void cell_remove(int i);
   void clear_cells();
-  void grow_cells(); // twice the capacity per cell, contents and their order kept
   void place_random(double scale);
   // Renumbers the storage slots in cell order (ties by particle id), so
   // that neighbours sit close in memory; then rebuilds the cells.
@@ -239,10 +234,8 @@ private:
   std::vector<int32_t> image_x_, image_y_;
   std::vector<double> last_collision_; // internal time of each particle's last collision; kept only with the TC model on
 
-  // Neighbour lists: i's is nbr_[i * nbr_stride_ ...], its count then the
-  // slots of its neighbours, one cache line while it holds up to 15.
-  std::vector<int32_t, BigArrayAlloc<int32_t>> nbr_;
-  int nbr_stride_ = 16;
+  // Neighbour lists: row i holds the slots of i's neighbours.
+  Rows nbr_;
   struct Centre {
     double x, y;
   };
@@ -253,11 +246,10 @@ private:
 
   int nc_ = 0;   // cells per side
   double cw_ = 0; // cell width
-  // Cells over the list centres, as fixed-capacity arrays, not linked
-  // lists: cell c is cells_[c * cell_stride_ ...], first its count, then the
-  // slots of its particles. cell_x_, cell_y_ are each particle's cell.
-  std::vector<int32_t, BigArrayAlloc<int32_t>> cells_;
-  int cell_stride_ = 16; // one cache line: a count and up to 15 members
+  // Cells over the list centres, as rows (not linked lists): row
+  // cell_index(cx, cy) holds the slots of its particles. cell_x_, cell_y_
+  // are each particle's cell.
+  Rows cells_;
   std::vector<int32_t> cell_x_, cell_y_;
 
   Calendar cal_;
