@@ -72,40 +72,64 @@ TEST(CollisionTime, GrowingDisksMeetEvenWhenAtRest) {
   EXPECT_NEAR(pair_collision_time(3.0, 0, 0, 0, 2.0, 0.5), 2.0, 1e-14);
 }
 
-TEST(Calendar, TopIsAlwaysTheEarliestLeaf) {
-  std::mt19937_64 gen(11);
-  std::uniform_real_distribution<double> u(0, 100);
-  const int n = 1000;
+// The calendar used as the engine uses it: the earliest event is taken, its
+// leaf gets a later time, other leaves' times change (earlier or later, never
+// before the clock), now and then everything is entered afresh. Times come
+// from a grid (many ties), some lie far beyond the ring (overflow), some are
+// infinite. Against a brute-force minimum over (time, leaf).
+struct VectorTimes {
+  const std::vector<double>* t;
+  double operator()(int i) const { return (*t)[i]; }
+  void prefetch(int) const {}
+};
+
+void calendar_against_brute_force(int n, uint64_t seed, double far_fraction) {
+  std::mt19937_64 gen(seed);
+  std::uniform_real_distribution<double> u(0, 1);
+  std::vector<double> t(n);
+  double now = 0;
+  auto draw = [&] {
+    const double r = u(gen);
+    if (r < 0.05) return kNever;
+    const double horizon = r < 0.05 + far_fraction ? 1e4 : 1.0;
+    return now + std::floor(u(gen) * horizon * 64) / 64; // grid: ties
+  };
+  for (auto& x : t) x = draw();
   Calendar cal;
-  cal.reset(n, kNever);
-  std::vector<double> t(n, kNever);
-  for (int step = 0; step < 100000; ++step) {
-    const int leaf = static_cast<int>(gen() % n);
-    t[leaf] = u(gen);
-    cal.set(leaf, t[leaf]);
-    const int best = static_cast<int>(std::min_element(t.begin(), t.end()) - t.begin());
-    ASSERT_EQ(cal.top_time(), t[best]);
+  const VectorTimes times{&t};
+  cal.rebuild(n, now, times);
+  for (int step = 0; step < 30 * n + 3000; ++step) {
+    const auto top = cal.top(times);
+    int best = 0;
+    for (int i = 1; i < n; ++i)
+      if (t[i] < t[best]) best = i; // ties: the lower leaf stays
+    if (t[best] == kNever) {
+      ASSERT_EQ(top.leaf, -1) << "n=" << n << " step=" << step;
+      for (auto& x : t) x = draw();
+      cal.rebuild(n, now, times);
+      continue;
+    }
+    ASSERT_EQ(top.leaf, best) << "n=" << n << " step=" << step;
+    ASSERT_EQ(top.time, t[best]);
+    now = t[best];
+    // The event is processed: its leaf's time moves on (or stays, a
+    // zero-delay event), and so do a few others'.
+    const double next = u(gen) < 0.05 ? now : draw();
+    if (next != t[best]) t[best] = next, cal.push(best, next);
+    for (int k = static_cast<int>(gen() % 3); k > 0; --k) {
+      const int j = static_cast<int>(gen() % n);
+      const double tj = draw();
+      if (tj != t[j]) t[j] = tj, cal.push(j, tj);
+    }
+    if (step % 997 == 0) cal.rebuild(n, now, times);
   }
 }
 
-TEST(Calendar, TiesGoToTheLowerLeafForEverySize) {
-  // Times from a few values (many ties), sizes around powers of 4; the top
-  // must be the earliest time and, among equal times, the lowest leaf
-  // (that order makes runs reproducible).
-  std::mt19937_64 gen(5);
-  for (int n : {1, 2, 3, 4, 5, 15, 16, 17, 63, 64, 65, 257, 1025}) {
-    Calendar cal;
-    cal.reset(n, kNever);
-    std::vector<double> t(n, kNever);
-    for (int step = 0; step < 20 * n + 100; ++step) {
-      const int leaf = static_cast<int>(gen() % n);
-      t[leaf] = (gen() % 5 == 0) ? kNever : static_cast<double>(gen() % 4);
-      cal.set(leaf, t[leaf]);
-      const int best = static_cast<int>(std::min_element(t.begin(), t.end()) - t.begin());
-      if (t[best] == kNever) continue;
-      ASSERT_EQ(cal.top(), best) << "n=" << n << " step=" << step;
-      ASSERT_EQ(cal.top_time(), t[best]);
-      ASSERT_EQ(cal.time(leaf), t[leaf]);
-    }
-  }
+TEST(Calendar, TakesEventsInTheOrderOfATournamentTree) {
+  for (int n : {1, 2, 3, 17, 100, 1000, 5000}) calendar_against_brute_force(n, 7 + n, 0.0);
+}
+
+TEST(Calendar, FarEventsWaitInTheOverflowAndAreNotLost) {
+  // A fifth of the times lie up to 10^4 horizons ahead: beyond the ring.
+  for (int n : {2, 50, 2000}) calendar_against_brute_force(n, 3 + n, 0.2);
 }

@@ -49,8 +49,6 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
   last_collision_.assign(n_, -kNever);
   centre_.assign(n_, Centre{0, 0});
   nbr_.reset(static_cast<size_t>(n_));
-  kick_leaf_ = static_cast<int>(n_);
-  cal_.reset(static_cast<int>(n_) + 1, kNever);
 }
 
 double Engine::packing_fraction() const {
@@ -264,8 +262,10 @@ void Engine::clear_events() {
   for (long i = 0; i < n_; ++i) sync(static_cast<int>(i));
   list_scale_ = grow_ > 0 ? std::min(1.0, scale0_ + grow_ * (now_ + 1.0)) : scale0_;
   build_lists();
-  for (long i = 0; i < n_; ++i) set_event_time(static_cast<int>(i), kNever);
+  cal_.suspend();
+  for (long i = 0; i < n_; ++i) part_[i].event_time = kNever;
   for (long i = 0; i < n_; ++i) predict(static_cast<int>(i));
+  cal_.rebuild(n_, now_, event_times());
 }
 
 void Engine::collide(int i, int j) {
@@ -306,7 +306,6 @@ void Engine::kick() {
     __builtin_prefetch(&part_[s]);
     nbr_.prefetch(s);
     __builtin_prefetch(&centre_[s]);
-    cal_.prefetch_path(s);
   }
   double kx, ky;
   rng_.normal_pair(kx, ky);
@@ -321,7 +320,7 @@ void Engine::kick() {
   ++part_[i].coll;
   ++part_[j].coll;
   ++count_.kicks;
-  cal_.set(kick_leaf_, now_ + rng_.exponential(kick_pair_rate_));
+  kick_time_ = now_ + rng_.exponential(kick_pair_rate_);
   predict(i);
   predict(j);
 }
@@ -333,19 +332,23 @@ void Engine::rebase() {
     part_[i].t = 0;
     last_collision_[i] -= now_;
   }
-  cal_.shift(now_); // the kick leaf too
+  kick_time_ -= now_;
   for (auto& a : part_) a.event_time -= now_;
   scale0_ += grow_ * now_;
   offset_ += now_;
   now_ = 0;
   events_since_rebase_ = 0;
+  cal_.rebuild(n_, now_, event_times());
 }
 
 bool Engine::run_until(double t_abs, int64_t max_events) {
   const double target = t_abs - offset_;
   for (int64_t done = 0; done < max_events; ++done) {
-    const int leaf = cal_.top();
-    const double t = cal_.top_time();
+    const Calendar::Entry next = cal_.top(event_times());
+    // On a tie the particle's event comes first (as the kick was the last leaf of the tree calendar).
+    const bool kick_next = kick_time_ < next.time;
+    const double t = kick_next ? kick_time_ : next.time;
+    const int leaf = next.leaf;
     if (t > target) {
       now_ = std::max(now_, target);
       if (events_since_rebase_ > 10 * n_) rebase();
@@ -353,16 +356,29 @@ bool Engine::run_until(double t_abs, int64_t max_events) {
     }
     now_ = t;
     ++events_since_rebase_;
-    if (leaf == kick_leaf_) {
+    // Software pipeline over the next events in the calendar: the list,
+    // centre and partner of the one after next, the neighbours of the next.
+    if (const int a3 = cal_.ahead(3); a3 >= 0) {
+      nbr_.prefetch(a3);
+      __builtin_prefetch(&centre_[a3]);
+      if (const int q = part_[a3].partner; q >= 0) __builtin_prefetch(&part_[q]);
+    }
+    if (const int a2 = cal_.ahead(2); a2 >= 0) {
+      prefetch_neighbours(a2);
+      if (const int q = part_[a2].partner; q >= 0) nbr_.prefetch(q), __builtin_prefetch(&centre_[q]);
+    }
+    if (const int a1 = cal_.ahead(1); a1 >= 0) {
+      if (const int q = part_[a1].partner; q >= 0) prefetch_neighbours(q);
+    }
+    if (kick_next) {
       kick();
       continue;
     }
     // Lines the event will need, requested before the first is waited for:
-    // the list, centre and calendar path of the particle, then, once its
-    // line says who the partner is, the same for the partner.
+    // the list and centre of the particle, then, once its line says who the
+    // partner is, the same for the partner.
     nbr_.prefetch(leaf);
     __builtin_prefetch(&centre_[leaf]);
-    cal_.prefetch_path(leaf);
     const int partner = part_[leaf].partner;
     if (partner == kRebuild) {
       sync(leaf);
@@ -371,7 +387,6 @@ bool Engine::run_until(double t_abs, int64_t max_events) {
     }
     nbr_.prefetch(partner);
     __builtin_prefetch(&centre_[partner]);
-    cal_.prefetch_path(partner);
     if (seen(part_[partner].coll) != part_[leaf].partner_seen) {
       ++count_.stale;
       sync(leaf);
@@ -494,7 +509,7 @@ void Engine::prepare(const std::function<void(double)>& progress) {
   count_ = Counters{};
   thermalize(1.0);
   start_run();
-  cal_.set(kick_leaf_, driving_ ? now_ + rng_.exponential(kick_pair_rate_) : kNever);
+  kick_time_ = driving_ ? now_ + rng_.exponential(kick_pair_rate_) : kNever;
   reorder();
   clear_events();
 }
@@ -514,7 +529,7 @@ void Engine::synchronize() {
 State Engine::state() const {
   State s;
   s.time = time();
-  s.kick_in = cal_.time(kick_leaf_) - now_; // now_ is 0 after synchronize()
+  s.kick_in = kick_time_ - now_; // now_ is 0 after synchronize()
   s.x.resize(n_), s.y.resize(n_), s.vx.resize(n_), s.vy.resize(n_), s.last_collision.resize(n_);
   s.image_x.resize(n_), s.image_y.resize(n_), s.collision_count.resize(n_);
   for (long k = 0; k < n_; ++k) { // stored by particle id
@@ -557,7 +572,7 @@ void Engine::restore(const State& s) {
   rng_.set_state(s.rng);
   count_ = s.counters;
   start_run();
-  cal_.set(kick_leaf_, s.kick_in);
+  kick_time_ = s.kick_in;
   reorder(); // the same slot order as the run that wrote the state
   clear_events();
 }

@@ -1,97 +1,208 @@
-// The event calendar: a complete 4-ary tournament tree over one event time
-// per leaf (each particle's next event, plus extra leaves such as the next
-// kick). The root holds the leaf with the earliest time (ties: the lower
-// leaf); changing a leaf's time costs O(log n). Each node keeps its winner's
-// time next to the winner's index, and the four children of a node are one
-// 64-byte cache line: a change reads one line per level, and there are half
-// as many levels as in a binary tree (at N = 10^5 every event replays about
-// two paths from leaf to root, most of whose lines are not in cache).
+// The event calendar: a bucket queue with lazy deletion (after Paul, J.
+// Comput. Phys. 221, 615 (2007)). Each leaf (particle) has one current
+// event time, kept by its owner and read through a `Times` source:
+//   double operator()(int leaf) const  the leaf's time now (infinite: none)
+//   void prefetch(int leaf) const      request the line holding it
+// The calendar returns the leaf with the earliest time, ties going to the
+// lower leaf: the order of a complete tournament tree, so a run does not
+// depend on which calendar it uses.
 //
-// Layout: a 4-ary heap shifted by 3 places (0-2 are padding) so that every
-// group of siblings starts on a multiple of 4: the root is at 3, the
-// children of p at 4p - 8 .. 4p - 5, the parent of p at p / 4 + 2; the
-// levels follow one another without gaps and the leaves are the last.
+// Time is cut into buckets of width w. The current bucket is a sorted array
+// of (time, leaf); the next nb - 1 buckets are a ring of unsorted leaf ids;
+// later events wait in an overflow list that is sorted into the ring once
+// per turn. Changing a leaf's time appends its id where the new time falls
+// (O(1), one line written) and leaves the old entry behind: an entry is
+// stale when its leaf's time has moved to another bucket, or (in the sorted
+// array) differs from the entry's. A bucket is read only when the clock
+// reaches it: all its leaves' lines are requested at once, stale entries
+// dropped and the rest sorted. The tree this replaces read and wrote a
+// path of about log4(N) lines per change, most of them misses at large N,
+// and could not tell which events come next; here the next events sit in
+// the sorted array, their lines fetched together when the bucket was read.
+//
+// Usage: after a bulk change of times (all events predicted anew, the clock
+// rebased), rebuild(); between rebuilds, every change of a leaf's time is
+// followed by push(leaf, new time). A time may not lie before the time of
+// the event last taken from top() (events never go back in time).
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 #include <vector>
-
-#include "dynhet/engine/memory.hpp"
 
 namespace dynhet::engine {
 
 class Calendar {
 public:
-  void reset(int n_leaves, double never) {
-    size_t width = 1, internal = 0;
-    while (width < static_cast<size_t>(n_leaves)) internal += width, width *= 4;
-    first_leaf_ = kRoot + internal;
-    // Only the leaves in use are stored (rounded up to a group of four):
-    // an internal node whose children would all lie beyond them stays
-    // "never" and is never on a leaf's path.
-    const size_t leaves = (static_cast<size_t>(n_leaves) + 3) / 4 * 4;
-    node_.assign(first_leaf_ + leaves, Node{never, 0});
-    for (size_t i = 0; i < leaves; ++i) node_[first_leaf_ + i].leaf = static_cast<int32_t>(i);
-    for (size_t p = first_leaf_; p-- > kRoot;)
-      node_[p] = 4 * p - 8 < node_.size() ? pick_children(p) : Node{never, static_cast<int32_t>(leaves)};
-  }
-  size_t bytes() const { return node_.capacity() * sizeof(Node); }
-  int top() const { return node_[kRoot].leaf; }
-  double top_time() const { return node_[kRoot].time; }
-  double time(int leaf) const { return node_[first_leaf_ + leaf].time; }
-  // A time that comes earlier climbs while it wins; one that comes later is
-  // replayed only where the leaf was the winner. Either loop stops at the
-  // first node that does not change.
-  // Requests the lines of a leaf's path to the root (those a set() of it
-  // will read), all at once rather than one miss after another.
-  void prefetch_path(int leaf) const {
-    for (size_t q = first_leaf_ + leaf; q > kRoot; q = q / 4 + 2) __builtin_prefetch(&node_[q]);
-  }
-  void set(int leaf, double t) {
-    size_t p = first_leaf_ + leaf;
-    prefetch_path(leaf);
-    const double old = node_[p].time;
-    node_[p].time = t;
-    if (t <= old) {
-      while (p != kRoot) {
-        p = p / 4 + 2;
-        Node& n = node_[p];
-        if (n.leaf != leaf && (n.time < t || (n.time == t && n.leaf < leaf))) break;
-        n.time = t;
-        n.leaf = leaf;
-      }
-    } else {
-      while (p != kRoot) {
-        p = p / 4 + 2;
-        if (node_[p].leaf != leaf) break;
-        node_[p] = pick_children(p);
-      }
-    }
-  }
-  // Subtract dt from every time (rebasing the clock).
-  void shift(double dt) {
-    for (Node& n : node_) n.time -= dt;
-  }
-
-private:
-  struct Node {
+  struct Entry {
     double time;
     int32_t leaf;
   };
-  // Earlier time wins; ties go to the lower leaf, so the order is
-  // reproducible. Without branches: which child wins is unpredictable.
-  static Node pick(const Node& a, const Node& b) {
-    const bool second = (b.time < a.time) | ((b.time == a.time) & (b.leaf < a.leaf));
-    return Node{second ? b.time : a.time, second ? b.leaf : a.leaf};
+  static constexpr double kNever = std::numeric_limits<double>::infinity();
+  // Live events per bucket aimed at, and how many mean horizons the ring covers.
+  static constexpr double kPerBucket = 8;
+  static constexpr double kRingHorizons = 4;
+  static constexpr size_t kMaxBuckets = 2048;
+
+  // Every leaf 0..n-1 with a finite time (none earlier than `now`) is
+  // entered afresh; the bucket width follows their mean distance from now.
+  template <class Times> void rebuild(long n, double now, const Times& time) {
+    suspended_ = false;
+    double sum = 0;
+    long finite = 0;
+    for (long i = 0; i < n; ++i) {
+      const double t = time(static_cast<int>(i));
+      if (t < kNever) sum += t - now, ++finite;
+    }
+    const double horizon = finite > 0 ? sum / finite : 0;
+    size_t nb = 16;
+    while (nb < kMaxBuckets && nb < kRingHorizons * finite / kPerBucket) nb *= 2;
+    const double w = finite > 0 && horizon > 0 ? kRingHorizons * horizon / nb : 1.0;
+    inv_w_ = 1.0 / w;
+    if (ring_.size() != nb) ring_.assign(nb, {});
+    for (auto& b : ring_) b.clear();
+    mask_ = static_cast<int64_t>(nb) - 1;
+    overflow_.clear();
+    current_.clear();
+    pos_ = 0;
+    in_ring_ = 0;
+    current_bucket_ = bucket(std::max(now, 0.0));
+    turn_start_ = current_bucket_ & ~mask_;
+    for (long i = 0; i < n; ++i) {
+      const double t = time(static_cast<int>(i));
+      if (t < kNever) push(static_cast<int32_t>(i), t);
+    }
   }
-  static constexpr size_t kRoot = 3;
-  Node pick_children(size_t p) const {
-    const Node* c = &node_[4 * p - 8];
-    return pick(pick(c[0], c[1]), pick(c[2], c[3]));
+
+  // Changes ignored until the next rebuild() (which reads every time anew).
+  void suspend() { suspended_ = true; }
+
+  // Leaf's time has changed to t (t infinite: it has no event; nothing to do).
+  void push(int32_t leaf, double t) {
+    if (suspended_ || !(t < kNever)) return;
+    const int64_t b = bucket(t);
+    if (b <= current_bucket_) {
+      const Entry e{t, leaf};
+      current_.insert(std::upper_bound(current_.begin() + static_cast<std::ptrdiff_t>(pos_), current_.end(), e, before), e);
+    } else if (b - current_bucket_ <= mask_) {
+      ring_[static_cast<size_t>(b & mask_)].push_back(leaf);
+      ++in_ring_;
+    } else {
+      overflow_.push_back(leaf);
+    }
   }
-  size_t first_leaf_ = 0;
-  std::vector<Node, BigArrayAlloc<Node>> node_;
+
+  // The earliest event, ties to the lower leaf; {kNever, -1} if none. It
+  // stays in the calendar until its leaf's time changes.
+  template <class Times> Entry top(const Times& time) {
+    for (;;) {
+      while (pos_ < current_.size()) {
+        const Entry& e = current_[pos_];
+        if (time(e.leaf) == e.time) {
+          // The next events' lines, for when they come up.
+          if (pos_ + kAhead < current_.size()) time.prefetch(current_[pos_ + kAhead].leaf);
+          return e;
+        }
+        ++pos_;
+      }
+      if (!advance(time)) return Entry{kNever, -1};
+    }
+  }
+
+  // The leaf k places after the current top in the sorted bucket (its event
+  // may be stale), or -1: for requesting lines ahead of time.
+  int32_t ahead(size_t k) const { return pos_ + k < current_.size() ? current_[pos_ + k].leaf : -1; }
+
+  size_t bytes() const {
+    size_t b = current_.capacity() * sizeof(Entry) + overflow_.capacity() * sizeof(int32_t) +
+               ring_.capacity() * sizeof(ring_[0]);
+    for (const auto& r : ring_) b += r.capacity() * sizeof(int32_t);
+    return b;
+  }
+
+private:
+  static constexpr size_t kAhead = 2;
+  struct Before {
+    bool operator()(const Entry& a, const Entry& b) const {
+      return a.time < b.time || (a.time == b.time && a.leaf < b.leaf);
+    }
+  };
+  static constexpr Before before{};
+  int64_t bucket(double t) const {
+    const double b = t * inv_w_;
+    return b < 4e18 ? static_cast<int64_t>(b) : static_cast<int64_t>(4e18);
+  }
+
+  // The current bucket is used up: move on to the next one that holds
+  // entries, and sort its live ones. False if no event is left.
+  template <class Times> bool advance(const Times& time) {
+    current_.clear();
+    pos_ = 0;
+    if (in_ring_ == 0) {
+      if (overflow_.empty()) return false;
+      // Nothing before the overflow: jump to the turn of its earliest event.
+      int64_t first = INT64_MAX;
+      for (const int32_t leaf : overflow_) {
+        const double t = time(leaf);
+        if (t < kNever) first = std::min(first, bucket(t));
+      }
+      if (first == INT64_MAX) {
+        overflow_.clear();
+        return false;
+      }
+      const int64_t start = first & ~mask_; // after this turn (the overflow lies beyond it)
+      if (start > current_bucket_) {
+        turn_start_ = start - (mask_ + 1);
+        current_bucket_ = start - 1;
+      }
+    }
+    ++current_bucket_;
+    if (current_bucket_ - turn_start_ > mask_) { // a new turn of the ring
+      turn_start_ += mask_ + 1;
+      size_t keep = 0;
+      for (const int32_t leaf : overflow_) time.prefetch(leaf);
+      for (const int32_t leaf : overflow_) {
+        const double t = time(leaf);
+        if (!(t < kNever)) continue;
+        const int64_t b = bucket(t);
+        if (b < turn_start_) continue; // stale: its leaf's entry is elsewhere
+        if (b - turn_start_ <= mask_) {
+          ring_[static_cast<size_t>(b & mask_)].push_back(leaf);
+          ++in_ring_;
+        } else {
+          overflow_[keep++] = leaf;
+        }
+      }
+      overflow_.resize(keep);
+    }
+    std::vector<int32_t>& slot = ring_[static_cast<size_t>(current_bucket_ & mask_)];
+    in_ring_ -= slot.size();
+    for (const int32_t leaf : slot) time.prefetch(leaf);
+    for (const int32_t leaf : slot) {
+      const double t = time(leaf);
+      if (t < kNever && bucket(t) == current_bucket_) current_.push_back(Entry{t, leaf});
+    }
+    slot.clear();
+    std::sort(current_.begin(), current_.end(), before);
+    // A leaf entered twice in this bucket appears twice: keep one.
+    current_.erase(std::unique(current_.begin(), current_.end(),
+                               [](const Entry& a, const Entry& b) { return a.time == b.time && a.leaf == b.leaf; }),
+                   current_.end());
+    return true;
+  }
+
+  double inv_w_ = 1;
+  int64_t mask_ = 15;
+  int64_t current_bucket_ = 0, turn_start_ = 0;
+  size_t in_ring_ = 0;
+  bool suspended_ = true;
+  std::vector<Entry> current_;
+  size_t pos_ = 0;
+  std::vector<std::vector<int32_t>> ring_;
+  std::vector<int32_t> overflow_;
 };
 
 } // namespace dynhet::engine

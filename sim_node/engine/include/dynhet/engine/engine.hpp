@@ -8,8 +8,7 @@
 // |c_i - c_j| <= sigma_ij + skin; while each stays within skin / 2 of its
 // centre, no pair outside the lists can touch. Lists are symmetric. Leaving
 // that disc is i's "rebuild" event: only i's list is rebuilt, from a cell
-// grid over the centres. An event costs O(1) work plus an O(log N)
-// calendar update. Each particle holds one event (a collision with a
+// grid over the centres. An event costs O(1) work, calendar included. Each particle holds one event (a collision with a
 // partner, or its rebuild); a collision predicted with partner j is stale
 // once j's collision counter has moved on, and is then predicted again
 // when it comes up.
@@ -162,7 +161,7 @@ private:
   // the particle, not two.
   struct alignas(64) Particle {
     double x, y, vx, vy, t; // position (in the box) at local time t, velocity
-    double event_time;      // its next event (a copy of its calendar leaf)
+    double event_time;      // its next event (the calendar reads it here)
     uint64_t coll : 63;     // collision counter (also counts kicks): staleness of predictions
     uint64_t species : 1;
     // The next event: a collision with `partner`, or (partner < 0) the
@@ -192,9 +191,17 @@ private:
   double growth(int i, int j) const { return grow_ * (radius_[part_[i].species] + radius_[part_[j].species]); }
   double mass_of(int i) const { return mass_[part_[i].species]; }
   void set_event_time(int i, double t) {
+    if (t == part_[i].event_time) return; // its entry in the calendar stands
     part_[i].event_time = t;
-    cal_.set(i, t);
+    cal_.push(i, t);
   }
+  // What the calendar reads of the particles: their event times.
+  struct EventTimes {
+    const Particle* p;
+    double operator()(int i) const { return p[i].event_time; }
+    void prefetch(int i) const { __builtin_prefetch(&p[i]); }
+  };
+  EventTimes event_times() const { return EventTimes{part_.data()}; }
   double scale() const { return scale0_ + grow_ * now_; }
   void rescale_velocities(double energy);
   void start_run(); // restitution, driving on; the first kick drawn
@@ -253,7 +260,7 @@ private:
   std::vector<int32_t> cell_x_, cell_y_;
 
   Calendar cal_;
-  int kick_leaf_;
+  double kick_time_ = Calendar::kNever; // the next kick (it comes after a particle's event at the same time)
   bool driving_ = false;
   double kick_pair_rate_ = 0; // pair kicks per unit time, whole system
   Rng rng_;
