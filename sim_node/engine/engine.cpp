@@ -9,6 +9,7 @@
 #include "dynhet/model.hpp"
 
 namespace dynhet::engine {
+static constexpr bool kSteal = true;
 
 Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution), rng_(p.seed) {
   if (n_ < 2) throw std::invalid_argument("engine: need at least 2 particles");
@@ -198,9 +199,9 @@ void Engine::sync(int i) {
 }
 
 // Next event of particle i (synchronised to now): reaching the edge of its
-// skin, or the earliest collision with a particle of its list. A neighbour
-// for which the collision with i comes before its own next event takes it.
-// The neighbours' cache lines are requested all at once before any is
+// skin, or the earliest collision with a particle of its list (the
+// neighbours' own events stay as they are: engine.hpp says why). The
+// neighbours' cache lines are requested all at once before any is
 // read: at large N each is a miss, and waiting for them one by one would
 // cost most of the time.
 void Engine::prefetch_neighbours(int i) const {
@@ -240,14 +241,7 @@ void Engine::predict(int i) {
     const double ddx = min_image(a.x - (b.x + b.vx * bdt)), ddy = min_image(a.y - (b.y + b.vy * bdt));
     const double rsum = sig_i + radius_[b.species];
     const double dt = pair_collision_time(ddx, ddy, a.vx - b.vx, a.vy - b.vy, sc * rsum, grow_ * rsum);
-    if (dt == kNever) continue;
-    const double t = now_ + dt;
     if (dt < best) best = dt, partner = j, partner_seen = seen(b.coll);
-    if (t < b.event_time) {
-      part_[j].partner = i;
-      part_[j].partner_seen = seen(a.coll);
-      set_event_time(j, t);
-    }
   }
   part_[i].partner = partner;
   part_[i].partner_seen = partner_seen;

@@ -45,7 +45,7 @@ public:
   // Live events per bucket aimed at, and how many mean horizons the ring covers.
   static constexpr double kPerBucket = 8;
   static constexpr double kRingHorizons = 4;
-  static constexpr size_t kMaxBuckets = 2048;
+  static constexpr size_t kMaxBuckets = 8192;
 
   // Every leaf 0..n-1 with a finite time (none earlier than `now`) is
   // entered afresh; the bucket width follows their mean distance from now.

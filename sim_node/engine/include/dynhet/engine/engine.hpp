@@ -8,10 +8,18 @@
 // |c_i - c_j| <= sigma_ij + skin; while each stays within skin / 2 of its
 // centre, no pair outside the lists can touch. Lists are symmetric. Leaving
 // that disc is i's "rebuild" event: only i's list is rebuilt, from a cell
-// grid over the centres. An event costs O(1) work, calendar included. Each particle holds one event (a collision with a
-// partner, or its rebuild); a collision predicted with partner j is stale
-// once j's collision counter has moved on, and is then predicted again
-// when it comes up.
+// grid over the centres. An event costs O(1) work, calendar included.
+//
+// Each particle holds one event: the earliest of its own predictions (a
+// collision with a partner, or its rebuild). A collision predicted with
+// partner j is stale once j's collision counter has moved on, and i is then
+// predicted again when it comes up. A prediction does not touch the
+// neighbours' events: a collision of i and j that comes first is always
+// held by whichever of them was predicted last (at that prediction both
+// trajectories were final and the pair listed, and nothing of either comes
+// up before it, or it would have been predicted again), so it is never
+// lost; handing it to the other one as well only makes work (calendar
+// updates, and stale events when the first one's plans change).
 #pragma once
 
 #include <algorithm>
