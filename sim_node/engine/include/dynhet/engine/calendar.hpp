@@ -62,8 +62,8 @@ public:
     while (nb < kMaxBuckets && nb < kRingHorizons * finite / kPerBucket) nb *= 2;
     const double w = finite > 0 && horizon > 0 ? kRingHorizons * horizon / nb : 1.0;
     inv_w_ = 1.0 / w;
-    if (ring_.size() != nb) ring_.assign(nb, {});
-    for (auto& b : ring_) b.clear();
+    if (fill_.size() != nb) fill_.assign(nb, 0), slots_.assign(nb * cap_, 0);
+    std::fill(fill_.begin(), fill_.end(), 0);
     mask_ = static_cast<int64_t>(nb) - 1;
     overflow_.clear();
     current_.clear();
@@ -88,8 +88,7 @@ public:
       const Entry e{t, leaf};
       current_.insert(std::upper_bound(current_.begin() + static_cast<std::ptrdiff_t>(pos_), current_.end(), e, before), e);
     } else if (b - current_bucket_ <= mask_) {
-      ring_[static_cast<size_t>(b & mask_)].push_back(leaf);
-      ++in_ring_;
+      to_ring(static_cast<size_t>(b & mask_), leaf);
     } else {
       overflow_.push_back(leaf);
     }
@@ -117,10 +116,8 @@ public:
   int32_t ahead(size_t k) const { return pos_ + k < current_.size() ? current_[pos_ + k].leaf : -1; }
 
   size_t bytes() const {
-    size_t b = current_.capacity() * sizeof(Entry) + overflow_.capacity() * sizeof(int32_t) +
-               ring_.capacity() * sizeof(ring_[0]);
-    for (const auto& r : ring_) b += r.capacity() * sizeof(int32_t);
-    return b;
+    return current_.capacity() * sizeof(Entry) + overflow_.capacity() * sizeof(int32_t) +
+           fill_.capacity() * sizeof(uint32_t) + slots_.capacity() * sizeof(int32_t);
   }
 
 private:
@@ -134,6 +131,19 @@ private:
   int64_t bucket(double t) const {
     const double b = t * inv_w_;
     return b < 4e18 ? static_cast<int64_t>(b) : static_cast<int64_t>(4e18);
+  }
+
+  void to_ring(size_t r, int32_t leaf) {
+    if (fill_[r] == cap_) grow();
+    slots_[r * cap_ + fill_[r]++] = leaf;
+    ++in_ring_;
+  }
+  [[gnu::noinline, gnu::cold]] void grow() {
+    std::vector<int32_t> bigger(slots_.size() * 2);
+    for (size_t r = 0; r < fill_.size(); ++r)
+      std::copy(&slots_[r * cap_], &slots_[r * cap_] + fill_[r], &bigger[r * 2 * cap_]);
+    slots_.swap(bigger);
+    cap_ *= 2;
   }
 
   // The current bucket is used up: move on to the next one that holds
@@ -170,22 +180,23 @@ private:
         const int64_t b = bucket(t);
         if (b < turn_start_) continue; // stale: its leaf's entry is elsewhere
         if (b - turn_start_ <= mask_) {
-          ring_[static_cast<size_t>(b & mask_)].push_back(leaf);
-          ++in_ring_;
+          to_ring(static_cast<size_t>(b & mask_), leaf);
         } else {
           overflow_[keep++] = leaf;
         }
       }
       overflow_.resize(keep);
     }
-    std::vector<int32_t>& slot = ring_[static_cast<size_t>(current_bucket_ & mask_)];
-    in_ring_ -= slot.size();
-    for (const int32_t leaf : slot) time.prefetch(leaf);
-    for (const int32_t leaf : slot) {
-      const double t = time(leaf);
-      if (t < kNever && bucket(t) == current_bucket_) current_.push_back(Entry{t, leaf});
+    const size_t r = static_cast<size_t>(current_bucket_ & mask_);
+    const int32_t* slot = &slots_[r * cap_];
+    const uint32_t m = fill_[r];
+    in_ring_ -= m;
+    for (uint32_t k = 0; k < m; ++k) time.prefetch(slot[k]);
+    for (uint32_t k = 0; k < m; ++k) {
+      const double t = time(slot[k]);
+      if (t < kNever && bucket(t) == current_bucket_) current_.push_back(Entry{t, slot[k]});
     }
-    slot.clear();
+    fill_[r] = 0;
     std::sort(current_.begin(), current_.end(), before);
     // A leaf entered twice in this bucket appears twice: keep one.
     current_.erase(std::unique(current_.begin(), current_.end(),
@@ -201,7 +212,13 @@ private:
   bool suspended_ = true;
   std::vector<Entry> current_;
   size_t pos_ = 0;
-  std::vector<std::vector<int32_t>> ring_;
+  // The ring: bucket r holds fill_[r] leaves at slots_[r * cap_ ...]. The
+  // fill counts are one small array (an insertion reads a line that is
+  // likely in cache, and only writes to the bucket's own line); a full
+  // bucket doubles every bucket's capacity.
+  std::vector<uint32_t> fill_;
+  std::vector<int32_t> slots_;
+  size_t cap_ = 32;
   std::vector<int32_t> overflow_;
 };
 
