@@ -89,6 +89,10 @@ void Engine::build_cells() {
 }
 
 void Engine::reorder() {
+  // Positions into the box first: the order must follow from the state
+  // alone (a run restored from a checkpoint, whose positions are wrapped,
+  // gets the same slots, and so the same kick pairs).
+  for (long s = 0; s < n_; ++s) wrap(static_cast<int>(s));
   std::vector<int32_t> cell(n_);
   for (long s = 0; s < n_; ++s) cell[s] = cell_index(cell_coord(part_[s].x), cell_coord(part_[s].y));
   std::vector<int32_t> order(n_);
@@ -286,21 +290,32 @@ void Engine::collide(int i, int j) {
 
 // Driving (paper, section 2): a random pair gets opposite momenta
 // +-p_Dr kappa, kappa a 2D standard Gaussian vector, so total momentum is
-// conserved. Choice where the paper is silent: the pair is two distinct
-// particles drawn uniformly from the whole system, and with the two species
-// the amplitude is p_Dr^2 = (1 - eps^2) m1 m2 / (m1 + m2) for every pair.
+// conserved. Choices where the paper is silent: the pair is two distinct
+// particles drawn uniformly from the whole system (by storage slot, from a
+// hash of the seed and the kick's number: kick_pair), and with the two
+// species the amplitude is p_Dr^2 = (1 - eps^2) m1 m2 / (m1 + m2) for every pair.
+void Engine::kick_pair(int64_t k, int& i, int& j) const {
+  const uint64_t base = mix64(p_.seed ^ 0x6b69636b70616972ULL) + 2 * static_cast<uint64_t>(k);
+  const auto below = [](uint64_t h, uint64_t n) {
+    return static_cast<int>((static_cast<unsigned __int128>(h) * n) >> 64);
+  };
+  i = below(mix64(base), static_cast<uint64_t>(n_));
+  j = below(mix64(base + 1), static_cast<uint64_t>(n_ - 1));
+  if (j >= i) ++j;
+}
+
+void Engine::prefetch_particle(int i) const {
+  __builtin_prefetch(&part_[i]);
+  nbr_.prefetch(i);
+  __builtin_prefetch(&centre_[i]);
+}
+
 void Engine::kick() {
-  const int a = static_cast<int>(rng_.below(n_));
-  int b = static_cast<int>(rng_.below(n_ - 1));
-  if (b >= a) ++b;
-  const int i = slot_of_[a], j = slot_of_[b]; // drawn by particle id
-  // Two particles anywhere in memory: everything both will need is
-  // requested before either is read.
-  for (const int s : {i, j}) {
-    __builtin_prefetch(&part_[s]);
-    nbr_.prefetch(s);
-    __builtin_prefetch(&centre_[s]);
-  }
+  int i, j;
+  kick_pair(count_.kicks, i, j);
+  // Their lines were requested at the previous kick; now their neighbours'.
+  prefetch_neighbours(i);
+  prefetch_neighbours(j);
   double kx, ky;
   rng_.normal_pair(kx, ky);
   const double p = kick_amplitude(eps_, mass_[0], mass_[1]);
@@ -317,6 +332,10 @@ void Engine::kick() {
   kick_time_ = now_ + rng_.exponential(kick_pair_rate_);
   predict(i);
   predict(j);
+  int ni, nj;
+  kick_pair(count_.kicks, ni, nj);
+  prefetch_particle(ni);
+  prefetch_particle(nj);
 }
 
 // Keep absolute time small: move every clock so that now is 0.

@@ -43,7 +43,7 @@ public:
   };
   static constexpr double kNever = std::numeric_limits<double>::infinity();
   // Live events per bucket aimed at, and how many mean horizons the ring covers.
-  static constexpr double kPerBucket = 8;
+  static constexpr double kPerBucket = 32;
   static constexpr double kRingHorizons = 4;
   static constexpr size_t kMaxBuckets = 8192;
 
@@ -218,7 +218,7 @@ private:
   // bucket doubles every bucket's capacity.
   std::vector<uint32_t> fill_;
   std::vector<int32_t> slots_;
-  size_t cap_ = 32;
+  size_t cap_ = 8;
   std::vector<int32_t> overflow_;
 };
 

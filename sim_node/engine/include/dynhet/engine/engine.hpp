@@ -193,6 +193,12 @@ private:
   void rebuild(int i); // i left its skin: new centre, new list
   void wrap(int i);    // back into the box, counting the image
   void kick();
+  // The pair of kick number k: two distinct storage slots drawn uniformly,
+  // from a hash of the seed and k. It needs no state of its own (the kick
+  // count is checkpointed) and is known ahead: its lines are requested
+  // when the kick before it is done.
+  void kick_pair(int64_t k, int& i, int& j) const;
+  void prefetch_particle(int i) const;
   void rebase();
   // Contact distance now, and its growth rate (compression only).
   double sigma(int i, int j) const { return scale() * (radius_[part_[i].species] + radius_[part_[j].species]); }

@@ -7,15 +7,20 @@
 
 namespace dynhet::engine {
 
+// A stateless 64-bit mix (splitmix64's finaliser): hash(k) for counters k
+// is a good uniform sequence.
+inline uint64_t mix64(uint64_t z) {
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+  return z ^ (z >> 31);
+}
+
 class Rng {
 public:
   explicit Rng(uint64_t seed = 1) {
     for (auto& w : s_) {
       seed += 0x9e3779b97f4a7c15ULL;
-      uint64_t z = seed;
-      z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
-      z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
-      w = z ^ (z >> 31);
+      w = mix64(seed);
     }
   }
   uint64_t next() {
