@@ -49,7 +49,7 @@ public:
   static constexpr size_t kMaxBuckets = 8192;
 
   // Every leaf 0..n-1 with a finite time (none earlier than `now`) is
-  // entered afresh; the bucket width follows their mean distance from now.
+  // entered afresh; the bucket width follows their typical distance from now.
   template <class Times> void rebuild(long n, double now, const Times& time) {
     suspended_ = false;
     // The typical distance of an event from now: the median over the
