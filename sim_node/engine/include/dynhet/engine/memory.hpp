@@ -1,7 +1,7 @@
 // Allocation for the engine's big arrays: cache-line aligned, and for arrays
 // of 2 MiB or more backed by transparent huge pages where the kernel offers
-// them (madvise mode). Every event touches particles, cells and calendar
-// nodes at random places of arrays of several MB; with 4 KiB pages most of
+// them (madvise mode). Every event touches particles, lists and cells
+// at random places of arrays of several MB; with 4 KiB pages most of
 // those accesses also miss the TLB.
 #pragma once
 
