@@ -137,7 +137,6 @@ int main(int argc, char** argv) {
         std::printf("%9ld %6.3f  failed: %s\n", n, phi, ex.what());
         continue;
       }
-      const double bytes = double(e.memory_bytes()) / n; // the engine's arrays
       const double e0 = e.kinetic_energy_per_particle();
       // Short warm-up to learn the collision rate, then the timed run.
       e.run_until(1.0);
@@ -162,6 +161,7 @@ int main(int argc, char** argv) {
       }
       const double t_sd = std::sqrt(std::max(0.0, t2 / temp.count() - temp.mean() * temp.mean()));
       const double wall = seconds(t0), cpu = cpu_seconds() - cpu0;
+      const double bytes = double(e.memory_bytes()) / n; // the engine's arrays, after the run (they grow)
       const auto c1 = e.counters();
       const double coll = double(c1.collisions - c0.collisions), kicks = double(c1.kicks - c0.kicks);
       const double cross = double(c1.rebuilds - c0.rebuilds), stale = double(c1.stale - c0.stale);

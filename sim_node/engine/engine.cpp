@@ -9,7 +9,6 @@
 #include "dynhet/model.hpp"
 
 namespace dynhet::engine {
-static constexpr bool kSteal = true;
 
 Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution), rng_(p.seed) {
   if (n_ < 2) throw std::invalid_argument("engine: need at least 2 particles");
@@ -123,10 +122,18 @@ bool Engine::near(int i, int j) const {
 
 void Engine::wrap(int i) {
   Particle& a = part_[i];
+  // x + box rounds to box for x just below 0: such a particle is put at 0
+  // (its own image), so that wrapping again changes nothing.
   if (a.x >= box_) a.x -= box_, ++image_x_[i];
-  else if (a.x < 0) a.x += box_, --image_x_[i];
+  else if (a.x < 0) {
+    a.x += box_, --image_x_[i];
+    if (a.x >= box_) a.x = 0, ++image_x_[i];
+  }
   if (a.y >= box_) a.y -= box_, ++image_y_[i];
-  else if (a.y < 0) a.y += box_, --image_y_[i];
+  else if (a.y < 0) {
+    a.y += box_, --image_y_[i];
+    if (a.y >= box_) a.y = 0, ++image_y_[i];
+  }
 }
 
 void Engine::build_lists() {

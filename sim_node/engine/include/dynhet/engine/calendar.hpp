@@ -8,7 +8,8 @@
 // depend on which calendar it uses.
 //
 // Time is cut into buckets of width w. The current bucket is a sorted array
-// of (time, leaf); the next nb - 1 buckets are a ring of unsorted leaf ids;
+// of (time, leaf); the next nb - 1 buckets are a ring of unsorted leaf ids
+// (chains of one-line chunks);
 // later events wait in an overflow list that is sorted into the ring once
 // per turn. Changing a leaf's time appends its id where the new time falls
 // (O(1), one line written) and leaves the old entry behind: an entry is
@@ -33,6 +34,8 @@
 #include <cstdint>
 #include <limits>
 #include <vector>
+
+#include "dynhet/engine/memory.hpp"
 
 namespace dynhet::engine {
 
@@ -71,8 +74,9 @@ public:
     while (nb < kMaxBuckets && nb < kRingHorizons * finite / kPerBucket) nb *= 2;
     const double w = finite > 0 && horizon > 0 ? kRingHorizons * horizon / nb : 1.0;
     inv_w_ = 1.0 / w;
-    if (fill_.size() != nb) fill_.assign(nb, 0), slots_.assign(nb * cap_, 0);
-    std::fill(fill_.begin(), fill_.end(), 0);
+    ring_.assign(nb, Bucket{-1, -1, 0});
+    chunks_.clear(); // (keeps its capacity)
+    free_ = -1;
     mask_ = static_cast<int64_t>(nb) - 1;
     overflow_.clear();
     current_.clear();
@@ -126,7 +130,7 @@ public:
 
   size_t bytes() const {
     return current_.capacity() * sizeof(Entry) + overflow_.capacity() * sizeof(int32_t) +
-           fill_.capacity() * sizeof(uint32_t) + slots_.capacity() * sizeof(int32_t);
+           ring_.capacity() * sizeof(Bucket) + chunks_.capacity() * sizeof(Chunk);
   }
 
 private:
@@ -143,16 +147,24 @@ private:
   }
 
   void to_ring(size_t r, int32_t leaf) {
-    if (fill_[r] == cap_) grow();
-    slots_[r * cap_ + fill_[r]++] = leaf;
+    Bucket& b = ring_[r];
+    if (b.tail < 0 || b.fill == kChunk) {
+      int32_t c;
+      if (free_ >= 0) {
+        c = free_;
+        free_ = chunks_[static_cast<size_t>(c)].next;
+      } else {
+        c = static_cast<int32_t>(chunks_.size());
+        chunks_.emplace_back();
+      }
+      chunks_[static_cast<size_t>(c)].next = -1;
+      if (b.tail >= 0) chunks_[static_cast<size_t>(b.tail)].next = c;
+      else b.head = c;
+      b.tail = c;
+      b.fill = 0;
+    }
+    chunks_[static_cast<size_t>(b.tail)].id[b.fill++] = leaf;
     ++in_ring_;
-  }
-  [[gnu::noinline, gnu::cold]] void grow() {
-    std::vector<int32_t> bigger(slots_.size() * 2);
-    for (size_t r = 0; r < fill_.size(); ++r)
-      std::copy(&slots_[r * cap_], &slots_[r * cap_] + fill_[r], &bigger[r * 2 * cap_]);
-    slots_.swap(bigger);
-    cap_ *= 2;
   }
 
   // The current bucket is used up: move on to the next one that holds
@@ -196,16 +208,24 @@ private:
       }
       overflow_.resize(keep);
     }
-    const size_t r = static_cast<size_t>(current_bucket_ & mask_);
-    const int32_t* slot = &slots_[r * cap_];
-    const uint32_t m = fill_[r];
-    in_ring_ -= m;
-    for (uint32_t k = 0; k < m; ++k) time.prefetch(slot[k]);
-    for (uint32_t k = 0; k < m; ++k) {
-      const double t = time(slot[k]);
-      if (t < kNever && bucket(t) == current_bucket_) current_.push_back(Entry{t, slot[k]});
+    // The bucket's ids, its chunks back to the free list.
+    Bucket& bk = ring_[static_cast<size_t>(current_bucket_ & mask_)];
+    drain_.clear();
+    for (int32_t c = bk.head; c >= 0;) {
+      Chunk& ch = chunks_[static_cast<size_t>(c)];
+      drain_.insert(drain_.end(), ch.id, ch.id + (c == bk.tail ? bk.fill : kChunk));
+      const int32_t next = ch.next;
+      ch.next = free_;
+      free_ = c;
+      c = next;
     }
-    fill_[r] = 0;
+    bk = Bucket{-1, -1, 0};
+    in_ring_ -= drain_.size();
+    for (const int32_t leaf : drain_) time.prefetch(leaf);
+    for (const int32_t leaf : drain_) {
+      const double t = time(leaf);
+      if (t < kNever && bucket(t) == current_bucket_) current_.push_back(Entry{t, leaf});
+    }
     std::sort(current_.begin(), current_.end(), before);
     // A leaf entered twice in this bucket appears twice: keep one.
     current_.erase(std::unique(current_.begin(), current_.end(),
@@ -221,13 +241,24 @@ private:
   bool suspended_ = true;
   std::vector<Entry> current_;
   size_t pos_ = 0;
-  // The ring: bucket r holds fill_[r] leaves at slots_[r * cap_ ...]. The
-  // fill counts are one small array (an insertion reads a line that is
-  // likely in cache, and only writes to the bucket's own line); a full
-  // bucket doubles every bucket's capacity.
-  std::vector<uint32_t> fill_;
-  std::vector<int32_t> slots_;
-  size_t cap_ = 8;
+  // The ring: each bucket is a chain of chunks of 15 ids (one cache line
+  // each) from a common pool, so memory follows the number of entries,
+  // however unevenly they fall. The bucket's head, tail and fill are one
+  // small array: an insertion reads a line that is likely in cache and
+  // writes the tail chunk.
+  static constexpr uint32_t kChunk = 15;
+  struct alignas(64) Chunk {
+    int32_t id[kChunk];
+    int32_t next;
+  };
+  struct Bucket {
+    int32_t head, tail;
+    uint32_t fill; // ids in the tail chunk
+  };
+  std::vector<Bucket> ring_;
+  std::vector<Chunk, BigArrayAlloc<Chunk>> chunks_;
+  int32_t free_ = -1; // chain of free chunks
+  std::vector<int32_t> drain_; // scratch: the ids of the bucket being read
   std::vector<int32_t> overflow_;
 };
 
