@@ -22,8 +22,7 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
   species_by_id_.resize(n_);
   for (long i = 0; i < n_; ++i) species_by_id_[i] = static_cast<uint8_t>(species_of(i, n_));
   id_.resize(n_);
-  slot_of_.resize(n_);
-  for (long i = 0; i < n_; ++i) id_[i] = slot_of_[i] = static_cast<int32_t>(i);
+  for (long i = 0; i < n_; ++i) id_[i] = static_cast<int32_t>(i);
 
   if (!(p.skin >= 0) || !std::isfinite(p.skin))
     throw std::invalid_argument("engine: the neighbour-list skin must be positive (or 0 for automatic), not " +
@@ -108,7 +107,6 @@ void Engine::reorder() {
   permute(image_y_);
   permute(last_collision_);
   permute(id_);
-  for (long s = 0; s < n_; ++s) slot_of_[id_[s]] = static_cast<int32_t>(s);
   build_cells();
 }
 
@@ -311,10 +309,14 @@ void Engine::kick_pair(int64_t k, int& i, int& j) const {
   if (j >= i) ++j;
 }
 
-void Engine::prefetch_particle(int i) const {
-  __builtin_prefetch(&part_[i]);
+void Engine::prefetch_list(int i) const {
   nbr_.prefetch(i);
   __builtin_prefetch(&centre_[i]);
+}
+
+void Engine::prefetch_particle(int i) const {
+  __builtin_prefetch(&part_[i]);
+  prefetch_list(i);
 }
 
 void Engine::kick() {
@@ -377,15 +379,15 @@ bool Engine::run_until(double t_abs, int64_t max_events) {
     now_ = t;
     ++events_since_rebase_;
     // Software pipeline over the next events in the calendar: the list,
-    // centre and partner of the one after next, the neighbours of the next.
+    // centre and partner of the third; the neighbours, and the partner's
+    // list and centre, of the second; the partner's neighbours of the next.
     if (const int a3 = cal_.ahead(3); a3 >= 0) {
-      nbr_.prefetch(a3);
-      __builtin_prefetch(&centre_[a3]);
+      prefetch_list(a3);
       if (const int q = part_[a3].partner; q >= 0) __builtin_prefetch(&part_[q]);
     }
     if (const int a2 = cal_.ahead(2); a2 >= 0) {
       prefetch_neighbours(a2);
-      if (const int q = part_[a2].partner; q >= 0) nbr_.prefetch(q), __builtin_prefetch(&centre_[q]);
+      if (const int q = part_[a2].partner; q >= 0) prefetch_list(q);
     }
     if (const int a1 = cal_.ahead(1); a1 >= 0) {
       if (const int q = part_[a1].partner; q >= 0) prefetch_neighbours(q);
@@ -397,16 +399,14 @@ bool Engine::run_until(double t_abs, int64_t max_events) {
     // Lines the event will need, requested before the first is waited for:
     // the list and centre of the particle, then, once its line says who the
     // partner is, the same for the partner.
-    nbr_.prefetch(leaf);
-    __builtin_prefetch(&centre_[leaf]);
+    prefetch_list(leaf);
     const int partner = part_[leaf].partner;
     if (partner == kRebuild) {
       sync(leaf);
       rebuild(leaf);
       continue;
     }
-    nbr_.prefetch(partner);
-    __builtin_prefetch(&centre_[partner]);
+    prefetch_list(partner);
     if (seen(part_[partner].coll) != part_[leaf].partner_seen) {
       ++count_.stale;
       sync(leaf);
@@ -588,7 +588,7 @@ void Engine::restore(const State& s) {
   }
   image_x_ = s.image_x;
   image_y_ = s.image_y;
-  for (long i = 0; i < n_; ++i) id_[i] = slot_of_[i] = static_cast<int32_t>(i);
+  for (long i = 0; i < n_; ++i) id_[i] = static_cast<int32_t>(i);
   rng_.set_state(s.rng);
   count_ = s.counters;
   start_run();
@@ -660,7 +660,7 @@ double Engine::mean_neighbours() const {
 
 size_t Engine::memory_bytes() const {
   auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  return b(part_) + b(species_by_id_) + b(id_) + b(slot_of_) + b(image_x_) + b(image_y_) + b(last_collision_) +
+  return b(part_) + b(species_by_id_) + b(id_) + b(image_x_) + b(image_y_) + b(last_collision_) +
          cells_.bytes() + b(cell_x_) + b(cell_y_) + nbr_.bytes() + b(centre_) + cal_.bytes();
 }
 

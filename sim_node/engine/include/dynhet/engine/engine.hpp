@@ -198,7 +198,8 @@ private:
   // count is checkpointed) and is known ahead: its lines are requested
   // when the kick before it is done.
   void kick_pair(int64_t k, int& i, int& j) const;
-  void prefetch_particle(int i) const;
+  void prefetch_list(int i) const;     // i's neighbour list and list centre
+  void prefetch_particle(int i) const; // its line, list and centre
   void rebase();
   // Contact distance now, and its growth rate (compression only).
   double sigma(int i, int j) const { return scale() * (radius_[part_[i].species] + radius_[part_[j].species]); }
@@ -248,10 +249,10 @@ private:
   double eps_;
 
   // Per-particle arrays are indexed by storage slot; id_[slot] is the
-  // particle's id (its index in frames and checkpoints), slot_of_ the inverse.
+  // particle's id (its index in frames and checkpoints).
   std::vector<Particle, BigArrayAlloc<Particle>> part_;
   std::vector<uint8_t> species_by_id_;
-  std::vector<int32_t> id_, slot_of_;
+  std::vector<int32_t> id_;
   std::vector<int32_t> image_x_, image_y_;
   std::vector<double> last_collision_; // internal time of each particle's last collision; kept only with the TC model on
 
