@@ -33,6 +33,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <limits>
+#include <stdexcept>
+#include <string>
 #include <vector>
 
 #include "dynhet/engine/memory.hpp"
@@ -50,10 +52,17 @@ public:
   static constexpr double kPerBucket = 32;
   static constexpr double kRingHorizons = 4;
   static constexpr size_t kMaxBuckets = 8192;
+  // Buckets per coarse bucket (a power of 2), and the largest leaf the
+  // ring's packed entries hold.
+  static constexpr int kFineBits = 5;
+  static constexpr int64_t kFine = int64_t{1} << kFineBits;
+  static constexpr long kMaxLeaves = long{1} << (32 - kFineBits);
 
   // Every leaf 0..n-1 with a finite time (none earlier than `now`) is
   // entered afresh; the bucket width follows their typical distance from now.
   template <class Times> void rebuild(long n, double now, const Times& time) {
+    if (n > kMaxLeaves)
+      throw std::length_error("calendar: at most " + std::to_string(kMaxLeaves) + " leaves, not " + std::to_string(n));
     suspended_ = false;
     // The typical distance of an event from now: the median over the
     // events, divided by ln 2 (the mean if they were exponential). Not the
@@ -70,18 +79,20 @@ public:
       std::nth_element(dist.begin(), dist.begin() + finite / 2, dist.end());
       horizon = dist[static_cast<size_t>(finite / 2)] / std::log(2.0);
     }
-    size_t nb = 16;
+    size_t nb = 4 * kFine;
     while (nb < kMaxBuckets && nb < kRingHorizons * finite / kPerBucket) nb *= 2;
     const double w = finite > 0 && horizon > 0 ? kRingHorizons * horizon / nb : 1.0;
     inv_w_ = 1.0 / w;
-    ring_.assign(nb, Bucket{-1, -1, 0});
+    ring_.assign(nb / kFine, Bucket{-1, -1, 0});
     chunks_.clear(); // (keeps its capacity)
     free_ = -1;
     mask_ = static_cast<int64_t>(nb) - 1;
+    coarse_mask_ = static_cast<int64_t>(nb / kFine) - 1;
     overflow_.clear();
     current_.clear();
+    for (auto& f : fine_) f.clear();
     pos_ = 0;
-    in_ring_ = 0;
+    in_ring_ = in_fine_ = 0;
     current_bucket_ = bucket(std::max(now, 0.0));
     turn_start_ = current_bucket_ & ~mask_;
     for (long i = 0; i < n; ++i) {
@@ -100,8 +111,11 @@ public:
     if (b <= current_bucket_) {
       const Entry e{t, leaf};
       current_.insert(std::upper_bound(current_.begin() + static_cast<std::ptrdiff_t>(pos_), current_.end(), e, before), e);
-    } else if (b - current_bucket_ <= mask_) {
-      to_ring(static_cast<size_t>(b & mask_), leaf);
+    } else if (const int64_t ahead = (b >> kFineBits) - (current_bucket_ >> kFineBits); ahead == 0) {
+      fine_[static_cast<size_t>(b & (kFine - 1))].push_back(leaf);
+      ++in_fine_;
+    } else if (ahead <= coarse_mask_) {
+      to_ring(static_cast<size_t>((b >> kFineBits) & coarse_mask_), pack(leaf, b));
     } else {
       overflow_.push_back(leaf);
     }
@@ -129,8 +143,10 @@ public:
   int32_t ahead(size_t k) const { return pos_ + k < current_.size() ? current_[pos_ + k].leaf : -1; }
 
   size_t bytes() const {
-    return current_.capacity() * sizeof(Entry) + overflow_.capacity() * sizeof(int32_t) +
-           ring_.capacity() * sizeof(Bucket) + chunks_.capacity() * sizeof(Chunk);
+    size_t fine = 0;
+    for (const auto& f : fine_) fine += f.capacity() * sizeof(int32_t);
+    return current_.capacity() * sizeof(Entry) + overflow_.capacity() * sizeof(int32_t) + fine +
+           ring_.capacity() * sizeof(Bucket) + chunks_.capacity() * sizeof(Chunk) + drain_.capacity() * sizeof(int32_t);
   }
 
 private:
@@ -145,8 +161,12 @@ private:
     const double b = t * inv_w_;
     return b < 4e18 ? static_cast<int64_t>(b) : static_cast<int64_t>(4e18);
   }
+  // A ring entry: the leaf and its bucket within the coarse bucket.
+  static uint32_t pack(int32_t leaf, int64_t b) {
+    return static_cast<uint32_t>(leaf) << kFineBits | static_cast<uint32_t>(b & (kFine - 1));
+  }
 
-  void to_ring(size_t r, int32_t leaf) {
+  void to_ring(size_t r, uint32_t packed) {
     Bucket& b = ring_[r];
     if (b.tail < 0 || b.fill == kChunk) {
       int32_t c;
@@ -163,8 +183,28 @@ private:
       b.tail = c;
       b.fill = 0;
     }
-    chunks_[static_cast<size_t>(b.tail)].id[b.fill++] = leaf;
+    chunks_[static_cast<size_t>(b.tail)].id[b.fill++] = packed;
     ++in_ring_;
+  }
+
+  // The coarse bucket of current_bucket_ has just become current: its
+  // ring entries go to the fine buckets, its chunks back to the free list.
+  void spread_coarse() {
+    Bucket& bk = ring_[static_cast<size_t>((current_bucket_ >> kFineBits) & coarse_mask_)];
+    for (int32_t c = bk.head; c >= 0;) {
+      Chunk& ch = chunks_[static_cast<size_t>(c)];
+      if (ch.next >= 0) __builtin_prefetch(&chunks_[static_cast<size_t>(ch.next)]);
+      const uint32_t m = c == bk.tail ? bk.fill : kChunk;
+      for (uint32_t k = 0; k < m; ++k)
+        fine_[ch.id[k] & (kFine - 1)].push_back(static_cast<int32_t>(ch.id[k] >> kFineBits));
+      in_ring_ -= m;
+      in_fine_ += m;
+      const int32_t next = ch.next;
+      ch.next = free_;
+      free_ = c;
+      c = next;
+    }
+    bk = Bucket{-1, -1, 0};
   }
 
   // The current bucket is used up: move on to the next one that holds
@@ -172,7 +212,7 @@ private:
   template <class Times> bool advance(const Times& time) {
     current_.clear();
     pos_ = 0;
-    if (in_ring_ == 0) {
+    if (in_ring_ == 0 && in_fine_ == 0) {
       if (overflow_.empty()) return false;
       // Nothing before the overflow: jump to the turn of its earliest event.
       int64_t first = INT64_MAX;
@@ -191,41 +231,36 @@ private:
       }
     }
     ++current_bucket_;
-    if (current_bucket_ - turn_start_ > mask_) { // a new turn of the ring
-      turn_start_ += mask_ + 1;
-      size_t keep = 0;
-      for (const int32_t leaf : overflow_) time.prefetch(leaf);
-      for (const int32_t leaf : overflow_) {
-        const double t = time(leaf);
-        if (!(t < kNever)) continue;
-        const int64_t b = bucket(t);
-        if (b < turn_start_) continue; // stale: its leaf's entry is elsewhere
-        if (b - turn_start_ <= mask_) {
-          to_ring(static_cast<size_t>(b & mask_), leaf);
-        } else {
-          overflow_[keep++] = leaf;
+    if ((current_bucket_ & (kFine - 1)) == 0) { // a new coarse bucket
+      if (current_bucket_ - turn_start_ > mask_) { // a new turn of the ring
+        turn_start_ += mask_ + 1;
+        size_t keep = 0;
+        for (const int32_t leaf : overflow_) time.prefetch(leaf);
+        for (const int32_t leaf : overflow_) {
+          const double t = time(leaf);
+          if (!(t < kNever)) continue;
+          const int64_t b = bucket(t);
+          if (b < turn_start_) continue; // stale: its leaf's entry is elsewhere
+          if (b - turn_start_ <= mask_) {
+            to_ring(static_cast<size_t>((b >> kFineBits) & coarse_mask_), pack(leaf, b));
+          } else {
+            overflow_[keep++] = leaf;
+          }
         }
+        overflow_.resize(keep);
       }
-      overflow_.resize(keep);
+      spread_coarse();
     }
-    // The bucket's ids, its chunks back to the free list.
-    Bucket& bk = ring_[static_cast<size_t>(current_bucket_ & mask_)];
-    drain_.clear();
-    for (int32_t c = bk.head; c >= 0;) {
-      Chunk& ch = chunks_[static_cast<size_t>(c)];
-      drain_.insert(drain_.end(), ch.id, ch.id + (c == bk.tail ? bk.fill : kChunk));
-      const int32_t next = ch.next;
-      ch.next = free_;
-      free_ = c;
-      c = next;
-    }
-    bk = Bucket{-1, -1, 0};
-    in_ring_ -= drain_.size();
+    // The bucket's ids: their lines requested at once, stale ones dropped,
+    // the rest sorted.
+    drain_.swap(fine_[static_cast<size_t>(current_bucket_ & (kFine - 1))]);
+    in_fine_ -= drain_.size();
     for (const int32_t leaf : drain_) time.prefetch(leaf);
     for (const int32_t leaf : drain_) {
       const double t = time(leaf);
       if (t < kNever && bucket(t) == current_bucket_) current_.push_back(Entry{t, leaf});
     }
+    drain_.clear();
     std::sort(current_.begin(), current_.end(), before);
     // A leaf entered twice in this bucket appears twice: keep one.
     current_.erase(std::unique(current_.begin(), current_.end(),
@@ -235,20 +270,25 @@ private:
   }
 
   double inv_w_ = 1;
-  int64_t mask_ = 15;
+  int64_t mask_ = 4 * kFine - 1;     // buckets in the ring, minus 1
+  int64_t coarse_mask_ = 3;          // coarse buckets in the ring, minus 1
   int64_t current_bucket_ = 0, turn_start_ = 0;
-  size_t in_ring_ = 0;
+  size_t in_ring_ = 0, in_fine_ = 0;
   bool suspended_ = true;
   std::vector<Entry> current_;
   size_t pos_ = 0;
-  // The ring: each bucket is a chain of chunks of 15 ids (one cache line
-  // each) from a common pool, so memory follows the number of entries,
-  // however unevenly they fall. The bucket's head, tail and fill are one
-  // small array: an insertion reads a line that is likely in cache and
-  // writes the tail chunk.
+  // The buckets of the current coarse bucket, as plain id lists: few, and
+  // all in cache.
+  std::vector<int32_t> fine_[kFine];
+  // The ring of coarse buckets: each is a chain of chunks of 15 packed
+  // entries (one cache line each) from a common pool, so memory follows
+  // the number of entries, however unevenly they fall. The ring's heads,
+  // tails and fills and its tail chunks are few enough to stay in cache: an
+  // insertion far ahead writes a line that is already there (one
+  // bucket per event would scatter the writes over thousands of lines).
   static constexpr uint32_t kChunk = 15;
   struct alignas(64) Chunk {
-    int32_t id[kChunk];
+    uint32_t id[kChunk];
     int32_t next;
   };
   struct Bucket {
