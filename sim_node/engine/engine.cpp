@@ -43,6 +43,7 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
 
   part_.assign(n_, Particle{0, 0, 0, 0, 0, kNever, 0, 0, kRebuild, 0});
   for (long i = 0; i < n_; ++i) part_[i].species = species_by_id_[i];
+  species_ = species_by_id_;
   image_x_.assign(n_, 0);
   image_y_.assign(n_, 0);
   last_collision_.assign(n_, -kNever);
@@ -103,6 +104,7 @@ void Engine::reorder() {
     for (long s = 0; s < n_; ++s) v[s] = old[order[s]];
   };
   permute(part_);
+  permute(species_);
   permute(image_x_);
   permute(image_y_);
   permute(last_collision_);
@@ -114,7 +116,7 @@ void Engine::reorder() {
 
 bool Engine::near(int i, int j) const {
   const double dx = min_image(centre_[i].x - centre_[j].x), dy = min_image(centre_[i].y - centre_[j].y);
-  const double reach = list_scale_ * (radius_[part_[i].species] + radius_[part_[j].species]) + skin_ + list_margin_;
+  const double reach = list_scale_ * (radius_[species_[i]] + radius_[species_[j]]) + skin_ + list_margin_;
   return dx * dx + dy * dy <= reach * reach;
 }
 
@@ -185,7 +187,6 @@ void Engine::rebuild(int i) {
     for (int k = 1; k <= c[0]; ++k) {
       const int j = c[k];
       __builtin_prefetch(&centre_[j]);
-      __builtin_prefetch(&part_[j]);
       cand[nc++] = j;
     }
   }
@@ -630,6 +631,7 @@ void Engine::restore(const State& s) {
   image_x_ = s.image_x;
   image_y_ = s.image_y;
   for (long i = 0; i < n_; ++i) id_[i] = static_cast<int32_t>(i);
+  species_ = species_by_id_;
   rng_.set_state(s.rng);
   count_ = s.counters;
   start_run();
@@ -701,7 +703,7 @@ double Engine::mean_neighbours() const {
 
 size_t Engine::memory_bytes() const {
   auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
-  return b(part_) + b(species_by_id_) + b(id_) + b(image_x_) + b(image_y_) + b(last_collision_) +
+  return b(part_) + b(species_by_id_) + b(species_) + b(id_) + b(image_x_) + b(image_y_) + b(last_collision_) +
          cells_.bytes() + b(cell_x_) + b(cell_y_) + nbr_.bytes() + b(centre_) + cal_.bytes();
 }
 

@@ -253,6 +253,10 @@ private:
   std::vector<Particle, BigArrayAlloc<Particle>> part_;
   std::vector<uint8_t> species_by_id_;
   std::vector<int32_t> id_;
+  // Species by slot, for the list criterion: a rebuild tests about 40
+  // candidates, most of them not listed, and this spares reading their
+  // particles' lines.
+  std::vector<uint8_t> species_;
   std::vector<int32_t> image_x_, image_y_;
   std::vector<double> last_collision_; // internal time of each particle's last collision; kept only with the TC model on
 
