@@ -12,6 +12,9 @@ namespace dynhet::engine {
 
 Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution), rng_(p.seed) {
   if (n_ < 2) throw std::invalid_argument("engine: need at least 2 particles");
+  if (n_ > Calendar::kMaxLeaves)
+    throw std::invalid_argument("engine: at most " + std::to_string(Calendar::kMaxLeaves) + " particles, not " +
+                                std::to_string(n_));
   const Model m = make_model(n_, p.packing_fraction, p.radius_ratio);
   box_ = m.box_length;
   half_box_ = 0.5 * box_;

@@ -7,12 +7,15 @@
 // lower leaf: the order of a complete tournament tree, so a run does not
 // depend on which calendar it uses.
 //
-// Time is cut into buckets of width w. The current bucket is a sorted array
-// of (time, leaf); the next nb - 1 buckets are a ring of unsorted leaf ids
-// (chains of one-line chunks);
-// later events wait in an overflow list that is sorted into the ring once
-// per turn. Changing a leaf's time appends its id where the new time falls
-// (O(1), one line written) and leaves the old entry behind: an entry is
+// Time is cut into buckets of width w, 32 buckets to a coarse bucket. The
+// current bucket is a sorted array of (time, leaf); the other buckets of
+// the current coarse bucket are plain lists of leaf ids; the next coarse
+// buckets (up to 255) are a ring of unsorted entries (leaf id and bucket
+// within, packed; chains of one-line chunks), spread into the 32 lists
+// when the clock reaches them; later events wait in an overflow list that
+// is sorted into the ring once per turn. Changing a leaf's time appends an
+// entry where the new time falls (O(1), one line written, nearly always
+// one in cache) and leaves the old entry behind: an entry is
 // stale when its leaf's time has moved to another bucket, or (in the sorted
 // array) differs from the entry's. A bucket is read only when the clock
 // reaches it: all its leaves' lines are requested at once, stale entries
