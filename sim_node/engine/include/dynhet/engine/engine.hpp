@@ -54,16 +54,18 @@ struct Params {
 };
 
 // Fastest skin at N = 10^5 (bench_engine --skin, docs/engine.md), in small
-// radii: 2.0 up to phi = 0.60, 1.8 at 0.70, 1.4 at 0.78, 1.1 at 0.805,
-// linear between and on to 0.9 from phi = 0.825. Denser packings rattle in
-// smaller cages, so a thinner skin is left as rarely; a thicker one lists
-// more neighbours (and lists longer than 15 double the memory they take).
+// radii: 3.0 up to phi = 0.30, 2.5 at 0.50, 2.0 at 0.60, 1.8 at 0.70, 1.4
+// at 0.78, 1.1 at 0.805, linear between and on to 0.9 from phi = 0.825.
+// Denser packings rattle in smaller cages, so a thinner skin is left as
+// rarely; a thicker one lists more neighbours (and lists longer than 15
+// double the memory they take).
 inline double auto_skin(double phi) {
-  constexpr double p[] = {0.60, 0.70, 0.78, 0.805, 0.825}, s[] = {2.0, 1.8, 1.4, 1.1, 0.9};
+  constexpr int k = 7;
+  constexpr double p[k] = {0.30, 0.50, 0.60, 0.70, 0.78, 0.805, 0.825}, s[k] = {3.0, 2.5, 2.0, 1.8, 1.4, 1.1, 0.9};
   if (phi <= p[0]) return s[0];
-  for (int k = 1; k < 5; ++k)
-    if (phi <= p[k]) return s[k - 1] + (phi - p[k - 1]) / (p[k] - p[k - 1]) * (s[k] - s[k - 1]);
-  return s[4];
+  for (int i = 1; i < k; ++i)
+    if (phi <= p[i]) return s[i - 1] + (phi - p[i - 1]) / (p[i] - p[i - 1]) * (s[i] - s[i - 1]);
+  return s[k - 1];
 }
 
 // The paper's system: radius ratio 1.43, kicks (if driven) at the Enskog
