@@ -229,6 +229,15 @@ void Engine::prefetch_neighbours(int i) const {
 // mispredictions than the arithmetic itself), so that the compiler makes
 // vector code of it. The AVX2 version (4 lanes) is picked at run time where
 // the processor has it; it computes the same bits as the default (no FMA).
+// An AVX2 clone of the pair tests, picked at run time, where the compiler
+// and the C library support it (x86-64 with ifunc); elsewhere, or with
+// DYNHET_NO_CLONES, one portable version.
+#if defined(__x86_64__) && defined(__gnu_linux__) && !defined(DYNHET_NO_CLONES)
+#define DYNHET_PAIR_CLONES [[gnu::target_clones("avx2", "default")]]
+#else
+#define DYNHET_PAIR_CLONES
+#endif
+
 namespace {
 struct PairBlock {
   static constexpr int kSize = 8;
@@ -236,7 +245,7 @@ struct PairBlock {
   alignas(32) double bx[kSize], by[kSize], bvx[kSize], bvy[kSize], bt[kSize], br[kSize];
 };
 
-[[gnu::target_clones("avx2", "default")]] void collision_times(const PairBlock& p, double* dt) {
+DYNHET_PAIR_CLONES void collision_times(const PairBlock& p, double* dt) {
   for (int q = 0; q < PairBlock::kSize; ++q) {
     const double bdt = p.now - p.bt[q];
     const double x = p.x - (p.bx[q] + p.bvx[q] * bdt), y = p.y - (p.by[q] + p.bvy[q] * bdt);
