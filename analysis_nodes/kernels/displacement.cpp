@@ -321,7 +321,7 @@ struct ExtremeSums {
 // One group of four particles (lanes beyond `valid` are no set's members):
 // the sure sums and counts, the set sizes, and the flag word of each
 // particle (bit j: in band j).
-inline void extreme_group(const double* x, const std::uint8_t* sp, V4l valid, const ExtremeCuts& c,
+inline void extreme_group(const double* x, const std::uint8_t* sp, const V4l& valid, const ExtremeCuts& c,
                           ExtremeSums& s, std::int64_t* flag) {
   V4d y;
   V4b t;
@@ -453,7 +453,7 @@ void sampled_extremes(const double* d2, const std::uint8_t* species, long n, con
   // Each side: exact if its k-th value is in the band (the counts say so),
   // else the whole set again with nth_element.
   for (int s = 0; s < n_sets; ++s) {
-    auto lanes = [](auto a) { return (a[0] + a[1]) + (a[2] + a[3]); };
+    auto lanes = [](const auto& a) { return (a[0] + a[1]) + (a[2] + a[3]); };
     const long m = lanes(sums.members[s]);
     if (m == 0) {
       out[s] = {NAN, NAN, 0, 0};
