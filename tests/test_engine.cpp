@@ -295,6 +295,18 @@ TEST(Engine, SkinChangesNoCollision) {
   EXPECT_THROW(Engine{bad}, std::invalid_argument);
 }
 
+TEST(Engine, RefusesMoreParticlesThanTheCalendarCanNumber) {
+  // The calendar packs particle ids into 27 bits: 2^27 + 1 particles are
+  // refused before anything is allocated.
+  Params p = dynhet::engine::paper_params(dynhet::engine::Calendar::kMaxLeaves + 1, 0.7, 1.0, false);
+  try {
+    Engine e(p);
+    FAIL() << "accepted " << p.n_particles << " particles";
+  } catch (const std::invalid_argument& ex) {
+    EXPECT_NE(std::string(ex.what()).find("at most 134217728 particles"), std::string::npos) << ex.what();
+  }
+}
+
 // Bidisperse (r2/r1 = 1.43, 50:50) against the mixture recipe of Santos,
 // Yuste and Lopez de Haro (Mol. Phys. 96, 1 (1999)) for d = 2:
 //   g_ij = 1/(1-phi) + [g_H(phi) - 1/(1-phi)] z_ij,  z_ij = (s_i s_j / s_ij) <s>/<s^2>,
