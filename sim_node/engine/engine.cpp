@@ -223,15 +223,12 @@ void Engine::prefetch_neighbours(int i) const {
 }
 
 // Collision times of particle (x, y, vx, vy, r) with a block of neighbours
-// (bx, by, bvx, bvy, br at their local times bt) at time now: the same
-// operations as pair_collision_time(), so the same bits, but without a
-// branch (a branch per pair, half of them receding at random, cost more in
-// mispredictions than the arithmetic itself), so that the compiler makes
-// vector code of it. The AVX2 version (4 lanes) is picked at run time where
-// the processor has it; it computes the same bits as the default (no FMA).
-// An AVX2 clone of the pair tests, picked at run time, where the compiler
-// and the C library support it (x86-64 with ifunc); elsewhere, or with
-// DYNHET_NO_CLONES, one portable version.
+// (bx, by, bvx, bvy, br at their local times bt) at time now, by
+// pair_collision_time(), which has no branch: the compiler makes vector
+// code of the loop. An AVX2 clone (4 lanes, no FMA, so the same bits) is
+// picked at run time where the compiler and the C library support it
+// (x86-64 with ifunc); elsewhere, or with DYNHET_NO_CLONES, one portable
+// version.
 #if defined(__x86_64__) && defined(__gnu_linux__) && !defined(DYNHET_NO_CLONES)
 #define DYNHET_PAIR_CLONES [[gnu::target_clones("avx2", "default")]]
 #else
@@ -249,19 +246,9 @@ DYNHET_PAIR_CLONES void collision_times(const PairBlock& p, double* dt) {
   for (int q = 0; q < PairBlock::kSize; ++q) {
     const double bdt = p.now - p.bt[q];
     const double x = p.x - (p.bx[q] + p.bvx[q] * bdt), y = p.y - (p.by[q] + p.bvy[q] * bdt);
-    const double dx = x > p.half_box ? x - p.box : (x < -p.half_box ? x + p.box : x); // min_image()
-    const double dy = y > p.half_box ? y - p.box : (y < -p.half_box ? y + p.box : y);
     const double rsum = p.r + p.br[q];
-    const double sigma = p.scale * rsum, growth = p.growth * rsum;
-    const double gx = p.vx - p.bvx[q], gy = p.vy - p.bvy[q];
-    const double B = dx * gx + dy * gy - sigma * growth;
-    const double A = gx * gx + gy * gy - growth * growth;
-    const double C = dx * dx + dy * dy - sigma * sigma;
-    const double disc = B * B - A * C;
-    const double root = C / (-B + std::sqrt(disc));
-    double t = disc > 0 ? root : kNever;
-    t = C <= 0 ? (B < 0 ? 0.0 : kNever) : t;
-    dt[q] = B >= 0 && A >= 0 ? kNever : t;
+    dt[q] = pair_collision_time(nearest_image(x, p.box, p.half_box), nearest_image(y, p.box, p.half_box),
+                                p.vx - p.bvx[q], p.vy - p.bvy[q], p.scale * rsum, p.growth * rsum);
   }
 }
 } // namespace

@@ -118,7 +118,7 @@ public:
       fine_[static_cast<size_t>(b & (kFine - 1))].push_back(leaf);
       ++in_fine_;
     } else if (ahead <= coarse_mask_) {
-      to_ring(static_cast<size_t>((b >> kFineBits) & coarse_mask_), pack(leaf, b));
+      to_ring(leaf, b);
     } else {
       overflow_.push_back(leaf);
     }
@@ -164,12 +164,13 @@ private:
     const double b = t * inv_w_;
     return b < 4e18 ? static_cast<int64_t>(b) : static_cast<int64_t>(4e18);
   }
-  // A ring entry: the leaf and its bucket within the coarse bucket.
-  static uint32_t pack(int32_t leaf, int64_t b) {
-    return static_cast<uint32_t>(leaf) << kFineBits | static_cast<uint32_t>(b & (kFine - 1));
-  }
-
-  void to_ring(size_t r, uint32_t packed) {
+  // Enters leaf, whose time falls in bucket bucket_of_leaf, into the ring:
+  // in the slot of that bucket's coarse bucket, packed with its place
+  // within it.
+  void to_ring(int32_t leaf, int64_t bucket_of_leaf) {
+    const size_t r = static_cast<size_t>((bucket_of_leaf >> kFineBits) & coarse_mask_);
+    const uint32_t packed =
+        static_cast<uint32_t>(leaf) << kFineBits | static_cast<uint32_t>(bucket_of_leaf & (kFine - 1));
     Bucket& b = ring_[r];
     if (b.tail < 0 || b.fill == kChunk) {
       int32_t c;
@@ -245,7 +246,7 @@ private:
           const int64_t b = bucket(t);
           if (b < turn_start_) continue; // stale: its leaf's entry is elsewhere
           if (b - turn_start_ <= mask_) {
-            to_ring(static_cast<size_t>((b >> kFineBits) & coarse_mask_), pack(leaf, b));
+            to_ring(leaf, b);
           } else {
             overflow_[keep++] = leaf;
           }

@@ -8,6 +8,12 @@ namespace dynhet::engine {
 
 inline constexpr double kNever = std::numeric_limits<double>::infinity();
 
+// Nearest periodic image of a separation component d in a box of side
+// `box` (half_box = box / 2), for |d| below 1.5 box.
+inline double nearest_image(double d, double box, double half_box) {
+  return d > half_box ? d - box : (d < -half_box ? d + box : d);
+}
+
 // Time from now until disks at separation (dx, dy) (r_i - r_j) with relative
 // velocity (gx, gy) (v_i - v_j) touch, their contact distance being sigma now
 // and growing at rate `growth` (0 except while compressing). Root of
@@ -15,17 +21,20 @@ inline constexpr double kNever = std::numeric_limits<double>::infinity();
 // t = C / (-B + sqrt(B^2 - A C)), A = g^2 - growth^2, B = dr.g - sigma growth,
 // C = dr^2 - sigma^2. A pair that is not approaching (B >= 0) never collides
 // unless the growth outruns it (A < 0); an approaching pair that overlaps by
-// roundoff (C <= 0) collides at once.
+// roundoff (C <= 0) collides at once. Every case is computed and the answer
+// picked by selects, without a branch: the engine calls this for a block of
+// neighbours at once, as vector code (half the pairs recede, at random, and
+// a branch per pair cost more in mispredictions than the arithmetic).
 inline double pair_collision_time(double dx, double dy, double gx, double gy, double sigma,
                                   double growth = 0.0) {
   const double B = dx * gx + dy * gy - sigma * growth;
   const double A = gx * gx + gy * gy - growth * growth;
-  if (B >= 0 && A >= 0) return kNever;
   const double C = dx * dx + dy * dy - sigma * sigma;
-  if (C <= 0) return B < 0 ? 0.0 : kNever;
   const double disc = B * B - A * C;
-  if (disc <= 0) return kNever;
-  return C / (-B + std::sqrt(disc));
+  const double root = C / (-B + std::sqrt(disc));
+  double t = disc > 0 ? root : kNever;
+  t = C <= 0 ? (B < 0 ? 0.0 : kNever) : t;
+  return B >= 0 && A >= 0 ? kNever : t;
 }
 
 // Paper eq. (1)-(3): (g.n)' = -eps (g.n) with n = (r_i - r_j)/|r_i - r_j|,

@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "dynhet/engine/calendar.hpp"
+#include "dynhet/engine/collision.hpp"
 #include "dynhet/engine/memory.hpp"
 #include "dynhet/engine/rng.hpp"
 #include "dynhet/engine/rows.hpp"
@@ -236,7 +237,7 @@ private:
   // Whether the centres of i and j are close enough to be listed.
   bool near(int i, int j) const;
   // Nearest periodic image of a separation component.
-  double min_image(double d) const { return d > half_box_ ? d - box_ : (d < -half_box_ ? d + box_ : d); }
+  double min_image(double d) const { return nearest_image(d, box_, half_box_); }
   void cell_insert(int i, int cx, int cy);
   void cell_remove(int i);
   void clear_cells();
