@@ -1,7 +1,7 @@
 // Engine benchmark: events per second and ns per collision against N and
 // phi, memory per particle, and the energy drift of elastic runs, as a
 // table. Usage: bench_engine [--n 10000,100000] [--phi 0.6,0.78] [--coll 50]
-//   [--eps 1.0] [--driven] [--cache DIR] [--tile-from 10000]
+//   [--eps 1.0] [--driven] [--pairs neighbours|any] [--reach 1] [--cache DIR] [--tile-from 10000]
 // With --tile-from B, a system of N = k^2 B particles starts from the
 // compressed B-particle state tiled k x k (velocities redrawn), instead of
 // compressing N particles from scratch (which takes hours at N = 10^6).
@@ -69,13 +69,17 @@ int main(int argc, char** argv) {
   double coll_per_particle = 50, eps = 1.0, sync = 50.0;
   bool driven = false, fingerprint = false;
   double skin = dynhet::engine::Params{}.skin;
-  std::string cache;
+  std::string cache, pairs = "neighbours";
+  double reach = dynhet::engine::Params{}.kick_reach;
   long tile_from = 0;
   app.add_option("--n", ns, "particle numbers")->delimiter(',');
   app.add_option("--phi", phis, "packing fractions")->delimiter(',');
   app.add_option("--coll", coll_per_particle, "collisions per particle to time");
   app.add_option("--eps", eps, "restitution");
   app.add_flag("--driven", driven, "kicks at the Enskog frequency");
+  app.add_option("--pairs", pairs, "kick pairs: neighbours (within --reach) or any two particles")
+      ->check(CLI::IsMember({"neighbours", "any"}));
+  app.add_option("--reach", reach, "largest surface gap of a neighbour kick pair, small radii");
   app.add_option("--sync", sync, "time between synchronisations (memory re-sorting)");
   app.add_option("--cache", cache,
                  "keep compressed states here (HDF5 checkpoints) and start from them next time");
@@ -88,16 +92,21 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
 
   std::printf("# dynhet engine, one core; eps=%g, %s; timed over %g collisions per particle, "
-              "synchronised every %g; rates per CPU second\n", eps, driven ? "driven" : "undriven",
+              "synchronised every %g; rates per CPU second\n", eps,
+              driven ? ("driven, kick pairs: " + (pairs == "any" ? pairs : pairs + " within " + std::to_string(reach)))
+                           .c_str()
+                     : "undriven",
               coll_per_particle, sync);
-  std::printf("%9s %6s %9s %10s %10s %10s %10s %10s %9s %9s %5s %8s %11s %8s %8s\n", "N", "phi", "prep_s", "coll/s",
-              "kicks/s", "rebuild/s", "stale/s", "events/s", "ns/coll", "B/part", "nbrs", "wall_s", "dE/E", "T_mean",
-              "T_sd");
+  std::printf("%9s %6s %9s %10s %10s %10s %10s %10s %10s %9s %9s %5s %8s %11s %8s %8s\n", "N", "phi", "prep_s",
+              "coll/s", "kicks/s", "c+k/s", "rebuild/s", "stale/s", "events/s", "ns/coll", "B/part", "nbrs", "wall_s",
+              "dE/E", "T_mean", "T_sd");
   for (long n : ns)
     for (double phi : phis) {
       dynhet::engine::Params p = dynhet::engine::paper_params(n, phi, eps, driven);
       p.seed = 1;
       p.skin = skin;
+      p.kick_pairs = pairs == "any" ? dynhet::engine::KickPairs::any : dynhet::engine::KickPairs::neighbours;
+      p.kick_reach = reach;
       dynhet::engine::Engine e(p);
       auto t0 = std::chrono::steady_clock::now();
       const std::string cached =
@@ -165,8 +174,8 @@ int main(int argc, char** argv) {
       const auto c1 = e.counters();
       const double coll = double(c1.collisions - c0.collisions), kicks = double(c1.kicks - c0.kicks);
       const double cross = double(c1.rebuilds - c0.rebuilds), stale = double(c1.stale - c0.stale);
-      std::printf("%9ld %6.3f %9.2f %10.3g %10.3g %10.3g %10.3g %10.3g %9.1f %9.0f %5.2f %8.1f %11.2e %8.4f %8.4f\n", n,
-                  phi, prep, coll / cpu, kicks / cpu, cross / cpu, stale / cpu, (coll + kicks + cross + stale) / cpu,
+      std::printf("%9ld %6.3f %9.2f %10.3g %10.3g %10.3g %10.3g %10.3g %10.3g %9.1f %9.0f %5.2f %8.1f %11.2e %8.4f %8.4f\n",
+                  n, phi, prep, coll / cpu, kicks / cpu, (coll + kicks) / cpu, cross / cpu, stale / cpu, (coll + kicks + cross + stale) / cpu,
                   1e9 * cpu / coll, bytes, e.mean_neighbours(), wall,
                   eps == 1.0 && !driven ? e.kinetic_energy_per_particle() / e0 - 1 : NAN, temp.mean(), t_sd);
       if (fingerprint) {

@@ -117,6 +117,16 @@ std::vector<std::string> nodes_for(const std::vector<std::string>& observables) 
   return nodes;
 }
 
+double scene_contact_value(const Scene& s) {
+  if (s.contact_value > 0) return s.contact_value;
+  return s.contact_recipe == "henderson" ? henderson_contact_value(s.packing_fraction)
+                                         : mixture_contact_value(s.packing_fraction, s.radius_ratio);
+}
+
+double scene_kick_rate(const Scene& s) {
+  return s.kick_rate > 0 ? s.kick_rate : enskog_frequency(s.packing_fraction, scene_contact_value(s));
+}
+
 bool Scene::wants(const std::string& o) const {
   return std::find(observables.begin(), observables.end(), o) != observables.end();
 }
@@ -216,7 +226,33 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
   schema["driving"] = {
       {"enabled", [&](const std::string& key, const toml::node& n) { c.get_bool(key, n, s.driving); }},
       {"kick_rate", number_or(s.kick_rate, "enskog")},
-      {"contact_value", number_or(s.contact_value, "henderson")},
+      {"contact_value",
+       [&](const std::string& key, const toml::node& n) {
+         if (n.is_string()) {
+           const std::string v = *n.value<std::string>();
+           if (v != "mixture" && v != "henderson")
+             return c.bad_value(key, n, "allowed: \"mixture\", \"henderson\" or a number > 0");
+           s.contact_recipe = v;
+           s.contact_value = -1.0;
+           return;
+         }
+         number_or(s.contact_value, "mixture")(key, n);
+       }},
+      {"pairs",
+       [&](const std::string& key, const toml::node& n) {
+         const auto v = n.value_exact<std::string>();
+         if (!v) return c.bad_type(key, n, "a string, \"neighbours\" or \"any\"");
+         if (*v != "neighbours" && *v != "any") return c.bad_value(key, n, "allowed: \"neighbours\" or \"any\"");
+         s.kick_pairs = *v;
+       }},
+      {"reach",
+       [&](const std::string& key, const toml::node& n) {
+         double v;
+         if (!c.get_double(key, n, v)) return;
+         if (!(v > 0 && v <= 10))
+           return c.bad_value(key, n, "allowed: 0 < reach <= 10 (a gap between surfaces, in small radii)");
+         s.kick_reach = v;
+       }},
   };
   schema["run"] = {
       {"equilibration_time", non_negative(s.equilibration_time)},

@@ -79,6 +79,9 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
     put_attr(f, "list_rebuilds", s.counters.rebuilds);
     put_attr(f, "stale", s.counters.stale);
     put_attr(f, "tc", s.counters.tc);
+    put_attr(f, "kick_redraws", s.counters.kick_redraws);
+    put_attr(f, "kick_far", s.counters.kick_far);
+    f.check(H5LTset_attribute_string(f.id(), "/", "kick_pairs", c.kick_pairs.c_str()), "kick_pairs");
     put_attr(f, "virial", s.counters.virial);
     put(f, "x", H5T_NATIVE_DOUBLE, s.x);
     put(f, "y", H5T_NATIVE_DOUBLE, s.y);
@@ -120,6 +123,19 @@ Checkpoint read_checkpoint(const std::string& path) {
   s.counters.rebuilds = H5Aexists(f.id(), "list_rebuilds") > 0 ? get_int(f, "list_rebuilds") : 0;
   s.counters.stale = get_int(f, "stale");
   s.counters.tc = get_int(f, "tc");
+  // Checkpoints from before neighbour kick pairs drew pairs from the whole system.
+  s.counters.kick_redraws = H5Aexists(f.id(), "kick_redraws") > 0 ? get_int(f, "kick_redraws") : 0;
+  s.counters.kick_far = H5Aexists(f.id(), "kick_far") > 0 ? get_int(f, "kick_far") : 0;
+  if (H5Aexists(f.id(), "kick_pairs") > 0) {
+    char rule[32] = {0};
+    hsize_t dims = 0;
+    H5T_class_t cls;
+    size_t size = 0;
+    f.check(H5LTget_attribute_info(f.id(), "/", "kick_pairs", &dims, &cls, &size), "kick_pairs");
+    if (size >= sizeof rule) throw std::runtime_error(path + ": kick_pairs attribute too long");
+    f.check(H5LTget_attribute_string(f.id(), "/", "kick_pairs", rule), "kick_pairs");
+    c.kick_pairs = rule;
+  }
   s.counters.virial = get_double(f, "virial");
   hsize_t n[1] = {0};
   f.check(H5LTget_dataset_info(f.id(), "x", n, nullptr, nullptr), "reading x");

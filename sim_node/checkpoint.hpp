@@ -14,6 +14,9 @@ struct Checkpoint {
   std::string scene_toml;
   int64_t run_id = 0;
   int32_t next_frame = 0; // first frame not yet published
+  // The kick-pair rule the run used ("any" in checkpoints from before the
+  // rule was a choice); a resume under another rule is refused.
+  std::string kick_pairs = "any";
   engine::State state;
 };
 

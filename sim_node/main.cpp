@@ -182,6 +182,11 @@ int main(int argc, char** argv) {
       scene = dynhet::parse_scene_text(resumed.scene_toml, resume_path + " (its scene)");
       run_id = resumed.run_id;
       scene_path = resume_path;
+      if (resumed.kick_pairs != scene.kick_pairs)
+        throw std::runtime_error(resume_path + ": the run drew kick pairs by the rule \"" + resumed.kick_pairs +
+                                 "\", its scene now means \"" + scene.kick_pairs +
+                                 "\" (a checkpoint from before driving.pairs): it cannot be resumed bit for bit; "
+                                 "start the run again");
     } else {
       scene = dynhet::parse_scene_file(scene_path);
     }
@@ -228,13 +233,17 @@ int main(int argc, char** argv) {
     p.seed = scene.seed;
     p.driving = scene.driving;
     p.tc = scene.tc_time;
-    const double gc = scene.contact_value > 0 ? scene.contact_value
-                                              : dynhet::henderson_contact_value(scene.packing_fraction);
-    p.kick_rate = scene.kick_rate > 0 ? scene.kick_rate : dynhet::enskog_frequency(scene.packing_fraction, gc);
+    p.kick_rate = dynhet::scene_kick_rate(scene);
+    p.kick_pairs = scene.kick_pairs == "any" ? dynhet::engine::KickPairs::any : dynhet::engine::KickPairs::neighbours;
+    p.kick_reach = scene.kick_reach;
     dynhet::engine::Engine eng(p);
-    std::fprintf(stderr, "sim_node: run %lld, N=%ld phi=%.4f eps=%.3f L=%.4f, kicks %s (%.4g per particle per unit time)\n",
+    std::fprintf(stderr,
+                 "sim_node: run %lld, N=%ld phi=%.4f eps=%.3f L=%.4f, kicks %s (%.4g per particle per unit time, "
+                 "pairs: %s)\n",
                  static_cast<long long>(run_id), eng.size(), scene.packing_fraction, scene.restitution,
-                 eng.box_length(), p.driving && scene.restitution < 1 ? "on" : "off", p.kick_rate);
+                 eng.box_length(), p.driving && scene.restitution < 1 ? "on" : "off", p.kick_rate,
+                 scene.kick_pairs == "any" ? "any two particles"
+                                           : ("neighbours within " + std::to_string(scene.kick_reach)).c_str());
 
     // The run info first, and again every 2 s, also while compressing (which
     // takes minutes at N = 10^5 and more): nodes and recorder then know the
@@ -278,7 +287,7 @@ int main(int argc, char** argv) {
     int64_t next_slot = static_cast<int64_t>(std::floor(eng.time() / interval + 0.5)) + 1;
     int next_frame = resumed.next_frame;
     auto checkpoint = [&] {
-      dynhet::write_checkpoint(checkpoint_path, {scene.text, run_id, next_frame, eng.state()});
+      dynhet::write_checkpoint(checkpoint_path, {scene.text, run_id, next_frame, scene.kick_pairs, eng.state()});
       checkpoint_written = true;
     };
     bool announced = false;

@@ -1,5 +1,6 @@
 // The EDMD engine as a whole: no overlaps (brute force over all pairs),
 // conservation laws, reproducibility.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <vector>
@@ -9,6 +10,7 @@
 #include "dynhet/engine/engine.hpp"
 
 using dynhet::engine::Engine;
+using dynhet::engine::KickPairs;
 using dynhet::engine::Params;
 
 namespace {
@@ -72,20 +74,100 @@ TEST(Engine, ElasticUndrivenConservesEnergyAndMomentum) {
 }
 
 TEST(Engine, DrivenConservesMomentumAndReachesSteadyState) {
-  Engine e(params(1000, 0.7, 0.9, true));
+  for (const auto rule : {KickPairs::neighbours, KickPairs::any}) {
+    Params p = params(1000, 0.7, 0.9, true);
+    p.kick_pairs = rule;
+    Engine e(p);
+    e.prepare();
+    e.run_until(100.0);
+    // Kicks are a Poisson process of N * rate / 2 pairs per unit time:
+    // 4e5 expected, standard deviation 632; 5 of them.
+    const double expected = 0.5 * p.kick_rate * p.n_particles * 100.0;
+    EXPECT_NEAR(double(e.counters().kicks), expected, 5 * std::sqrt(expected));
+    double px, py;
+    e.momentum(px, py);
+    // Each event adds roundoff ~1e-16 of the momenta it moves (~1): a random
+    // walk over ~1e6 events stays far below 1e-10.
+    EXPECT_LT(std::hypot(px, py), 1e-10);
+    // Kicks balance the collisional loss: the granular temperature stays O(1).
+    const double ke = e.kinetic_energy_per_particle();
+    EXPECT_GT(ke, 0.3);
+    EXPECT_LT(ke, 3.0);
+    EXPECT_GE(brute_min_gap(e), 1.0 - 1e-9);
+  }
+}
+
+namespace {
+// Ids of the particles whose surface lies within `reach` of particle i's,
+// by brute force over all pairs (minimum image), in id order.
+std::vector<long> brute_kick_partners(const Engine& e, long i, double reach) {
+  std::vector<double> xy;
+  e.unwrapped_positions(xy);
+  const double L = e.box_length();
+  std::vector<long> out;
+  for (long j = 0; j < e.size(); ++j) {
+    if (j == i) continue;
+    double dx = xy[2 * i] - xy[2 * j], dy = xy[2 * i + 1] - xy[2 * j + 1];
+    dx -= L * std::round(dx / L);
+    dy -= L * std::round(dy / L);
+    if (std::hypot(dx, dy) <= e.radius(e.species()[i]) + e.radius(e.species()[j]) + reach) out.push_back(j);
+  }
+  return out;
+}
+} // namespace
+
+// Neighbour pairs: at 2000 moments of a driven run, the pair the next kick
+// takes is checked against brute force: the second particle is one of
+// those within reach of the first, and uniform among them (the mean of
+// (rank + 1/2) / count is 1/2, standard deviation at most 1/sqrt(12 K);
+// 4 of them). The first particle is uniform: the mean id is (N - 1)/2.
+TEST(Engine, NeighbourKickPairsAreWithinReachAndUniform) {
+  for (const double reach : {1.0, 2.5}) {
+    Params p = params(600, 0.72, 0.9, true);
+    p.kick_reach = reach;
+    Engine e(p);
+    e.prepare();
+    e.run_until(2.0);
+    const int k = 2000;
+    double u_sum = 0, i_sum = 0;
+    for (int s = 0; s < k; ++s) {
+      e.run_until(2.0 + 0.01 * (s + 1));
+      const auto pair = e.next_kick_pair();
+      ASSERT_EQ(pair.redraws, 0); // at phi = 0.72 everyone has neighbours in reach
+      const auto partners = brute_kick_partners(e, pair.i, reach);
+      const auto at = std::find(partners.begin(), partners.end(), pair.j);
+      ASSERT_NE(at, partners.end()) << "kick " << s << ": " << pair.j << " is not within reach of " << pair.i;
+      u_sum += (double(at - partners.begin()) + 0.5) / double(partners.size());
+      i_sum += double(pair.i);
+    }
+    EXPECT_NEAR(u_sum / k, 0.5, 4 / std::sqrt(12.0 * k)) << "reach " << reach;
+    // ids uniform on 0..N-1: standard deviation N / sqrt(12 K).
+    EXPECT_NEAR(i_sum / k, 0.5 * (p.n_particles - 1), 4 * p.n_particles / std::sqrt(12.0 * k));
+  }
+}
+
+// A dilute gas with a short reach: most first particles have nobody in
+// reach and are drawn again; after kMaxKickDraws in vain the pair comes
+// from the whole system. Both are counted, momentum is still conserved,
+// and every pair found by a draw is within reach.
+TEST(Engine, LonelyFirstParticlesAreDrawnAgain) {
+  Params p = params(400, 0.05, 0.9, true);
+  p.kick_reach = 0.1;
+  Engine e(p);
   e.prepare();
-  e.run_until(100.0);
-  EXPECT_GT(e.counters().kicks, 100'000);
+  for (int s = 1; s <= 200; ++s) {
+    e.run_until(0.05 * s);
+    const auto pair = e.next_kick_pair();
+    if (pair.redraws < Engine::kMaxKickDraws) {
+      const auto partners = brute_kick_partners(e, pair.i, p.kick_reach);
+      EXPECT_NE(std::find(partners.begin(), partners.end(), pair.j), partners.end());
+    }
+  }
+  EXPECT_GT(e.counters().kick_redraws, 10 * e.counters().kicks);
+  EXPECT_GT(e.counters().kick_far, 0);
   double px, py;
   e.momentum(px, py);
-  // Each event adds roundoff ~1e-16 of the momenta it moves (~1): a random
-  // walk over ~1e6 events stays far below 1e-10.
   EXPECT_LT(std::hypot(px, py), 1e-10);
-  // Kicks balance the collisional loss: the granular temperature stays O(1).
-  const double ke = e.kinetic_energy_per_particle();
-  EXPECT_GT(ke, 0.3);
-  EXPECT_LT(ke, 3.0);
-  EXPECT_GE(brute_min_gap(e), 1.0 - 1e-9);
 }
 
 TEST(Engine, SameSeedSameTrajectoryBitForBit) {
@@ -218,38 +300,57 @@ TEST(Engine, TcModelMakesCollisionsWithinTcElastic) {
 
 TEST(Engine, RestoredRunContinuesBitForBit) {
   // Uninterrupted: synchronise at t = 10 and 20, run to 30. Resumed: a
-  // second engine restored from the state at t = 10 does the same.
-  Params p = params(400, 0.75, 0.9, true);
-  p.tc = 1e-3;
-  Engine a(p);
-  a.prepare();
-  a.run_until(10.0);
-  a.synchronize();
-  const auto saved = a.state();
-  a.run_until(20.0);
-  a.synchronize();
-  a.run_until(30.0);
+  // second engine restored from the state at t = 10 does the same, and
+  // draws the same kick pairs (which, with neighbour pairs, depend on the
+  // positions at the kick).
+  for (const auto rule : {KickPairs::neighbours, KickPairs::any}) {
+    Params p = params(400, 0.75, 0.9, true);
+    p.tc = 1e-3;
+    p.kick_pairs = rule;
+    Engine a(p);
+    a.prepare();
+    a.run_until(10.0);
+    a.synchronize();
+    const auto saved = a.state();
+    const auto pair_a = a.next_kick_pair();
+    a.run_until(15.0);
+    const auto pair_a15 = a.next_kick_pair();
+    a.run_until(20.0);
+    a.synchronize();
+    a.run_until(30.0);
 
-  Engine b(p);
-  b.restore(saved);
-  EXPECT_EQ(b.time(), 10.0);
-  b.run_until(20.0);
-  b.synchronize();
-  b.run_until(30.0);
+    Engine b(p);
+    b.restore(saved);
+    EXPECT_EQ(b.time(), 10.0);
+    const auto pair_b = b.next_kick_pair();
+    EXPECT_EQ(pair_a.i, pair_b.i);
+    EXPECT_EQ(pair_a.j, pair_b.j);
+    b.run_until(15.0);
+    const auto pair_b15 = b.next_kick_pair();
+    EXPECT_EQ(pair_a15.i, pair_b15.i);
+    EXPECT_EQ(pair_a15.j, pair_b15.j);
+    b.run_until(20.0);
+    b.synchronize();
+    b.run_until(30.0);
 
-  std::vector<double> xa, xb;
-  a.unwrapped_positions(xa);
-  b.unwrapped_positions(xb);
-  ASSERT_EQ(xa.size(), xb.size());
-  for (size_t i = 0; i < xa.size(); ++i) ASSERT_EQ(xa[i], xb[i]) << i;
-  EXPECT_EQ(a.counters().collisions, b.counters().collisions);
-  EXPECT_EQ(a.counters().kicks, b.counters().kicks);
-  EXPECT_EQ(a.kinetic_energy_per_particle(), b.kinetic_energy_per_particle());
+    std::vector<double> xa, xb;
+    a.unwrapped_positions(xa);
+    b.unwrapped_positions(xb);
+    ASSERT_EQ(xa.size(), xb.size());
+    for (size_t i = 0; i < xa.size(); ++i) ASSERT_EQ(xa[i], xb[i]) << i;
+    EXPECT_EQ(a.counters().collisions, b.counters().collisions);
+    EXPECT_EQ(a.counters().kicks, b.counters().kicks);
+    EXPECT_EQ(a.counters().kick_redraws, b.counters().kick_redraws);
+    EXPECT_EQ(a.kinetic_energy_per_particle(), b.kinetic_energy_per_particle());
+    double px, py;
+    a.momentum(px, py);
+    EXPECT_LT(std::hypot(px, py), 1e-10);
 
-  Params wrong = p;
-  wrong.n_particles = 401;
-  Engine c(wrong);
-  EXPECT_THROW(c.restore(saved), std::invalid_argument);
+    Params wrong = p;
+    wrong.n_particles = 401;
+    Engine c(wrong);
+    EXPECT_THROW(c.restore(saved), std::invalid_argument);
+  }
 }
 
 // The neighbour-list skin changes only the bookkeeping: from one state, a
@@ -321,31 +422,54 @@ TEST(Theory, BidispersePressureFollowsSantosYusteLopezDeHaro) {
   Engine e(p);
   e.prepare();
   e.run_until(20.0);
-  std::vector<double> z;
+  std::vector<double> z, om;
   for (int b = 0; b < 10; ++b) {
     const auto c0 = e.counters();
     const double t0 = e.time();
     e.run_until(t0 + 10.0);
     z.push_back(dynhet::engine::reduced_pressure(e.counters().virial - c0.virial, 10.0, e.size(),
                                                  e.kinetic_energy_per_particle()));
+    om.push_back(2.0 * double(e.counters().collisions - c0.collisions) / (10.0 * e.size()));
   }
-  double mean = 0, s2 = 0;
-  for (double v : z) mean += v / z.size();
-  for (double v : z) s2 += (v - mean) * (v - mean);
-  const double err = std::sqrt(s2 / (z.size() - 1) / z.size());
+  const auto mean_err = [](const std::vector<double>& v, double& mean, double& err) {
+    double s2 = 0;
+    mean = 0;
+    for (double x : v) mean += x / v.size();
+    for (double x : v) s2 += (x - mean) * (x - mean);
+    err = std::sqrt(s2 / (v.size() - 1) / v.size());
+  };
+  double mean, err, om_mean, om_err;
+  mean_err(z, mean, err);
+  mean_err(om, om_mean, om_err);
 
   const double s[2] = {2.0, 2.0 * ratio}, x[2] = {0.5, 0.5};
   const double m1 = x[0] * s[0] + x[1] * s[1], m2 = x[0] * s[0] * s[0] + x[1] * s[1] * s[1];
-  double sum = 0;
+  // The Enskog collision frequency of the mixture with the same g_ij, per
+  // particle at T = 1: omega = sum_ij x_i x_j n s_ij g_ij 2 sqrt(pi T / (2 mu_ij)).
+  const double mass[2] = {1.0, ratio * ratio}, n = e.size() / (e.box_length() * e.box_length());
+  double sum = 0, omega = 0;
   for (int i = 0; i < 2; ++i)
     for (int j = 0; j < 2; ++j) {
       const double sij = 0.5 * (s[i] + s[j]);
       const double zij = s[i] * s[j] / sij * m1 / m2;
       const double gij = 1 / (1 - phi) + (henderson_g(phi) - 1 / (1 - phi)) * zij;
+      EXPECT_NEAR(dynhet::mixture_pair_contact_value(phi, ratio, i, j), gij, 1e-12 * gij); // model.hpp's recipe
       sum += x[i] * x[j] * sij * sij * gij;
+      const double mu = mass[i] * mass[j] / (mass[i] + mass[j]);
+      omega += x[i] * x[j] * n * sij * gij * 2 * std::sqrt(M_PI / (2 * mu));
     }
   const double z_syl = 1 + 2 * phi * sum / m2;
-  std::printf("bidisperse phi %.2f: Z = %.4f +- %.4f, SYL %.4f (%.2f%%)\n", phi, mean, err, z_syl,
-              100 * (mean / z_syl - 1));
+  std::printf("bidisperse phi %.2f: Z = %.4f +- %.4f, SYL %.4f (%.2f%%); omega = %.4f +- %.4f, Enskog-SYL %.4f "
+              "(%.2f%%)\n",
+              phi, mean, err, z_syl, 100 * (mean / z_syl - 1), om_mean, om_err, omega, 100 * (om_mean / omega - 1));
   EXPECT_NEAR(mean, z_syl, 0.02 * z_syl + 3 * err);
+  // The collision frequency of an elastic fluid is the Enskog one with the
+  // true contact values: the recipe's 1-2% again.
+  EXPECT_NEAR(om_mean, omega, 0.02 * omega + 3 * om_err);
+  // G_c of the kick rate is a weighted mean of the three g_ij.
+  const double gc = dynhet::mixture_contact_value(phi, ratio);
+  EXPECT_GT(gc, dynhet::mixture_pair_contact_value(phi, ratio, 0, 0));
+  EXPECT_LT(gc, dynhet::mixture_pair_contact_value(phi, ratio, 1, 1));
+  // A monodisperse "mixture" is Henderson's fluid.
+  EXPECT_NEAR(dynhet::mixture_contact_value(phi, 1.0), henderson_g(phi), 1e-12);
 }

@@ -1,9 +1,11 @@
 // Scene validation: bad input is refused before anything runs, with a
 // message naming the key, the value and what is allowed.
+#include <cmath>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "dynhet/model.hpp"
 #include "dynhet/scene.hpp"
 
 using dynhet::parse_scene_text;
@@ -45,6 +47,21 @@ TEST(Scene, EmptySceneTakesDefaults) {
   EXPECT_DOUBLE_EQ(s.cutoff_a.at(0), 0.6);
 }
 
+TEST(Scene, DrivingDefaultsToNeighbourPairsAndTheMixtureContactValue) {
+  const auto s = parse_scene_text("[system]\npacking_fraction = 0.78\n", "driving");
+  EXPECT_EQ(s.kick_pairs, "neighbours");
+  EXPECT_DOUBLE_EQ(s.kick_reach, 1.0);
+  EXPECT_DOUBLE_EQ(dynhet::scene_contact_value(s), dynhet::mixture_contact_value(0.78, 1.43));
+  EXPECT_DOUBLE_EQ(dynhet::scene_kick_rate(s), 2.59 * 0.78 * dynhet::scene_contact_value(s) / std::sqrt(M_PI));
+  const auto h = parse_scene_text("[driving]\ncontact_value = \"henderson\"\npairs = \"any\"\nreach = 0.5\n", "h");
+  EXPECT_EQ(h.kick_pairs, "any");
+  EXPECT_DOUBLE_EQ(h.kick_reach, 0.5);
+  EXPECT_DOUBLE_EQ(dynhet::scene_contact_value(h), dynhet::henderson_contact_value(0.7));
+  const auto n = parse_scene_text("[driving]\ncontact_value = 3.5\nkick_rate = 2\n", "n");
+  EXPECT_DOUBLE_EQ(dynhet::scene_contact_value(n), 3.5);
+  EXPECT_DOUBLE_EQ(dynhet::scene_kick_rate(n), 2.0);
+}
+
 TEST(Scene, UnknownKeyAndTableAreRefused) {
   expect_error("[system]\nn_partcles = 100\n", {"system.n_partcles", "unknown key", "n_particles"});
   expect_error("[sytem]\nn_particles = 100\n", {"sytem", "unknown table"});
@@ -71,6 +88,11 @@ TEST(Scene, ImpossibleValuesAreRefused) {
   expect_error("[observables]\ncompute = [\"entropy\"]\n", {"observables.compute", "entropy", "overlap"});
   expect_error("[observables]\ncutoff_a = [0.6, -1]\n", {"observables.cutoff_a", "-1"});
   expect_error("[driving]\nkick_rate = \"fast\"\n", {"driving.kick_rate", "enskog"});
+  expect_error("[driving]\npairs = \"nearest\"\n", {"driving.pairs", "nearest", "\"neighbours\" or \"any\""});
+  expect_error("[driving]\npairs = 1\n", {"driving.pairs", "a string"});
+  expect_error("[driving]\nreach = 0\n", {"driving.reach", "0 < reach <= 10"});
+  expect_error("[driving]\nreach = 11\n", {"driving.reach", "11"});
+  expect_error("[driving]\ncontact_value = \"carnahan\"\n", {"driving.contact_value", "\"mixture\", \"henderson\""});
   expect_error("[transport]\nchunk_particles = 100000\n", {"transport.chunk_particles", "65000"});
   expect_error("[observables]\ncutoff_a = [0.6, 0.6]\n", {"observables.cutoff_a", "once"});
   expect_error("[observables]\ncompute = [\"overlap\", \"overlap\"]\n", {"observables.compute", "once"});

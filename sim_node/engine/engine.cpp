@@ -31,7 +31,13 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
     throw std::invalid_argument("engine: the neighbour-list skin must be positive (or 0 for automatic), not " +
                                 std::to_string(p.skin));
   list_margin_ = 1e-12 * box_;
-  const double widest = 2.0 * std::max(radius_[0], radius_[1]) + 2 * list_margin_;
+  neighbour_kicks_ = p.driving && p.kick_rate > 0 && p.restitution < 1.0 && p.kick_pairs == KickPairs::neighbours;
+  if (neighbour_kicks_ && !(p.kick_reach > 0 && std::isfinite(p.kick_reach)))
+    throw std::invalid_argument("engine: the kick reach must be a positive gap, not " + std::to_string(p.kick_reach));
+  // Cells must hold, in the 3 x 3 around a particle's, every partner its
+  // kick may take: wider by the kick reach with neighbour pairs.
+  const double widest =
+      2.0 * std::max(radius_[0], radius_[1]) + 2 * list_margin_ + (neighbour_kicks_ ? p.kick_reach : 0.0);
   skin_ = (p.skin > 0 ? p.skin : auto_skin(p.packing_fraction)) * radius_[0];
   // An automatic skin narrows to let a small box hold 3 cells.
   if (p.skin == 0) skin_ = std::max(0.0, std::min(skin_, 0.999 * (box_ / 3 - widest)));
@@ -40,8 +46,9 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
   nc_ = static_cast<int>(std::floor(box_ / (widest + skin_)));
   if (nc_ < 3 || !(skin_ > 0))
     throw std::invalid_argument("engine: box of side " + std::to_string(box_) +
-                                " holds fewer than 3 cells of the largest contact distance plus the skin; "
-                                "use more particles or a thinner skin");
+                                " holds fewer than 3 cells of the largest contact distance plus the skin" +
+                                (neighbour_kicks_ ? " and the kick reach" : "") +
+                                "; use more particles or a thinner skin");
   cw_ = box_ / nc_;
 
   part_.assign(n_, Particle{0, 0, 0, 0, 0, kNever, 0, 0, kRebuild, 0});
@@ -334,20 +341,96 @@ void Engine::collide(int i, int j) {
   predict(j);
 }
 
-// Driving (paper, section 2): a random pair gets opposite momenta
-// +-p_Dr kappa, kappa a 2D standard Gaussian vector, so total momentum is
-// conserved. Choices where the paper is silent: the pair is two distinct
-// particles drawn uniformly from the whole system (by storage slot, from a
-// hash of the seed and the kick's number: kick_pair), and with the two
-// species the amplitude is p_Dr^2 = (1 - eps^2) m1 m2 / (m1 + m2) for every pair.
-void Engine::kick_pair(int64_t k, int& i, int& j) const {
-  const uint64_t base = mix64(p_.seed ^ 0x6b69636b70616972ULL) + 2 * static_cast<uint64_t>(k);
-  const auto below = [](uint64_t h, uint64_t n) {
-    return static_cast<int>((static_cast<unsigned __int128>(h) * n) >> 64);
-  };
-  i = below(mix64(base), static_cast<uint64_t>(n_));
-  j = below(mix64(base + 1), static_cast<uint64_t>(n_ - 1));
+// Driving (paper, section 2): "kicks" to "randomly chosen pairs of
+// particles": the pair gets opposite momenta +-p_Dr kappa, kappa a 2D
+// standard Gaussian vector, "to ensure conservation of the total momentum of
+// the system" (citing Espanol and Warren, Europhys. Lett. 30, 191 (1995)).
+// With two species the amplitude is p_Dr^2 = (1 - eps^2) m1 m2 / (m1 + m2)
+// for every pair. How the pair is drawn the paper leaves to its references:
+//
+// - KickPairs::neighbours (the default): the first particle uniform over
+//   the system, the second uniform among the particles whose surface lies
+//   within kick_reach of its surface (|r_i - r_j| <= sigma_ij + reach) at
+//   the time of the kick. In Espanol and Warren's dissipative particle
+//   dynamics the random forces act between neighbours, and the driven
+//   granular fluids of Fiege et al. (2009) and Gholami et al. (2011),
+//   which the paper cites for its details, show the hydrodynamic long-time
+//   tails that exist only when the driving conserves momentum locally.
+//   A first particle with nobody in reach is drawn again (counted in
+//   kick_redraws), so the kick rate stays what the scene says; after
+//   kMaxKickDraws such draws (a very dilute gas, where locality means
+//   little) the last one's partner is drawn from the whole system
+//   (kick_far).
+// - KickPairs::any: two distinct particles uniform over the whole system:
+//   momentum is conserved only globally, and each kick acts like an
+//   independent random force on two distant particles. Near phi_c the two
+//   rules differ in tau_alpha by more than tenfold (docs/engine.md).
+//
+// Every draw comes from a hash of the seed and the kick's number (and the
+// draw's), by storage slot, so it needs no random state of its own (the
+// kick count is checkpointed); the neighbours are read from the positions
+// now. Slots, cells and positions follow from the state alone after a
+// synchronisation (reorder()), so a run restored from a checkpoint draws
+// the same pairs.
+namespace {
+// Uniform in [0, n) from a 64-bit hash.
+int below(uint64_t h, uint64_t n) { return static_cast<int>((static_cast<unsigned __int128>(h) * n) >> 64); }
+} // namespace
+
+uint64_t Engine::kick_hash(int64_t k, int draw, int which) const {
+  const uint64_t h = mix64(mix64(p_.seed ^ 0x6b69636b70616972ULL) + 2 * static_cast<uint64_t>(k) + which);
+  return draw == 0 ? h : mix64(h ^ static_cast<uint64_t>(draw)); // the first draw's: those of the rule "any"
+}
+
+int Engine::kick_pair(int64_t k, int& i, int& j) const {
+  const auto hash = [&](int d, int which) { return kick_hash(k, d, which); };
+  if (neighbour_kicks_) {
+    int32_t cand[kMaxKickCandidates];
+    for (int d = 0; d < kMaxKickDraws; ++d) {
+      i = below(hash(d, 0), static_cast<uint64_t>(n_));
+      if (const int m = kick_candidates(i, cand); m > 0) {
+        j = cand[below(hash(d, 1), static_cast<uint64_t>(m))];
+        return d;
+      }
+    }
+  } else {
+    i = below(hash(0, 0), static_cast<uint64_t>(n_));
+  }
+  j = below(hash(0, 1), static_cast<uint64_t>(n_ - 1));
   if (j >= i) ++j;
+  return neighbour_kicks_ ? kMaxKickDraws : 0;
+}
+
+// The 3 x 3 cells around i's list centre hold every such partner: centres
+// are within skin / 2 of their particles, and cells at least the largest
+// contact distance plus skin plus reach wide.
+int Engine::kick_candidates(int i, int32_t* out) const {
+  const Particle& a = part_[i];
+  const double ax = a.x + a.vx * (now_ - a.t), ay = a.y + a.vy * (now_ - a.t);
+  const double ri = radius_[a.species] + p_.kick_reach;
+  int around[9];
+  cells_around(cell_x_[i], cell_y_[i], around);
+  int m = 0;
+  for (const int ci : around) {
+    const int32_t* c = cells_.row(ci);
+    for (int k = 1; k <= c[0]; ++k) {
+      const int j = c[k];
+      const Particle& b = part_[j];
+      const double dx = min_image(ax - (b.x + b.vx * (now_ - b.t))), dy = min_image(ay - (b.y + b.vy * (now_ - b.t)));
+      const double reach = ri + radius_[species_[j]];
+      if (j != i && dx * dx + dy * dy <= reach * reach) {
+        if (m == kMaxKickCandidates) throw std::logic_error("engine: more than 512 particles within kick reach");
+        out[m++] = j;
+      }
+    }
+  }
+  return m;
+}
+
+Engine::KickPair Engine::next_kick_pair() const {
+  int i, j;
+  const int redraws = kick_pair(count_.kicks, i, j);
+  return KickPair{id_[i], id_[j], redraws};
 }
 
 void Engine::prefetch_list(int i) const {
@@ -362,7 +445,10 @@ void Engine::prefetch_particle(int i) const {
 
 void Engine::kick() {
   int i, j;
-  kick_pair(count_.kicks, i, j);
+  if (const int redraws = kick_pair(count_.kicks, i, j); redraws > 0) {
+    count_.kick_redraws += std::min(redraws, kMaxKickDraws - 1);
+    count_.kick_far += redraws == kMaxKickDraws;
+  }
   // Their lines were requested at the previous kick; now their neighbours'.
   prefetch_neighbours(i);
   prefetch_neighbours(j);
@@ -382,10 +468,21 @@ void Engine::kick() {
   kick_time_ = now_ + rng_.exponential(kick_pair_rate_);
   predict(i);
   predict(j);
-  int ni, nj;
-  kick_pair(count_.kicks, ni, nj);
-  prefetch_particle(ni);
-  prefetch_particle(nj);
+  // The next pair's lines (with neighbour pairs, the first particle's and
+  // its cell's: its partner depends on where things are then; requesting
+  // the lines of the search itself a kick or two ahead, in stages, gained
+  // nothing measurable).
+  if (neighbour_kicks_) {
+    const int ni = below(kick_hash(count_.kicks, 0, 0), static_cast<uint64_t>(n_));
+    __builtin_prefetch(&part_[ni]);
+    __builtin_prefetch(&cell_x_[ni]);
+    __builtin_prefetch(&cell_y_[ni]);
+  } else {
+    int ni, nj;
+    kick_pair(count_.kicks, ni, nj);
+    prefetch_particle(ni);
+    prefetch_particle(nj);
+  }
 }
 
 // Keep absolute time small: move every clock so that now is 0.

@@ -44,6 +44,37 @@ inline double henderson_contact_value(double phi) {
   return (1.0 - 7.0 * phi / 16.0) / ((1.0 - phi) * (1.0 - phi));
 }
 
+// Contact value g_ij(sigma_ij) of pair type (i, j) in a binary hard-disk
+// mixture at packing fraction phi, diameters 2 and 2 r2/r1, mole fractions
+// 1/2: Jenkins and Mancini, J. Appl. Mech. 54, 27 (1987), the d = 2 case of
+// Santos, Yuste and Lopez de Haro, Mol. Phys. 96, 1 (1999) on Henderson's g:
+//   g_ij = 1/(1-phi) + (9/16) phi/(1-phi)^2 z_ij,
+//   z_ij = (s_i s_j / s_ij) <s>/<s^2>,  s_ij = (s_i + s_j)/2.
+// A monodisperse fluid (r2/r1 = 1, z = 1) gets Henderson's value.
+inline double mixture_pair_contact_value(double phi, double radius_ratio, int a, int b) {
+  const double s[2] = {2.0, 2.0 * radius_ratio};
+  const double m1 = 0.5 * (s[0] + s[1]), m2 = 0.5 * (s[0] * s[0] + s[1] * s[1]);
+  const double sab = 0.5 * (s[a] + s[b]);
+  const double z = s[a] * s[b] / sab * m1 / m2;
+  return 1.0 / (1.0 - phi) + 9.0 / 16.0 * phi / ((1.0 - phi) * (1.0 - phi)) * z;
+}
+
+// The one G_c of the mixture that the paper's omega_coll needs: the g_ij
+// averaged with the weights of the pair types in the Enskog collision
+// rate, x_i x_j s_ij sqrt(1/mu_ij) (mu_ij the reduced mass), so that
+// omega_coll grows with phi as the mixture's Enskog frequency does.
+inline double mixture_contact_value(double phi, double radius_ratio) {
+  const double s[2] = {2.0, 2.0 * radius_ratio}, m[2] = {1.0, radius_ratio * radius_ratio};
+  double num = 0, den = 0;
+  for (int a = 0; a < 2; ++a)
+    for (int b = 0; b < 2; ++b) {
+      const double w = 0.25 * 0.5 * (s[a] + s[b]) * std::sqrt((m[a] + m[b]) / (m[a] * m[b]));
+      num += w * mixture_pair_contact_value(phi, radius_ratio, a, b);
+      den += w;
+    }
+  return num / den;
+}
+
 // Paper, section 2: omega_coll = 2.59 phi G_c sqrt(1/pi).
 inline double enskog_frequency(double phi, double contact_value) {
   return 2.59 * phi * contact_value * std::sqrt(1.0 / M_PI);

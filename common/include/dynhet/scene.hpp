@@ -41,9 +41,16 @@ struct Scene {
   // Kicks per particle per unit time; < 0 means the Enskog collision
   // frequency of the paper, omega = 2.59 phi G_c / sqrt(pi).
   double kick_rate = -1.0;
-  // Pair correlation at contact G_c used in omega; < 0 means Henderson's
-  // (1 - 7 phi / 16) / (1 - phi)^2 for hard disks.
+  // Pair correlation at contact G_c used in omega; < 0 means the recipe
+  // `contact_recipe` names: "mixture" (Jenkins-Mancini g_ij of the binary
+  // mixture, averaged over pair types with their Enskog collision weights;
+  // model.hpp) or "henderson" ((1 - 7 phi/16)/(1 - phi)^2, monodisperse disks).
   double contact_value = -1.0;
+  std::string contact_recipe = "mixture";
+  // How kick pairs are drawn: "neighbours" (the second particle within
+  // kick_reach of the first's surface) or "any" (engine.cpp, kick_pair).
+  std::string kick_pairs = "neighbours";
+  double kick_reach = 1.0; // largest surface gap of a neighbour pair, in r1
 
   // [run]
   double equilibration_time = 100.0;
@@ -124,6 +131,12 @@ struct Scene {
 Scene parse_scene_text(const std::string& text, const std::string& origin);
 // Read the file and parse it.
 Scene parse_scene_file(const std::string& path);
+
+// G_c of the scene: its number, or its recipe at its phi and radius ratio.
+double scene_contact_value(const Scene& s);
+// Kicks per particle per unit time: the scene's number, or the paper's
+// omega_coll = 2.59 phi G_c / sqrt(pi) with scene_contact_value().
+double scene_kick_rate(const Scene& s);
 
 // Observables this build knows how to compute.
 const std::vector<std::string>& known_observables();

@@ -37,6 +37,13 @@
 
 namespace dynhet::engine {
 
+// How the two particles of a kick are drawn (engine.cpp, kick_pair, says
+// why neighbours are the default).
+enum class KickPairs {
+  neighbours, // the first uniform, the second uniform among those within kick_reach of it
+  any,        // two distinct particles uniform over the whole system
+};
+
 struct Params {
   long n_particles = 1000;
   double packing_fraction = 0.7;
@@ -45,6 +52,11 @@ struct Params {
   uint64_t seed = 1;
   bool driving = false;
   double kick_rate = 0.0; // kicks per particle per unit time (a pair kick counts for both)
+  KickPairs kick_pairs = KickPairs::neighbours;
+  // Neighbour pairs: the largest gap between the two surfaces, |r_i - r_j|
+  // - sigma_ij, in small radii (the first minimum of g_ab lies about one
+  // small radius beyond contact at phi = 0.6-0.8: docs/engine.md).
+  double kick_reach = 1.0;
   // TC model against inelastic collapse: a collision within tc of either
   // particle's previous collision is elastic. 0: off.
   double tc = 0.0;
@@ -69,15 +81,16 @@ inline double auto_skin(double phi) {
   return s[k - 1];
 }
 
-// The paper's system: radius ratio 1.43, kicks (if driven) at the Enskog
-// frequency with Henderson's contact value.
-inline Params paper_params(long n, double phi, double eps, bool driven) {
+// The paper's system: radius ratio 1.43, kicks (if driven) to neighbour
+// pairs at the Enskog frequency with the mixture's contact value.
+inline Params paper_params(long n, double phi, double eps, bool driven, KickPairs pairs = KickPairs::neighbours) {
   Params p;
   p.n_particles = n;
   p.packing_fraction = phi;
   p.restitution = eps;
   p.driving = driven;
-  p.kick_rate = enskog_frequency(phi, henderson_contact_value(phi));
+  p.kick_rate = enskog_frequency(phi, mixture_contact_value(phi, p.radius_ratio));
+  p.kick_pairs = pairs;
   return p;
 }
 
@@ -90,6 +103,11 @@ struct Counters {
   // Collision virial sum over collisions of sigma_ij * J_ij, J the normal
   // momentum transfer: P A = N T + virial / (2 dt) in 2D.
   double virial = 0;
+  // Neighbour kick pairs: first particles drawn again because none lay in
+  // reach of the one drawn, and kicks that found no neighbour pair in
+  // kMaxKickDraws draws and took a pair from the whole system instead.
+  int64_t kick_redraws = 0;
+  int64_t kick_far = 0;
 };
 
 // Reduced pressure Z = P A / (N T) = 1 + virial / (2 N T dt) from the
@@ -160,6 +178,14 @@ public:
   const Counters& counters() const { return count_; }
   double kinetic_energy_per_particle() const;
   void momentum(double& px, double& py) const;
+  // The particle ids the next kick would take if it came now (positions as
+  // they are now), and how many first particles it would draw in vain.
+  struct KickPair {
+    long i, j;
+    int redraws;
+  };
+  KickPair next_kick_pair() const;
+  static constexpr int kMaxKickDraws = 64;
 
   // Unwrapped positions at the current time, x0 y0 x1 y1 ...
   void unwrapped_positions(std::vector<double>& xy) const;
@@ -204,7 +230,15 @@ private:
   // from a hash of the seed and k. It needs no state of its own (the kick
   // count is checkpointed) and is known ahead: its lines are requested
   // when the kick before it is done.
-  void kick_pair(int64_t k, int& i, int& j) const;
+  // Returns how many first particles were drawn in vain (neighbour pairs;
+  // kMaxKickDraws: the pair was taken from the whole system).
+  int kick_pair(int64_t k, int& i, int& j) const;
+  // Hash `which` (0: first particle, 1: second) of draw `draw` of kick k.
+  uint64_t kick_hash(int64_t k, int draw, int which) const;
+  // Slots within kick reach of slot i's position now, into out (at most
+  // kMaxKickCandidates); returns their number.
+  static constexpr int kMaxKickCandidates = 512;
+  int kick_candidates(int i, int32_t* out) const;
   void prefetch_list(int i) const;     // i's neighbour list and list centre
   void prefetch_particle(int i) const; // its line, list and centre
   void rebase();
@@ -288,6 +322,7 @@ private:
   Calendar cal_;
   double kick_time_ = Calendar::kNever; // the next kick (it comes after a particle's event at the same time)
   bool driving_ = false;
+  bool neighbour_kicks_ = false; // driven with KickPairs::neighbours: cells are wider by kick_reach
   double kick_pair_rate_ = 0; // pair kicks per unit time, whole system
   Rng rng_;
 
