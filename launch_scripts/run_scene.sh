@@ -11,12 +11,17 @@
 #   --url URL       LCM URL (default udpm://239.255.76.67:7667?ttl=0)
 #   --record LOG    also record everything with lcm-logger into LOG
 #   --no-build      skip setup.sh (packages and build)
+#   --resume CKPT   continue the run saved in checkpoint CKPT (instead of a
+#                   scene) with fresh nodes and recorder: use the run's
+#                   checkpoint_before_frames.h5 (the last one before its
+#                   first frame, which every run keeps), so that the nodes
+#                   see every frame; the result equals the uninterrupted run
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
-scene="" out="" bus=private url="" record="" build_first=1
+scene="" out="" bus=private url="" record="" build_first=1 resume="" 
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
@@ -24,22 +29,32 @@ while (($#)); do
   --url) url=$2; shift 2 ;;
   --record) record=$2; shift 2 ;;
   --no-build) build_first=0; shift ;;
-  -h | --help) sed -n '2,15p' "$0"; exit 0 ;;
+  --resume) resume=$2; shift 2 ;;
+  -h | --help) sed -n '2,20p' "$0"; exit 0 ;;
   -*) echo "run_scene: unknown option $1" >&2; exit 2 ;;
   *) [[ -z $scene ]] || { echo "run_scene: one scene only" >&2; exit 2; }; scene=$1; shift ;;
   esac
 done
-[[ -n $scene ]] || { echo "usage: run_scene.sh SCENE.toml [--out DIR] [--bus private|host] [--url URL] [--record LOG]" >&2; exit 2; }
-[[ -f $scene ]] || { echo "run_scene: no scene file $scene" >&2; exit 2; }
+if [[ -n $resume ]]; then
+  [[ -z $scene ]] || { echo "run_scene: give a scene or --resume CHECKPOINT, not both" >&2; exit 2; }
+  [[ -f $resume ]] || { echo "run_scene: no checkpoint $resume" >&2; exit 2; }
+  resume=$(cd "$(dirname "$resume")" && pwd)/$(basename "$resume")
+  sim_input=(--resume "$resume")
+else
+  [[ -n $scene ]] || { echo "usage: run_scene.sh SCENE.toml [--out DIR] [--bus private|host] [--url URL] [--record LOG] [--resume CKPT]" >&2; exit 2; }
+  [[ -f $scene ]] || { echo "run_scene: no scene file $scene" >&2; exit 2; }
+  sim_input=("$scene")
+fi
 [[ $bus == private || $bus == host ]] || { echo "run_scene: --bus is private or host, not $bus" >&2; exit 2; }
 
 if ((build_first)) && [[ -z ${DYNHET_IN_NETNS:-} ]]; then BUILD_DIR=$build "$root/launch_scripts/setup.sh"; fi
 
 # Refuse a bad scene before anything starts.
-check=$("$bin/sim_node" "$scene" --check) || exit 2
+check=$("$bin/sim_node" "${sim_input[@]}" --check) || exit 2
 nodes=$(sed -n 's/^nodes: *//p' <<<"$check")
 
-name=$(basename "$scene" .toml)
+name=$(basename "${scene:-$resume}" .toml)
+name=${name%.h5}
 out=${out:-$root/runs/$name-$(date +%Y%m%d-%H%M%S)}
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
@@ -47,9 +62,10 @@ out=$(cd "$out" && pwd)
 
 if [[ $bus == private && -z ${DYNHET_IN_NETNS:-} ]]; then
   args=(--out "$out" --bus private --no-build)
+  [[ -z $resume ]] || args+=(--resume "$resume")
   [[ -z $url ]] || args+=(--url "$url")
   [[ -z $record ]] || args+=(--record "$record")
-  exec "$root/launch_scripts/netns.sh" "$0" "$scene" "${args[@]}"
+  exec "$root/launch_scripts/netns.sh" "$0" ${scene:+"$scene"} "${args[@]}"
 fi
 if [[ -n $url ]]; then export LCM_DEFAULT_URL=$url; fi
 url=${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0}
@@ -74,7 +90,7 @@ start() { # name, then the command; waits for its "ready" line
   echo "run_scene: $n did not get ready in 10 s" >&2; exit 1
 }
 
-echo "run_scene: $scene -> $out (bus $bus, $url)" >&2
+echo "run_scene: ${scene:-resuming $resume} -> $out (bus $bus, $url)" >&2
 if [[ -n $record ]]; then
   rm -f "$record"
   # Ahead of the other processes where allowed (root): a starved lcm-logger
@@ -97,7 +113,8 @@ fi
 # The sim in the foreground (its progress line goes to the terminal and
 # sim_node.log).
 set +e
-"$bin/sim_node" "$scene" --checkpoint "$out/checkpoint.h5" 2> >(tee "$out/sim_node.log" >&2)
+"$bin/sim_node" "${sim_input[@]}" --checkpoint "$out/checkpoint.h5" \
+  --checkpoint-before-frames "$out/checkpoint_before_frames.h5" 2> >(tee ${resume:+-a} "$out/sim_node.log" >&2)
 sim_rc=$?
 set -e
 if [[ $sim_rc -ne 0 ]]; then

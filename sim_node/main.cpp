@@ -160,10 +160,14 @@ int main(int argc, char** argv) {
   CLI::App app{"dynhet sim_node: event-driven MD of a driven granular fluid, frames over LCM"};
   std::string scene_path, url;
   int64_t run_id = 0;
-  std::string checkpoint_path, resume_path;
+  std::string checkpoint_path, resume_path, before_frames_path;
   app.add_option("scene", scene_path, "scene file (TOML)");
   app.add_option("--checkpoint", checkpoint_path, "write checkpoints (HDF5) to this file");
   app.add_option("--resume", resume_path, "continue the run saved in this checkpoint");
+  app.add_option("--checkpoint-before-frames", before_frames_path,
+                 "also keep the last checkpoint taken before the first frame in this file (with --checkpoint): a "
+                 "run interrupted in production restarts from it with every frame still to come, so fresh "
+                 "analysis nodes see them all");
   app.add_option("--lcm-url", url, "LCM URL (default $LCM_DEFAULT_URL or " + std::string(dynhet::kDefaultLcmUrl) + ")");
   app.add_option("--run-id", run_id, "run id (default: random)");
   bool check = false;
@@ -287,7 +291,9 @@ int main(int argc, char** argv) {
     int64_t next_slot = static_cast<int64_t>(std::floor(eng.time() / interval + 0.5)) + 1;
     int next_frame = resumed.next_frame;
     auto checkpoint = [&] {
-      dynhet::write_checkpoint(checkpoint_path, {scene.text, run_id, next_frame, scene.kick_pairs, eng.state()});
+      const dynhet::Checkpoint c{scene.text, run_id, next_frame, scene.kick_pairs, eng.state()};
+      dynhet::write_checkpoint(checkpoint_path, c);
+      if (next_frame == 0 && !before_frames_path.empty()) dynhet::write_checkpoint(before_frames_path, c);
       checkpoint_written = true;
     };
     bool announced = false;

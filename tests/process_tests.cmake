@@ -26,3 +26,10 @@ foreach(c 0 1)
 endforeach()
 add_test(NAME stress_engine_elastic_1e8 COMMAND stress_engine --collisions 1e8 --case 2)
 set_tests_properties(stress_engine_elastic_1e8 PROPERTIES LABELS stress TIMEOUT 3600)
+
+# The study runner, local executor: studies/tiny.toml end to end, skipped
+# when run again, an interrupted study resumed to the same results bit for
+# bit, changed and invalid studies refused (tests/study_local.sh).
+add_test(NAME study_local_tiny
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/study_local.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(study_local_tiny PROPERTIES LABELS process TIMEOUT 400)

@@ -1,0 +1,34 @@
+#!/usr/bin/env bash
+# Runs a study: a sweep of scenes (studies/README.md), on this machine or on
+# a Slurm cluster, resumable: the same command again skips complete runs,
+# resumes interrupted ones from their checkpoints and reruns failed ones.
+#
+# Usage: launch_scripts/run_study.sh STUDY.toml [options]
+#   --executor local   (default) up to --jobs runs at once on this machine,
+#                      each on its own private network namespace
+#   --executor slurm   one sbatch job array (a task per run) and a dependent
+#                      job that writes the index; --partition, --time, --mem
+#                      and --sbatch=FLAG (repeatable) pass through
+#   --jobs K           runs at once (local; default cores/2) or array tasks
+#                      at once (slurm; default no limit)
+#   --out DIR          the study directory (default runs/study-<name>)
+#   --dry-run          print every run with its times, estimated CPU time and
+#                      memory, and the totals; start nothing
+#   --no-build         skip setup.sh (packages and build)
+# The study directory holds study.toml (a copy; a changed study file is
+# refused), runs/<run>/{scene.toml,status.toml,run.h5,logs}, pilots/ and
+# index.toml, which the analysis reads.
+set -euo pipefail
+root=$(cd "$(dirname "$0")/.." && pwd)
+build=${BUILD_DIR:-$root/build}
+args=() build_first=1
+for a in "$@"; do
+  case "$a" in
+  --no-build) build_first=0 ;;
+  -h | --help) sed -n '2,22p' "$0"; exit 0 ;;
+  *) args+=("$a") ;;
+  esac
+done
+((${#args[@]})) || { sed -n '6,6p' "$0" >&2; exit 2; }
+if ((build_first)); then BUILD_DIR=$build "$root/launch_scripts/setup.sh"; fi
+BUILD_DIR=$build exec /usr/bin/python3 "$root/launch_scripts/study.py" run "${args[@]}"

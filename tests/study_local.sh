@@ -1,0 +1,72 @@
+#!/usr/bin/env bash
+# The study runner on the local executor (launch_scripts/run_study.sh):
+# studies/tiny.toml end to end; the same command again skips every run; a
+# study stopped by SIGTERM in a run's production is resumed from that
+# run's checkpoint and ends with the results of the uninterrupted study,
+# bit for bit; a changed study file and an invalid one are refused with
+# messages naming the problem. Each run is on its own private bus
+# (run_scene.sh).
+set -euo pipefail
+root=$1 build=$2
+export BUILD_DIR=$build
+tmp=$(mktemp -d)
+trap 'pkill -TERM -f "study.py run .*$tmp" 2>/dev/null || true; rm -rf "$tmp"' EXIT
+study=(bash "$root/launch_scripts/run_study.sh" --no-build)
+fail=0
+check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
+
+"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/a" --jobs 2 >"$tmp/a.out" 2>&1 || { cat "$tmp/a.out"; exit 1; }
+check 'grep -q "4 of 4 runs complete, 0 failed" "$tmp/a.out"' "tiny study: 4 of 4 runs complete"
+check '[[ $(grep -c "tau_source = \"pilot\"" "$tmp/a/index.toml") == 4 ]]' "every run's tau_alpha estimate came from a pilot, and says so"
+check '[[ $(ls "$tmp"/a/runs/*/run.h5 | wc -l) == 4 ]]' "each run has its run.h5"
+
+stamp=$(stat -c %Y "$tmp"/a/runs/*/status.toml | sort | tail -1)
+sleep 1
+"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/a" --jobs 2 >"$tmp/a2.out" 2>&1
+check 'grep -q "4 of 4 runs complete already (skipped)" "$tmp/a2.out"' "run again: every run skipped"
+check '[[ $(stat -c %Y "$tmp"/a/runs/*/status.toml | sort | tail -1) == "$stamp" ]]' "run again: no run touched"
+
+# Stop the study (SIGTERM, as a shutdown does) once the first run is in production.
+"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/b" --jobs 1 >"$tmp/b.out" 2>&1 &
+runner=$!
+for _ in $(seq 600); do
+  ls "$tmp"/b/runs/*/checkpoint_before_frames.h5 >/dev/null 2>&1 && grep -qs "frames" "$tmp"/b/runs/*/sim_node.log &&
+    [[ -n $(grep -ls "production" "$tmp"/b/runs/*/sim_node.log) ]] && break
+  sleep 0.1
+done
+kill -TERM "$runner"
+wait "$runner" && rc=0 || rc=$?
+check '[[ $rc == 130 ]]' "stopped study exits 130 (got $rc)"
+check 'grep -qs "state = \"interrupted\"" "$tmp"/b/runs/*/status.toml' "the stopped run is marked interrupted"
+"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/b" --jobs 2 >"$tmp/b2.out" 2>&1 || { cat "$tmp/b2.out"; exit 1; }
+check 'grep -q "was interrupted; resuming from .*checkpoint_before_frames.h5" "$tmp/b2.out"' "run again: the interrupted run resumes from its checkpoint"
+check 'grep -q "4 of 4 runs complete, 0 failed" "$tmp/b2.out"' "run again: 4 of 4 complete"
+/usr/bin/python3 "$root/tests/compare_studies.py" "$tmp/a" "$tmp/b" || fail=1
+
+# A changed study file under an existing study directory is refused.
+sed -e 's/seed = \[1, 2\]/seed = [1, 2, 3]/' -e "s|\"../scenes/tiny.toml\"|\"$root/scenes/tiny.toml\"|" \
+  "$root/studies/tiny.toml" >"$tmp/changed.toml"
+"${study[@]}" "$tmp/changed.toml" --out "$tmp/a" >"$tmp/c.out" 2>&1 && rc=0 || rc=$?
+check '[[ $rc == 2 ]] && grep -q "differs from the study that" "$tmp/c.out"' "a changed study is refused (exit $rc)"
+
+# An invalid study: each problem named with its key, nothing run.
+cat >"$tmp/bad.toml" <<TOML
+[study]
+scene = "$root/scenes/tiny.toml"
+nmae = "x"
+[axes]
+packing_fraction = [0.6, "dense"]
+seeds = [1]
+[run_length]
+tau_alpha = "guess"
+TOML
+"${study[@]}" "$tmp/bad.toml" --out "$tmp/bad" >"$tmp/bad.out" 2>&1 && rc=0 || rc=$?
+check '[[ $rc == 2 ]] && grep -q "study.nmae: unknown key" "$tmp/bad.out" && grep -q "axes.packing_fraction" "$tmp/bad.out" &&
+  grep -q "axes.seeds: unknown axis" "$tmp/bad.out" && grep -q "run_length.tau_alpha" "$tmp/bad.out"' "an invalid study is refused, every problem named"
+check '[[ ! -d $tmp/bad/runs ]]' "an invalid study runs nothing"
+# A study whose scene would be refused: named by run and scene key.
+printf '[study]\nscene = "%s"\n[axes]\npacking_fraction = [0.6, 0.95]\n' "$root/scenes/tiny.toml" >"$tmp/dense.toml"
+"${study[@]}" "$tmp/dense.toml" --out "$tmp/dense" >"$tmp/dense.out" 2>&1 && rc=0 || rc=$?
+check '[[ $rc == 2 ]] && grep -q "phi0.9500.*system.packing_fraction" "$tmp/dense.out"' "a point whose scene sim_node refuses is named before anything runs"
+((fail == 0)) || { echo "--- outputs"; cat "$tmp"/*.out; }
+exit $fail
