@@ -126,7 +126,9 @@ def check_type(where, v, typ):
 
 
 class Study:
-    def __init__(self, path):
+    def __init__(self, path, base_scene=None):
+        """base_scene: read the base scene from this file instead (a study
+        directory's copy, for its tasks wherever they run)."""
         self.path = os.path.abspath(path)
         try:
             self.text = open(self.path, "rb").read()
@@ -150,7 +152,9 @@ class Study:
         # The base scene: a path (relative to the study file) or an inline [scene] table.
         if "scene" in st and "scene" in data:
             self.errors.append("study.scene: give the base scene as a path or as a [scene] table, not both")
-        if "scene" in st:
+        if base_scene:
+            self.base = read_toml(base_scene)
+        elif "scene" in st:
             if not isinstance(st["scene"], str):
                 self.errors.append(f"study.scene: value {st['scene']!r} must be a path (string)")
                 self.base = {}
@@ -462,9 +466,9 @@ class StudyDir:
         s = (math.log(b[1]) - math.log(a[1])) / (b[0] - a[0])
         return math.exp(math.log(a[1]) + s * (phi - a[0]))
 
-    def guess(self, p):
+    def guess(self, p, finished=True):
         """A prior guess of tau_alpha: finished points, then the study's tau_guess table, then 1."""
-        t = self.interpolate(self.finished_taus(p), p["packing_fraction"])
+        t = self.interpolate(self.finished_taus(p), p["packing_fraction"]) if finished else None
         if t:
             return t, "interpolated from finished points"
         g = self.study.run_length["tau_guess"]
@@ -510,7 +514,11 @@ def run_scene(scene_path, out, log_path, resume=None):
         r0 = os.times()
         if STOPPING.is_set():
             return 130, 0.0, 0.0
-        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, start_new_session=True)
+        # Each run on a private bus of its own (run_scene.sh --bus private makes
+        # a new network namespace unless told it is in one already): runs that
+        # share a bus would take each other's frames.
+        env = {k: v for k, v in os.environ.items() if k != "DYNHET_IN_NETNS"}
+        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, start_new_session=True, env=env)
         with CHILDREN_LOCK:
             CHILDREN.add(proc)
         try:
@@ -554,9 +562,11 @@ def pilot_locked(sd, p, name, d):
     old = read_status(d)
     if old.get("state") == "complete":
         return old["tau_alpha"]
-    # The same pilot whichever seed of the point comes first: the first seed's.
+    # The same pilot whichever seed of the point comes first (the first
+    # seed's), and whatever else has finished (its first guess only from the
+    # study file): the pilot, and so the run, is a function of the point.
     p = dict(p, seed=st.axes.get("seed", [st.base_value("seed")])[0])
-    g, _ = sd.guess(p)
+    g, _ = sd.guess(p, finished=False)
     for attempt in range(1, 7):
         sc = st.scene(p, g, pilot=True)
         write_atomic(os.path.join(d, "scene.toml"), toml_dump(sc, f"# pilot of {name}, tau guess {g:.6g}"))
@@ -920,7 +930,7 @@ def main():
             if a.executor == "local":
                 return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2))
             return run_slurm(sd, a)
-        sd = StudyDir(Study(os.path.join(a.dir, "study.toml")), a.dir)
+        sd = StudyDir(Study(os.path.join(a.dir, "study.toml"), os.path.join(a.dir, "base_scene.toml")), a.dir)
         if a.cmd == "task":
             return task(sd, a.name)
         rows = write_index(sd)

@@ -33,3 +33,10 @@ set_tests_properties(stress_engine_elastic_1e8 PROPERTIES LABELS stress TIMEOUT 
 add_test(NAME study_local_tiny
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/study_local.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(study_local_tiny PROPERTIES LABELS process TIMEOUT 400)
+
+# The study runner, Slurm executor, against a real throwaway single-host
+# Slurm cluster in a private network namespace (tests/slurm_study.sh): every
+# run equals the local executor's bit for bit.
+add_test(NAME study_slurm_tiny
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/slurm_study.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(study_slurm_tiny PROPERTIES LABELS process TIMEOUT 600)
