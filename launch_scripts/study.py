@@ -138,7 +138,7 @@ class Study:
         except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
             raise StudyError(f"{path}: not valid TOML: {e}")
         self.errors = []
-        known = {"study", "scene", "axes", "run_length", "override"}
+        known = {"study", "scene", "axes", "series", "run_length", "override"}
         for k in data:
             if k not in known:
                 self.errors.append(f"{k}: unknown key or table; known: {', '.join(sorted(known))}")
@@ -175,23 +175,21 @@ class Study:
                 self.base = {}
         else:
             self.base = {}
-        self.axes = {}
-        for k, v in data.get("axes", {}).items():
-            if k not in AXES:
-                self.errors.append(f"axes.{k}: unknown axis; known: {', '.join(AXES)}")
-                continue
-            if not isinstance(v, list) or not v:
-                self.errors.append(f"axes.{k}: value {v!r} must be a non-empty array")
-                continue
-            try:
-                vals = [check_type(f"axes.{k}", x, AXES[k][2]) for x in v]
-            except StudyError as e:
-                self.errors.append(str(e))
-                continue
-            if len(set(vals)) != len(vals):
-                self.errors.append(f"axes.{k}: each value may be listed once")
-                continue
-            self.axes[k] = vals
+        # [axes]: one product of axes; or [[series]]: several, the runs their union.
+        if "axes" in data and "series" in data:
+            self.errors.append("series: give [axes] or [[series]], not both")
+        blocks = [("axes", data.get("axes", {}))]
+        if "series" in data:
+            if not isinstance(data["series"], list):
+                self.errors.append("series: must be an array of tables ([[series]])")
+            else:
+                blocks = [(f"series[{i}]", b) for i, b in enumerate(data["series"])]
+        self.series = [self.read_axes(where, b) for where, b in blocks]
+        self.axes = {}  # every value of each axis over all series
+        for ax in self.series:
+            for k, vals in ax.items():
+                self.axes.setdefault(k, [])
+                self.axes[k] += [v for v in vals if v not in self.axes[k]]
         rl = dict(RUN_LENGTH_DEFAULTS)
         for k, v in data.get("run_length", {}).items():
             if k not in RUN_LENGTH_KEYS:
@@ -241,6 +239,29 @@ class Study:
             raise StudyError(f"{path}: invalid study ({len(self.errors)} problem"
                              f"{'s' if len(self.errors) > 1 else ''}):\n  " + "\n  ".join(self.errors))
 
+    def read_axes(self, where, block):
+        axes = {}
+        if not isinstance(block, dict):
+            self.errors.append(f"{where}: must be a table of axes")
+            return axes
+        for k, v in block.items():
+            if k not in AXES:
+                self.errors.append(f"{where}.{k}: unknown axis; known: {', '.join(AXES)}")
+                continue
+            if not isinstance(v, list) or not v:
+                self.errors.append(f"{where}.{k}: value {v!r} must be a non-empty array")
+                continue
+            try:
+                vals = [check_type(f"{where}.{k}", x, AXES[k][2]) for x in v]
+            except StudyError as e:
+                self.errors.append(str(e))
+                continue
+            if len(set(vals)) != len(vals):
+                self.errors.append(f"{where}.{k}: each value may be listed once")
+                continue
+            axes[k] = vals
+        return axes
+
     def base_value(self, axis):
         table, key, _ = AXES[axis]
         defaults = {"packing_fraction": 0.7, "restitution": 0.9, "n_particles": 1000, "seed": 1,
@@ -250,10 +271,12 @@ class Study:
     def points(self):
         """Every run: a dict of axis values, in a fixed order (phi slowest)."""
         names = list(AXES)
-        values = [self.axes.get(a, [self.base_value(a)]) for a in names]
-        runs = [{}]
-        for a, vs in zip(names, values):
-            runs = [dict(r, **{a: v}) for r in runs for v in vs]
+        runs = []
+        for ax in self.series:
+            block = [{}]
+            for a in names:
+                block = [dict(r, **{a: v}) for r in block for v in ax.get(a, [self.base_value(a)])]
+            runs += [r for r in block if r not in runs]
         # Overrides of an axis' own key (a larger N at low phi) show in the point.
         for r in runs:
             for when, st in self.overrides:
