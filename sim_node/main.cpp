@@ -387,12 +387,14 @@ int main(int argc, char** argv) {
     double px, py;
     eng.momentum(px, py);
     std::fprintf(stderr,
-                 "\nsim_node: done in %.1f s: %lld collisions, %lld kicks, %d frames, KE/N=%.4f, "
+                 "\nsim_node: done in %.1f s: %lld collisions, %lld kicks (first particles drawn again %lld times, "
+                 "%lld pairs from the whole system), %d frames, KE/N=%.4f, "
                  "total momentum (%.2g, %.2g), max overlap %.2g\n"
                  "sim_node: production: Z = %.5g +- %.2g, collisions per particle per unit time %.5g +- %.2g, "
                  "TC model acted %lld times\n",
                  seconds_since(t_wall), static_cast<long long>(eng.counters().collisions),
-                 static_cast<long long>(eng.counters().kicks), info.n_frames,
+                 static_cast<long long>(eng.counters().kicks), static_cast<long long>(eng.counters().kick_redraws),
+                 static_cast<long long>(eng.counters().kick_far), info.n_frames,
                  eng.kinetic_energy_per_particle(), px, py, std::max(0.0, eng.max_overlap()),
                  rep.msg().reduced_pressure, rep.msg().reduced_pressure_err, rep.msg().collision_frequency,
                  rep.msg().collision_frequency_err, static_cast<long long>(eng.counters().tc));
