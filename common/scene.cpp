@@ -215,6 +215,13 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
          s.radius_ratio = v;
        }},
       {"tc_time", non_negative(s.tc_time)},
+      {"initial_state",
+       [&](const std::string& key, const toml::node& n) {
+         const auto v = n.value_exact<std::string>();
+         if (!v) return c.bad_type(key, n, "a string (the path of a prepared state or an H5MD file)");
+         if (v->empty()) return c.bad_value(key, n, "give a path, or leave the key out to compress");
+         s.initial_state = *v;
+       }},
       {"seed",
        [&](const std::string& key, const toml::node& n) {
          int64_t v;

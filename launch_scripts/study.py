@@ -144,8 +144,12 @@ class Study:
                 self.errors.append(f"{k}: unknown key or table; known: {', '.join(sorted(known))}")
         st = data.get("study", {})
         for k in st:
-            if k not in ("name", "description", "scene"):
-                self.errors.append(f"study.{k}: unknown key; known keys in [study]: name, description, scene")
+            if k not in ("name", "description", "scene", "prepared_states"):
+                self.errors.append(f"study.{k}: unknown key; known keys in [study]: name, description, scene, "
+                                   "prepared_states")
+        self.prepared_states = st.get("prepared_states", True)
+        if not isinstance(self.prepared_states, bool):
+            self.errors.append(f"study.prepared_states: value {self.prepared_states!r} must be true or false")
         self.name = st.get("name", os.path.splitext(os.path.basename(path))[0])
         if not isinstance(self.name, str) or not self.name or "/" in self.name:
             self.errors.append(f"study.name: value {self.name!r} must be a non-empty string without '/'")
@@ -557,6 +561,36 @@ def run_scene(scene_path, out, log_path, resume=None):
     return rc, time.time() - t0, (r1.children_user - r0.children_user) + (r1.children_system - r0.children_system)
 
 
+def prepared_state(sd, sc):
+    """The prepared state (compressed, velocities drawn) of scene sc's system:
+    made once per (N, phi, radius ratio, seed) by sim_node --prepare-only and
+    shared by every run and pilot of it (other restitutions, driving, cutoffs,
+    schedules); a run from it equals the run that compresses itself, bit for
+    bit. Sets sc's system.initial_state to it."""
+    if not sd.study.prepared_states or sc["system"].get("initial_state"):
+        return
+    sy = sc["system"]
+    key = (f"n{int(sy['n_particles'])}_phi{float(sy['packing_fraction']):.6g}"
+           f"_r{float(sy.get('radius_ratio', 1.43)):.6g}_seed{int(sy.get('seed', 1))}")
+    d = os.path.join(sd.dir, "states")
+    os.makedirs(d, exist_ok=True)
+    path = os.path.join(d, key + ".h5")
+    with open(os.path.join(d, key + ".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        if not os.path.exists(path):
+            scene_path = os.path.join(d, key + ".toml")
+            write_atomic(scene_path, toml_dump(sc, f"# the system of prepared state {key}"))
+            with open(os.path.join(d, key + ".log"), "w") as log:
+                rc = subprocess.call([SIM, scene_path, "--prepare-only", path + ".tmp"], stdout=log,
+                                     stderr=subprocess.STDOUT)
+            if rc != 0 or STOPPING.is_set():
+                if STOPPING.is_set():
+                    raise StudyInterrupted(f"preparing {key} stopped")
+                raise StudyError(f"preparing the state {key} failed (exit {rc}); its log: {d}/{key}.log")
+            os.replace(path + ".tmp", path)
+    sy["initial_state"] = path
+
+
 def pid_alive(pid):
     try:
         os.kill(int(pid), 0)
@@ -592,6 +626,7 @@ def pilot_locked(sd, p, name, d):
     g, _ = sd.guess(p, finished=False)
     for attempt in range(1, 7):
         sc = st.scene(p, g, pilot=True)
+        prepared_state(sd, sc)
         write_atomic(os.path.join(d, "scene.toml"), toml_dump(sc, f"# pilot of {name}, tau guess {g:.6g}"))
         rc, wall, cpu = run_scene(os.path.join(d, "scene.toml"), d, os.path.join(d, "run_scene.log"))
         if STOPPING.is_set():
@@ -644,6 +679,7 @@ def do_run(sd, p, log=print):
             tau_est = pilot(sd, p)
             source = "pilot"
         sc = st.scene(p, tau_est)
+        prepared_state(sd, sc)
         write_atomic(os.path.join(d, "scene.toml"),
                      toml_dump(sc, f"# {st.name}: {st.run_name(p)}; tau_alpha estimate {tau_est} ({source})"))
     sc = read_toml(os.path.join(d, "scene.toml"))

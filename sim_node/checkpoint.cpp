@@ -1,5 +1,6 @@
 #include "checkpoint.hpp"
 
+#include <cmath>
 #include <cstdio>
 #include <stdexcept>
 #include <vector>
@@ -96,6 +97,70 @@ void write_checkpoint(const std::string& path, const Checkpoint& c) {
   }
   if (std::rename(tmp.c_str(), path.c_str()) != 0)
     throw std::runtime_error(path + ": cannot move the checkpoint into place");
+}
+
+bool is_checkpoint(const std::string& path) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  const hid_t f = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  if (f < 0) return false;
+  char format[64] = {0};
+  hsize_t dims = 0;
+  H5T_class_t cls;
+  size_t size = 0;
+  const bool ok = H5Aexists(f, "format") > 0 && H5LTget_attribute_info(f, "/", "format", &dims, &cls, &size) >= 0 &&
+                  size < sizeof format && H5LTget_attribute_string(f, "/", "format", format) >= 0 &&
+                  std::string(format) == kFormat;
+  H5Fclose(f);
+  return ok;
+}
+
+void read_h5md_positions(const std::string& path, long n, double box, std::vector<double>& x,
+                         std::vector<double>& y) {
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  File f(H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT), path);
+  const char* name = "particles/all/position/value";
+  if (H5LTpath_valid(f.id(), name, 1) <= 0)
+    throw std::runtime_error(path + ": no " + name + " (an H5MD file with the particles' positions)");
+  int rank = 0;
+  f.check(H5LTget_dataset_ndims(f.id(), name, &rank), "reading the positions");
+  if (rank < 1 || rank > 3) throw std::runtime_error(path + ": " + name + " has rank " + std::to_string(rank));
+  std::vector<hsize_t> dims(rank);
+  f.check(H5LTget_dataset_info(f.id(), name, dims.data(), nullptr, nullptr), "reading the positions");
+  hsize_t total = 1;
+  for (hsize_t d : dims) total *= d;
+  const hsize_t frame = 2 * static_cast<hsize_t>(n);
+  if (total == 0 || total % frame != 0 || total > (hsize_t{1} << 34))
+    throw std::runtime_error(path + ": " + name + " holds " + std::to_string(total) +
+                             " numbers, not whole frames of 2 x " + std::to_string(n) + " (the scene's particles)");
+  std::vector<double> all(total);
+  f.check(H5LTread_dataset_double(f.id(), name, all.data()), "reading the positions");
+  x.resize(n), y.resize(n);
+  const double* last = all.data() + (total - frame);
+  for (long i = 0; i < n; ++i) {
+    const double px = last[2 * i], py = last[2 * i + 1];
+    if (!std::isfinite(px) || !std::isfinite(py))
+      throw std::runtime_error(path + ": particle " + std::to_string(i) + " has a position that is not a number");
+    x[i] = px - box * std::floor(px / box), y[i] = py - box * std::floor(py / box);
+    if (x[i] >= box) x[i] = 0;
+    if (y[i] >= box) y[i] = 0;
+  }
+  const char* edges = "particles/all/box/edges";
+  if (H5LTpath_valid(f.id(), edges, 1) > 0) {
+    int er = 0;
+    f.check(H5LTget_dataset_ndims(f.id(), edges, &er), "reading the box");
+    std::vector<hsize_t> ed(std::max(er, 1));
+    f.check(H5LTget_dataset_info(f.id(), edges, ed.data(), nullptr, nullptr), "reading the box");
+    hsize_t ne = 1;
+    for (int k = 0; k < er; ++k) ne *= ed[k];
+    if (ne >= 1 && ne <= 64) {
+      std::vector<double> e(ne);
+      f.check(H5LTread_dataset_double(f.id(), edges, e.data()), "reading the box");
+      for (double v : e)
+        if (!(std::fabs(v - box) <= 1e-9 * box))
+          throw std::runtime_error(path + ": its box edge " + std::to_string(v) + " is not the scene's box " +
+                                   std::to_string(box) + " (N, phi and the radius ratio fix it)");
+    }
+  }
 }
 
 Checkpoint read_checkpoint(const std::string& path) {

@@ -5,6 +5,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include "dynhet/engine/engine.hpp"
 
@@ -21,6 +22,18 @@ struct Checkpoint {
 };
 
 void write_checkpoint(const std::string& path, const Checkpoint& c);
+
+// Whether the file is a dynhet checkpoint (a prepared state is one, at time
+// 0, written by sim_node --prepare-only).
+bool is_checkpoint(const std::string& path);
+
+// Positions of n particles from an H5MD file: the last frame of
+// particles/all/position/value ([frame][n][2], [frame][2n] or [n][2]),
+// folded into the box of side `box`; particles/all/box/edges, if there,
+// must be that box. Throws std::runtime_error naming the file and what is
+// wrong.
+void read_h5md_positions(const std::string& path, long n, double box, std::vector<double>& x,
+                         std::vector<double>& y);
 // Throws std::runtime_error naming the file and what is wrong with it.
 Checkpoint read_checkpoint(const std::string& path);
 

@@ -154,6 +154,77 @@ private:
   dynhet::BlockAverage pressure_, frequency_;
 };
 
+dynhet::engine::Params engine_params(const dynhet::Scene& scene) {
+  dynhet::engine::Params p;
+  p.n_particles = scene.n_particles;
+  p.packing_fraction = scene.packing_fraction;
+  p.restitution = scene.restitution;
+  p.radius_ratio = scene.radius_ratio;
+  p.seed = scene.seed;
+  p.driving = scene.driving;
+  p.tc = scene.tc_time;
+  p.kick_rate = dynhet::scene_kick_rate(scene);
+  p.kick_pairs = scene.kick_pairs == "any" ? dynhet::engine::KickPairs::any : dynhet::engine::KickPairs::neighbours;
+  p.kick_reach = scene.kick_reach;
+  return p;
+}
+
+// --prepare-only: compression and velocities, written as a checkpoint at t = 0.
+int prepare_only(const dynhet::Scene& scene, const std::string& path) {
+  try {
+    dynhet::engine::Engine eng(engine_params(scene));
+    const auto t0 = Clock::now();
+    eng.compress([&](double phi) {
+      if (isatty(STDERR_FILENO)) std::fprintf(stderr, "\rsim_node: compressing, phi = %.4f", phi);
+    });
+    eng.thermalize(1.0);
+    dynhet::write_checkpoint(path, {scene.text, 0, 0, scene.kick_pairs, eng.state()});
+    std::fprintf(stderr, "\nsim_node: prepared state (N=%ld, phi=%.4f, seed %llu) in %.1f s -> %s\n", eng.size(),
+                 eng.packing_fraction(), static_cast<unsigned long long>(scene.seed), seconds_since(t0), path.c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "sim_node: %s\n", e.what());
+    return 1;
+  }
+}
+
+// system.initial_state: a prepared state of the same system (N, phi,
+// radius ratio, seed), or positions from an H5MD file (velocities drawn).
+void start_from(dynhet::engine::Engine& eng, const dynhet::Scene& scene) {
+  const std::string& path = scene.initial_state;
+  if (access(path.c_str(), R_OK) != 0) throw std::runtime_error(path + ": no such file (system.initial_state)");
+  if (dynhet::is_checkpoint(path)) {
+    const dynhet::Checkpoint c = dynhet::read_checkpoint(path);
+    if (c.state.time != 0.0 || c.next_frame != 0)
+      throw std::runtime_error(path + ": a checkpoint at t = " + std::to_string(c.state.time) +
+                               ", not a prepared state (sim_node --prepare-only writes those; resume a "
+                               "checkpoint with --resume)");
+    const dynhet::Scene made = dynhet::parse_scene_text(c.scene_toml, path + " (its scene)");
+    auto differs = [&](const char* key, const std::string& was, const std::string& is) {
+      if (was != is)
+        throw std::runtime_error(path + ": prepared for system." + key + " = " + was + ", the scene has " + is);
+    };
+    differs("n_particles", std::to_string(made.n_particles), std::to_string(scene.n_particles));
+    differs("packing_fraction", std::to_string(made.packing_fraction), std::to_string(scene.packing_fraction));
+    differs("radius_ratio", std::to_string(made.radius_ratio), std::to_string(scene.radius_ratio));
+    differs("seed", std::to_string(made.seed), std::to_string(scene.seed));
+    if (made.packing_fraction != scene.packing_fraction || made.radius_ratio != scene.radius_ratio)
+      throw std::runtime_error(path + ": prepared for another packing fraction or radius ratio (they differ "
+                               "beyond the digits shown)");
+    eng.start_prepared(c.state);
+    return;
+  }
+  std::vector<double> x, y;
+  dynhet::read_h5md_positions(path, eng.size(), eng.box_length(), x, y);
+  try {
+    eng.place(x, y);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  eng.thermalize(1.0);
+  eng.begin();
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -168,6 +239,11 @@ int main(int argc, char** argv) {
                  "also keep the last checkpoint taken before the first frame in this file (with --checkpoint): a "
                  "run interrupted in production restarts from it with every frame still to come, so fresh "
                  "analysis nodes see them all");
+  std::string prepare_path;
+  app.add_option("--prepare-only", prepare_path,
+                 "compress the scene's system, draw its velocities, write this prepared state (HDF5) and exit: "
+                 "runs of any restitution or driving that start from it (system.initial_state) equal the runs "
+                 "that compress themselves, bit for bit");
   app.add_option("--lcm-url", url, "LCM URL (default $LCM_DEFAULT_URL or " + std::string(dynhet::kDefaultLcmUrl) + ")");
   app.add_option("--run-id", run_id, "run id (default: random)");
   bool check = false;
@@ -208,6 +284,12 @@ int main(int argc, char** argv) {
                 static_cast<long long>(scene.n_particles), scene.equilibration_time + scene.production_time);
     return 0;
   }
+  // Where a scene's initial_state is: relative to the scene file.
+  if (!scene.initial_state.empty() && scene.initial_state[0] != '/' && resume_path.empty()) {
+    const auto slash = scene_path.find_last_of('/');
+    if (slash != std::string::npos) scene.initial_state = scene_path.substr(0, slash + 1) + scene.initial_state;
+  }
+  if (!prepare_path.empty()) return prepare_only(scene, prepare_path);
   if (run_id == 0) run_id = static_cast<int64_t>(std::random_device{}() & 0x7fffffff) << 20 ^ getpid();
 
   lcm::LCM lcm(dynhet::resolve_lcm_url(url));
@@ -229,17 +311,7 @@ int main(int argc, char** argv) {
 
   bool checkpoint_written = !resume_path.empty();
   try {
-    dynhet::engine::Params p;
-    p.n_particles = scene.n_particles;
-    p.packing_fraction = scene.packing_fraction;
-    p.restitution = scene.restitution;
-    p.radius_ratio = scene.radius_ratio;
-    p.seed = scene.seed;
-    p.driving = scene.driving;
-    p.tc = scene.tc_time;
-    p.kick_rate = dynhet::scene_kick_rate(scene);
-    p.kick_pairs = scene.kick_pairs == "any" ? dynhet::engine::KickPairs::any : dynhet::engine::KickPairs::neighbours;
-    p.kick_reach = scene.kick_reach;
+    const dynhet::engine::Params p = engine_params(scene);
     dynhet::engine::Engine eng(p);
     std::fprintf(stderr,
                  "sim_node: run %lld, N=%ld phi=%.4f eps=%.3f L=%.4f, kicks %s (%.4g per particle per unit time, "
@@ -269,6 +341,10 @@ int main(int argc, char** argv) {
       eng.restore(resumed.state);
       std::fprintf(stderr, "sim_node: resumed at t=%.10g, frame %d, from %s\n", eng.time(),
                    resumed.next_frame, resume_path.c_str());
+    } else if (!scene.initial_state.empty()) {
+      start_from(eng, scene);
+      std::fprintf(stderr, "sim_node: started from %s (max overlap %.2g)\n", scene.initial_state.c_str(),
+                   std::max(0.0, eng.max_overlap()));
     } else {
       // Compression to the scene's packing fraction.
       rep.msg().phase = "compress";

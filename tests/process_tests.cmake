@@ -40,3 +40,9 @@ set_tests_properties(study_local_tiny PROPERTIES LABELS process TIMEOUT 400)
 add_test(NAME study_slurm_tiny
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/slurm_study.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(study_slurm_tiny PROPERTIES LABELS process TIMEOUT 600)
+
+# Prepared states (sim_node --prepare-only, system.initial_state): runs from
+# one equal the runs that compress themselves, bit for bit; bad states refused.
+add_test(NAME prepared_state_bit_for_bit
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/prepared_state.sh ${PROJECT_SOURCE_DIR} $<TARGET_FILE_DIR:sim_node>)
+set_tests_properties(prepared_state_bit_for_bit PROPERTIES LABELS process TIMEOUT 300)

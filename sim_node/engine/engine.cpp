@@ -34,22 +34,24 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
   neighbour_kicks_ = p.driving && p.kick_rate > 0 && p.restitution < 1.0 && p.kick_pairs == KickPairs::neighbours;
   if (neighbour_kicks_ && !(p.kick_reach > 0 && std::isfinite(p.kick_reach)))
     throw std::invalid_argument("engine: the kick reach must be a positive gap, not " + std::to_string(p.kick_reach));
-  // Cells must hold, in the 3 x 3 around a particle's, every partner its
-  // kick may take: wider by the kick reach with neighbour pairs.
-  const double widest =
-      2.0 * std::max(radius_[0], radius_[1]) + 2 * list_margin_ + (neighbour_kicks_ ? p.kick_reach : 0.0);
+  const double widest = 2.0 * std::max(radius_[0], radius_[1]) + 2 * list_margin_;
   skin_ = (p.skin > 0 ? p.skin : auto_skin(p.packing_fraction)) * radius_[0];
   // An automatic skin narrows to let a small box hold 3 cells.
   if (p.skin == 0) skin_ = std::max(0.0, std::min(skin_, 0.999 * (box_ / 3 - widest)));
   // Cells over list centres at least as wide as the largest contact
-  // distance plus the skin, at least 3 a side.
-  nc_ = static_cast<int>(std::floor(box_ / (widest + skin_)));
-  if (nc_ < 3 || !(skin_ > 0))
+  // distance plus the skin, at least 3 a side. In the run, with neighbour
+  // kick pairs, wider by the kick reach: the 3 x 3 cells around a particle's
+  // then hold every partner its kick may take. Compression uses the narrower
+  // cells whatever the run does, so that its result, a prepared state, is
+  // the same for every restitution and driving.
+  nc_compress_ = static_cast<int>(std::floor(box_ / (widest + skin_)));
+  nc_run_ = static_cast<int>(std::floor(box_ / (widest + skin_ + (neighbour_kicks_ ? p.kick_reach : 0.0))));
+  if (nc_run_ < 3 || !(skin_ > 0))
     throw std::invalid_argument("engine: box of side " + std::to_string(box_) +
                                 " holds fewer than 3 cells of the largest contact distance plus the skin" +
                                 (neighbour_kicks_ ? " and the kick reach" : "") +
                                 "; use more particles or a thinner skin");
-  cw_ = box_ / nc_;
+  use_cells(false);
 
   part_.assign(n_, Particle{0, 0, 0, 0, 0, kNever, 0, 0, kRebuild, 0});
   for (long i = 0; i < n_; ++i) part_[i].species = species_by_id_[i];
@@ -617,6 +619,18 @@ void Engine::rescale_velocities(double energy) {
 }
 
 void Engine::prepare(const std::function<void(double)>& progress) {
+  compress(progress);
+  thermalize(1.0);
+  begin();
+}
+
+void Engine::use_cells(bool run) {
+  nc_ = run ? nc_run_ : nc_compress_;
+  cw_ = box_ / nc_;
+}
+
+void Engine::compress(const std::function<void(double)>& progress) {
+  use_cells(false);
   const double phi = p_.packing_fraction;
   const double phi_start = std::min(phi, 0.35);
   place_random(std::sqrt(phi_start / phi));
@@ -660,19 +674,60 @@ void Engine::prepare(const std::function<void(double)>& progress) {
     throw std::runtime_error("engine: compression left an overlap of " + std::to_string(ov) +
                              " of a contact distance (a bug)");
 
-  // The run proper starts at t = 0 with kinetic energy 1 per particle.
+  // The run proper starts at t = 0 (with kinetic energy 1 per particle:
+  // thermalize(), then begin()).
   now_ = offset_ = 0;
   last_collision_.assign(n_, -kNever);
   events_since_rebase_ = 0;
   count_ = Counters{};
-  thermalize(1.0);
+  kick_time_ = kNever;
+}
+
+void Engine::begin() {
   start_run();
   kick_time_ = driving_ ? now_ + rng_.exponential(kick_pair_rate_) : kNever;
   reorder();
   clear_events();
 }
 
+void Engine::place(const std::vector<double>& x, const std::vector<double>& y) {
+  if (x.size() != static_cast<size_t>(n_) || y.size() != static_cast<size_t>(n_))
+    throw std::invalid_argument("engine: " + std::to_string(x.size()) + " positions for " + std::to_string(n_) +
+                                " particles");
+  for (long i = 0; i < n_; ++i) {
+    if (!std::isfinite(x[i]) || !std::isfinite(y[i]) || x[i] < 0 || x[i] >= box_ || y[i] < 0 || y[i] >= box_)
+      throw std::invalid_argument("engine: particle " + std::to_string(i) + " at (" + std::to_string(x[i]) + ", " +
+                                  std::to_string(y[i]) + ") is not in the box [0, " + std::to_string(box_) + ")");
+  }
+  scale0_ = 1.0;
+  grow_ = 0.0;
+  now_ = offset_ = 0;
+  for (long i = 0; i < n_; ++i)
+    part_[i] = Particle{x[i], y[i], 0.0, 0.0, 0.0, kNever, 0, species_by_id_[i], kRebuild, 0};
+  for (long i = 0; i < n_; ++i) id_[i] = static_cast<int32_t>(i);
+  species_ = species_by_id_;
+  image_x_.assign(n_, 0);
+  image_y_.assign(n_, 0);
+  last_collision_.assign(n_, -kNever);
+  events_since_rebase_ = 0;
+  count_ = Counters{};
+  kick_time_ = kNever;
+  reorder(); // cells over the positions, for the overlap check
+  clear_events();
+  if (const double ov = max_overlap(); ov > 1e-9)
+    throw std::invalid_argument("engine: the positions overlap: a pair is closer than its contact distance by " +
+                                std::to_string(ov) + " of it");
+}
+
+void Engine::start_prepared(const State& s) {
+  if (s.time != 0.0)
+    throw std::invalid_argument("engine: a prepared state is at time 0, this one at " + std::to_string(s.time));
+  restore(s);
+  begin();
+}
+
 void Engine::start_run() {
+  use_cells(true); // the caller sorts the particles into them (reorder)
   eps_ = p_.restitution;
   driving_ = p_.driving && p_.kick_rate > 0 && eps_ < 1.0;
   kick_pair_rate_ = 0.5 * p_.kick_rate * n_;

@@ -35,6 +35,10 @@ struct Scene {
   double radius_ratio = 1.43; // r2 / r1; 1 is monodisperse
   uint64_t seed = 1;
   double tc_time = 0.0; // TC model: collisions within tc of a particle's previous one are elastic; 0 off
+  // Start from this state instead of compressing (path, relative to the
+  // scene file): a prepared state (sim_node --prepare-only) or an H5MD file
+  // with particles/all/position. Empty: compress.
+  std::string initial_state;
 
   // [driving]
   bool driving = true;

@@ -144,6 +144,21 @@ public:
   // set to 0. `progress(phi_now)` is called now and then. Throws
   // std::runtime_error if the growth stalls (the packing jams).
   void prepare(const std::function<void(double phi_now)>& progress = {});
+  // prepare() in its three steps: compress() (positions at the scene's phi,
+  // the clock at 0), thermalize(1.0), begin() (restitution and driving on,
+  // the first kick drawn, lists and events). A prepared state is the
+  // state() between thermalize and begin: start_prepared() from it gives
+  // the run prepare() would have given, bit for bit, whatever restitution
+  // or driving the run has.
+  void compress(const std::function<void(double phi_now)>& progress = {});
+  void begin();
+  // Positions (by particle id, in the box) of a state from elsewhere:
+  // throws std::invalid_argument if one is not finite or any pair overlaps
+  // by more than 1e-9 of its contact distance. Velocities: thermalize().
+  void place(const std::vector<double>& x, const std::vector<double>& y);
+  // Continues from a prepared state (time 0): positions, velocities and
+  // random state as saved, then begin().
+  void start_prepared(const State& s);
 
   // Maxwell-Boltzmann velocities, zero total momentum, kinetic energy per
   // particle exactly `energy` (the paper's time unit: 1 at t = 0).
@@ -311,7 +326,9 @@ private:
   double list_scale_ = 1; // radii scale the lists hold for (below 1 only while compressing)
   double list_margin_;  // roundoff allowance in the list criterion
 
-  int nc_ = 0;   // cells per side
+  int nc_ = 0;   // cells per side: nc_compress_ while compressing, nc_run_ in the run
+  int nc_compress_ = 0, nc_run_ = 0;
+  void use_cells(bool run);
   double cw_ = 0; // cell width
   // Cells over the list centres, as rows (not linked lists): row
   // cell_index(cx, cy) holds the slots of its particles. cell_x_, cell_y_
