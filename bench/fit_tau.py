@@ -22,15 +22,7 @@ import sys
 
 import numpy as np
 
-
-def read_result(path):
-    out = {}
-    with open(path) as f:
-        for line in f:
-            if "=" in line:
-                k, v = (s.strip() for s in line.split("=", 1))
-                out[k] = v.strip('"')
-    return out
+from tau_scan import read_result
 
 
 def load(d):
