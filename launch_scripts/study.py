@@ -108,11 +108,13 @@ RUN_LENGTH_KEYS = {
     "origin_spacing_tau": float,
     "origins": int,
     "pilot_particles": int,
+    "pilot_margin": float,
     "max_attempts": int,
     "tau_guess": list,
 }
 RUN_LENGTH_DEFAULTS = dict(tau_alpha="scene", equilibration_tau=10.0, lag_max_tau=4.0, lag_min_tau=0.02,
-                           origin_spacing_tau=1.0, origins=8, pilot_particles=2048, max_attempts=3, tau_guess=[])
+                           origin_spacing_tau=1.0, origins=8, pilot_particles=2048, pilot_margin=1.2, max_attempts=3,
+                           tau_guess=[])
 
 
 def check_type(where, v, typ):
@@ -206,6 +208,8 @@ class Study:
         if rl["tau_alpha"] not in ("scene", "pilot", "interpolate"):
             self.errors.append(f"run_length.tau_alpha: value {rl['tau_alpha']!r} is not allowed; "
                                'allowed: "scene" (the scene\'s own times), "pilot", "interpolate"')
+        if not (1.0 <= rl["pilot_margin"] <= 10.0):
+            self.errors.append(f"run_length.pilot_margin: value {rl['pilot_margin']} is not allowed; allowed: 1 to 10")
         for k in ("equilibration_tau", "lag_max_tau", "lag_min_tau", "origin_spacing_tau"):
             if not (rl[k] > 0 and math.isfinite(rl[k])):
                 self.errors.append(f"run_length.{k}: value {rl[k]} must be > 0")
@@ -676,8 +680,10 @@ def do_run(sd, p, log=print):
         elif rl["tau_alpha"] == "interpolate" and len(sd.finished_taus(p)) >= 2:
             tau_est, source = sd.guess(p)
         else:
-            tau_est = pilot(sd, p)
-            source = "pilot"
+            # A short, small pilot scatters by some 10% from the run (seen in
+            # studies/quick.toml): a margin spares most runs a second attempt.
+            tau_est = rl["pilot_margin"] * pilot(sd, p)
+            source = "pilot" if rl["pilot_margin"] == 1.0 else f"pilot x {rl['pilot_margin']:g}"
         sc = st.scene(p, tau_est)
         prepared_state(sd, sc)
         write_atomic(os.path.join(d, "scene.toml"),

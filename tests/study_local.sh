@@ -23,7 +23,7 @@ check 'grep -q "4 of 4 runs complete, 0 failed" "$tmp/a.out"' "tiny study: 4 of 
 check '/usr/bin/python3 -c "
 import tomllib, sys
 runs = tomllib.load(open(\"$tmp/a/index.toml\", \"rb\"))[\"runs\"].values()
-ok = all(r[\"tau_source\"] in (\"pilot\", \"1.3 x the tau_alpha of the previous, too short attempt\")
+ok = all(r[\"tau_source\"] in (\"pilot x 1.2\", \"1.3 x the tau_alpha of the previous, too short attempt\")
          and 10 * r[\"tau_estimate\"] >= 9 * r[\"tau_alpha\"] for r in runs)
 sys.exit(0 if ok and len(runs) == 4 else 1)"' "every run's schedule came from a pilot (or its own too short attempt), says so, and is >= 9 tau_alpha long"
 check '[[ $(ls "$tmp"/a/runs/*/run.h5 | wc -l) == 4 ]]' "each run has its run.h5"
