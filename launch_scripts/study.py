@@ -668,7 +668,7 @@ def do_run(sd, p, log=print):
         if os.path.exists(ck) and os.path.exists(os.path.join(d, "scene.toml")):
             resume = ck
             log(f"{st.run_name(p)}: was interrupted; resuming from {ck}")
-        else:
+        elif old.get("state") != "queued" or old.get("started"):
             log(f"{st.run_name(p)}: was interrupted before its first checkpoint; starting again")
     elif old.get("state") in ("failed", "too_short", "unknown"):
         log(f"{st.run_name(p)}: {old.get('state')} before ({old.get('message', '')}); running it again")
