@@ -11,7 +11,7 @@ packages=(build-essential cmake pkg-config git
   libeigen3-dev libfftw3-dev libhdf5-dev hdf5-tools libgtest-dev
   libtomlplusplus-dev libcli11-dev
   python3-matplotlib python3-h5py python3-numpy iproute2 util-linux
-  slurmctld slurmd slurm-client)
+  slurmctld slurmd slurm-client munge)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -1,20 +1,22 @@
 #!/usr/bin/env bash
 # The study runner's Slurm executor against a real, throwaway single-host
-# Slurm cluster (Debian slurm-wlm: slurmctld and slurmd, auth/none, config
-# and state in a temporary directory, started inside a private network
+# Slurm cluster (Debian slurm-wlm: slurmctld and slurmd authenticating with
+# munge, as a real cluster does; key, socket, config and state in a temporary
+# directory, all started inside a private network
 # namespace so it cannot meet any real Slurm): studies/tiny.toml submitted
 # with --executor slurm must end with every run complete and equal, bit for
 # bit, to the local executor's runs (same seeds). Bounded waits throughout.
 set -euo pipefail
 root=$1 build=$2
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then exec "$root/launch_scripts/netns.sh" bash "$0" "$@"; fi
-for b in slurmctld slurmd sbatch squeue scontrol; do
+for b in munged munge slurmctld slurmd sbatch squeue scontrol; do
   command -v $b >/dev/null || { echo "FAIL $b not installed (launch_scripts/setup.sh installs slurm-wlm)"; exit 1; }
 done
 export BUILD_DIR=$build
 tmp=$(mktemp -d)
 d=$tmp/slurm
-mkdir -p "$d/state" "$d/spool"
+mkdir -p "$d/state" "$d/spool" "$d/munge"
+chmod 700 "$d/munge"
 pids=()
 cleanup() {
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
@@ -27,14 +29,27 @@ trap cleanup EXIT
 # slurmctld cannot resolve itself in a namespace with nothing but loopback.
 ip addr add 127.0.0.2/8 dev lo 2>/dev/null || true
 host=$(hostname -s)
+# munge: a fresh key of our own and a socket in the temporary directory, so
+# the host's munged (if any) is never used or disturbed.
+dd if=/dev/urandom of="$d/munge/key" bs=1024 count=1 status=none
+chmod 600 "$d/munge/key"
+msock=$d/munge/socket
+munged -F --force --key-file="$d/munge/key" --socket="$msock" --pid-file="$d/munge/pid" \
+  --log-file="$d/munge/log" --seed-file="$d/munge/seed" >"$d/munged.out" 2>&1 &
+pids+=($!)
+for _ in $(seq 100); do [[ -S $msock ]] && break; sleep 0.1; done
+munge -S "$msock" -n | unmunge -S "$msock" >/dev/null ||
+  { echo "FAIL munged did not start"; cat "$d/munged.out" "$d/munge/log" 2>/dev/null; exit 1; }
+echo "ok   munged up, a credential round-trips"
 : >"$d/plugstack.conf"
 cat >"$d/slurm.conf" <<CONF
 ClusterName=dynhettest
 SlurmctldHost=$host(127.0.0.1)
 SlurmctldPort=16917
 SlurmdPort=16918
-AuthType=auth/none
-CredType=cred/none
+AuthType=auth/munge
+AuthInfo=socket=$msock
+CredType=cred/munge
 SlurmUser=root
 SlurmdUser=root
 StateSaveLocation=$d/state
