@@ -18,6 +18,7 @@ import fcntl
 import hashlib
 import math
 import os
+import re
 import shutil
 import signal
 import socket
@@ -149,9 +150,16 @@ class Study:
             if k not in ("name", "description", "scene", "prepared_states"):
                 self.errors.append(f"study.{k}: unknown key; known keys in [study]: name, description, scene, "
                                    "prepared_states")
-        self.prepared_states = st.get("prepared_states", True)
-        if not isinstance(self.prepared_states, bool):
-            self.errors.append(f"study.prepared_states: value {self.prepared_states!r} must be true or false")
+        # true or "compressed": compression once per (N, phi, ratio, seed);
+        # "equilibrated": also the equilibration, once per run dynamics
+        # (extended, never repeated, when a run needs more); false: neither.
+        ps = st.get("prepared_states", True)
+        if not (isinstance(ps, bool) or ps in ("compressed", "equilibrated")):
+            self.errors.append(f"study.prepared_states: value {ps!r} must be true, false, \"compressed\" or "
+                               "\"equilibrated\"")
+            ps = True
+        self.prepared_states = {True: "compressed", False: None}.get(ps, ps) if isinstance(ps, bool) else ps
+        self.equilibrated_states = self.prepared_states == "equilibrated"
         self.name = st.get("name", os.path.splitext(os.path.basename(path))[0])
         if not isinstance(self.name, str) or not self.name or "/" in self.name:
             self.errors.append(f"study.name: value {self.name!r} must be a non-empty string without '/'")
@@ -571,7 +579,7 @@ def prepared_state(sd, sc):
     shared by every run and pilot of it (other restitutions, driving, cutoffs,
     schedules); a run from it equals the run that compresses itself, bit for
     bit. Sets sc's system.initial_state to it."""
-    if not sd.study.prepared_states or sc["system"].get("initial_state"):
+    if sd.study.prepared_states is None or sc["system"].get("initial_state"):
         return
     sy = sc["system"]
     key = (f"n{int(sy['n_particles'])}_phi{float(sy['packing_fraction']):.6g}"
@@ -593,6 +601,62 @@ def prepared_state(sd, sc):
                 raise StudyError(f"preparing the state {key} failed (exit {rc}); its log: {d}/{key}.log")
             os.replace(path + ".tmp", path)
     sy["initial_state"] = path
+
+
+def equilibrated_state(sd, sc):
+    """With prepared_states = "equilibrated": the state of run scene sc's
+    dynamics (everything in [system] and [driving], and the checkpoint
+    interval, which the bit-for-bit continuation needs) equilibrated up to
+    its run.equilibration_time, made by sim_node --prepare-only --equilibrate
+    from the compressed state or from the longest shorter one already made
+    (a run found too short extends its state instead of starting again).
+    Each length is a file of its own, never replaced, so a run that refers
+    to one can always start again. Sets sc's initial_state to it; a run
+    from it equals, bit for bit, the run that equilibrates itself."""
+    if not sd.study.equilibrated_states:
+        return
+    sy = {k: v for k, v in sc["system"].items() if k != "initial_state"}
+    interval = float(sc.get("run", {}).get("checkpoint_interval", 10.0))  # the scene default
+    dyn = toml_dump({"system": sy, "driving": sc.get("driving", {}), "run": {"checkpoint_interval": interval}})
+    key = (f"eq_n{int(sy['n_particles'])}_phi{float(sy['packing_fraction']):.6g}"
+           f"_eps{float(sy.get('restitution', 1.0)):.6g}_seed{int(sy.get('seed', 1))}_"
+           + hashlib.sha1(dyn.encode()).hexdigest()[:10])
+    d = os.path.join(sd.dir, "states")
+    t_eq = float(sc["run"]["equilibration_time"])
+    if t_eq < interval:  # not one checkpoint slot: the run equilibrates itself
+        return
+    with open(os.path.join(d, key + ".lock"), "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        made = {}  # time -> path of the states of this dynamics made so far
+        for f in os.listdir(d):
+            if f.startswith(key + "_t") and f.endswith(".h5"):
+                made[float(f[len(key) + 2:-3])] = os.path.join(d, f)
+        within = [t for t in made if t <= t_eq]
+        # Equilibrated to within one checkpoint interval of what the run asks
+        # (the last slot before it is where sim_node --equilibrate stops): take it.
+        if within and max(within) > t_eq - interval:
+            sc["system"]["initial_state"] = made[max(within)]
+            return
+        src = dict(sc, system=dict(sc["system"]))
+        if within:
+            src["system"]["initial_state"] = made[max(within)]
+        scene_path = os.path.join(d, f"{key}.toml")
+        write_atomic(scene_path, toml_dump(src, f"# the dynamics of equilibrated states {key}"))
+        tmp = os.path.join(d, key + ".tmp.h5")
+        with open(os.path.join(d, key + ".log"), "a") as log:
+            log.write(f"\n# {time.strftime('%Y-%m-%d %H:%M:%S')} to t = {t_eq:g}\n")
+            log.flush()
+            rc = subprocess.call([SIM, scene_path, "--prepare-only", tmp, "--equilibrate"], stdout=log,
+                                 stderr=subprocess.STDOUT)
+        if rc != 0 or STOPPING.is_set():
+            if STOPPING.is_set():
+                raise StudyInterrupted(f"equilibrating {key} stopped")
+            raise StudyError(f"equilibrating the state {key} failed (exit {rc}); its log: {d}/{key}.log")
+        with open(os.path.join(d, key + ".log")) as log:
+            t = float(re.findall(r"equilibrated state .* from t = \S+ to (\S+) in ", log.read())[-1])
+        path = os.path.join(d, f"{key}_t{t:.10g}.h5")
+        os.replace(tmp, path)
+    sc["system"]["initial_state"] = path
 
 
 def pid_alive(pid):
@@ -686,6 +750,7 @@ def do_run(sd, p, log=print):
             source = "pilot" if rl["pilot_margin"] == 1.0 else f"pilot x {rl['pilot_margin']:g}"
         sc = st.scene(p, tau_est)
         prepared_state(sd, sc)
+        equilibrated_state(sd, sc)
         write_atomic(os.path.join(d, "scene.toml"),
                      toml_dump(sc, f"# {st.name}: {st.run_name(p)}; tau_alpha estimate {tau_est} ({source})"))
     sc = read_toml(os.path.join(d, "scene.toml"))

@@ -169,37 +169,50 @@ dynhet::engine::Params engine_params(const dynhet::Scene& scene) {
   return p;
 }
 
-// --prepare-only: compression and velocities, written as a checkpoint at t = 0.
-int prepare_only(const dynhet::Scene& scene, const std::string& path) {
-  try {
-    dynhet::engine::Engine eng(engine_params(scene));
-    const auto t0 = Clock::now();
-    eng.compress([&](double phi) {
-      if (isatty(STDERR_FILENO)) std::fprintf(stderr, "\rsim_node: compressing, phi = %.4f", phi);
-    });
-    eng.thermalize(1.0);
-    dynhet::write_checkpoint(path, {scene.text, 0, 0, scene.kick_pairs, eng.state()});
-    std::fprintf(stderr, "\nsim_node: prepared state (N=%ld, phi=%.4f, seed %llu) in %.1f s -> %s\n", eng.size(),
-                 eng.packing_fraction(), static_cast<unsigned long long>(scene.seed), seconds_since(t0), path.c_str());
-    return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "sim_node: %s\n", e.what());
-    return 1;
-  }
+// The first key of the dynamics (engine parameters) in which two scenes
+// differ, or "" if a run of one continues a state of the other exactly.
+std::string dynamics_difference(const dynhet::Scene& a, const dynhet::Scene& b) {
+  if (a.n_particles != b.n_particles) return "system.n_particles";
+  if (a.packing_fraction != b.packing_fraction) return "system.packing_fraction";
+  if (a.radius_ratio != b.radius_ratio) return "system.radius_ratio";
+  if (a.seed != b.seed) return "system.seed";
+  if (a.restitution != b.restitution) return "system.restitution";
+  if (a.tc_time != b.tc_time) return "the TC model";
+  if (a.driving != b.driving) return "driving";
+  if (dynhet::scene_kick_rate(a) != dynhet::scene_kick_rate(b)) return "the kick rate (driving)";
+  if (a.kick_pairs != b.kick_pairs) return "driving.pairs";
+  if (a.kick_reach != b.kick_reach) return "driving.reach";
+  return "";
 }
 
 // system.initial_state: a prepared state of the same system (N, phi,
-// radius ratio, seed), or positions from an H5MD file (velocities drawn).
+// radius ratio, seed), an equilibrated state of the same dynamics (sim_node
+// --prepare-only --equilibrate), or positions from an H5MD file (velocities
+// drawn).
 void start_from(dynhet::engine::Engine& eng, const dynhet::Scene& scene) {
   const std::string& path = scene.initial_state;
   if (access(path.c_str(), R_OK) != 0) throw std::runtime_error(path + ": no such file (system.initial_state)");
   if (dynhet::is_checkpoint(path)) {
     const dynhet::Checkpoint c = dynhet::read_checkpoint(path);
-    if (c.state.time != 0.0 || c.next_frame != 0)
-      throw std::runtime_error(path + ": a checkpoint at t = " + std::to_string(c.state.time) +
-                               ", not a prepared state (sim_node --prepare-only writes those; resume a "
-                               "checkpoint with --resume)");
     const dynhet::Scene made = dynhet::parse_scene_text(c.scene_toml, path + " (its scene)");
+    if (c.next_frame != 0)
+      throw std::runtime_error(path + ": a checkpoint taken after frame " + std::to_string(c.next_frame - 1) +
+                               ", not a prepared state (resume a run's checkpoint with --resume)");
+    if (c.state.time != 0.0) {
+      // An equilibrated state: the run continues it, as a resumed run would.
+      const std::string d = dynamics_difference(made, scene);
+      if (!d.empty())
+        throw std::runtime_error(path + ": equilibrated with another " + d +
+                                 " than the scene's (an equilibrated state serves only runs of the same dynamics)");
+      if (c.kick_pairs != scene.kick_pairs)
+        throw std::runtime_error(path + ": equilibrated with kick pairs \"" + c.kick_pairs + "\"");
+      if (c.state.time > scene.equilibration_time)
+        throw std::runtime_error(path + ": equilibrated to t = " + std::to_string(c.state.time) +
+                                 ", beyond the scene's run.equilibration_time = " +
+                                 std::to_string(scene.equilibration_time));
+      eng.restore(c.state);
+      return;
+    }
     auto differs = [&](const char* key, const std::string& was, const std::string& is) {
       if (was != is)
         throw std::runtime_error(path + ": prepared for system." + key + " = " + was + ", the scene has " + is);
@@ -225,6 +238,63 @@ void start_from(dynhet::engine::Engine& eng, const dynhet::Scene& scene) {
   eng.begin();
 }
 
+// --prepare-only: compression and velocities, written as a checkpoint at
+// t = 0. With --equilibrate: then the scene's dynamics up to the last
+// checkpoint slot (a multiple of run.checkpoint_interval) at or before
+// run.equilibration_time, synchronised at every slot as a run is, and the
+// state there: a run of the same dynamics from it equals, bit for bit, the
+// run that equilibrates itself. The scene's own initial_state (a prepared
+// or a shorter equilibrated state) is the start if it has one.
+int prepare_only(const dynhet::Scene& scene, const std::string& path, bool equilibrate) {
+  try {
+    dynhet::engine::Engine eng(engine_params(scene));
+    const auto t0 = Clock::now();
+    const bool tty = isatty(STDERR_FILENO);
+    if (!equilibrate) {
+      eng.compress([&](double phi) {
+        if (tty) std::fprintf(stderr, "\rsim_node: compressing, phi = %.4f", phi);
+      });
+      eng.thermalize(1.0);
+      dynhet::write_checkpoint(path, {scene.text, 0, 0, scene.kick_pairs, eng.state()});
+      std::fprintf(stderr, "\nsim_node: prepared state (N=%ld, phi=%.4f, seed %llu) in %.1f s -> %s\n", eng.size(),
+                   eng.packing_fraction(), static_cast<unsigned long long>(scene.seed), seconds_since(t0),
+                   path.c_str());
+      return 0;
+    }
+    if (!scene.initial_state.empty()) {
+      start_from(eng, scene);
+    } else {
+      eng.prepare([&](double phi) {
+        if (tty) std::fprintf(stderr, "\rsim_node: compressing, phi = %.4f", phi);
+      });
+    }
+    const double interval = scene.checkpoint_interval;
+    const double t_end = std::floor(scene.equilibration_time / interval + 1e-9) * interval;
+    const double t_start = eng.time();
+    for (int64_t slot = static_cast<int64_t>(std::floor(t_start / interval + 0.5)) + 1; slot * interval <= t_end + 1e-12 * interval;
+         ++slot) {
+      while (!eng.run_until(slot * interval, 1000000)) {
+        if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
+        if (tty)
+          std::fprintf(stderr, "\rsim_node: equilibrating, t = %.6g of %.6g (%.1f s)", eng.time(), t_end,
+                       seconds_since(t0));
+      }
+      eng.synchronize();
+    }
+    if (eng.time() == 0.0)
+      throw std::runtime_error("run.equilibration_time = " + std::to_string(scene.equilibration_time) +
+                               " is shorter than one run.checkpoint_interval: nothing to equilibrate");
+    dynhet::write_checkpoint(path, {scene.text, 0, 0, scene.kick_pairs, eng.state()});
+    std::fprintf(stderr, "\nsim_node: equilibrated state (N=%ld, phi=%.4f, eps=%.3f, seed %llu) from t = %.6g to "
+                 "%.6g in %.1f s -> %s\n", eng.size(), eng.packing_fraction(), scene.restitution,
+                 static_cast<unsigned long long>(scene.seed), t_start, eng.time(), seconds_since(t0), path.c_str());
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "\nsim_node: %s\n", e.what());
+    return 1;
+  }
+}
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -244,6 +314,11 @@ int main(int argc, char** argv) {
                  "compress the scene's system, draw its velocities, write this prepared state (HDF5) and exit: "
                  "runs of any restitution or driving that start from it (system.initial_state) equal the runs "
                  "that compress themselves, bit for bit");
+  bool equilibrate = false;
+  app.add_flag("--equilibrate", equilibrate,
+               "with --prepare-only: also run the scene's dynamics to the last checkpoint slot within "
+               "run.equilibration_time (from the scene's initial_state if it has one) and write that state: "
+               "runs of the same dynamics from it equal the runs that equilibrate themselves, bit for bit");
   app.add_option("--lcm-url", url, "LCM URL (default $LCM_DEFAULT_URL or " + std::string(dynhet::kDefaultLcmUrl) + ")");
   app.add_option("--run-id", run_id, "run id (default: random)");
   bool check = false;
@@ -289,7 +364,15 @@ int main(int argc, char** argv) {
     const auto slash = scene_path.find_last_of('/');
     if (slash != std::string::npos) scene.initial_state = scene_path.substr(0, slash + 1) + scene.initial_state;
   }
-  if (!prepare_path.empty()) return prepare_only(scene, prepare_path);
+  if (equilibrate && prepare_path.empty()) {
+    std::fprintf(stderr, "sim_node: --equilibrate goes with --prepare-only FILE\n");
+    return 2;
+  }
+  if (!prepare_path.empty()) {
+    std::signal(SIGINT, on_signal);
+    std::signal(SIGTERM, on_signal);
+    return prepare_only(scene, prepare_path, equilibrate);
+  }
   if (run_id == 0) run_id = static_cast<int64_t>(std::random_device{}() & 0x7fffffff) << 20 ^ getpid();
 
   lcm::LCM lcm(dynhet::resolve_lcm_url(url));

@@ -54,6 +54,16 @@ check 'grep -q "was interrupted; resuming from .*checkpoint_before_frames.h5" "$
 check 'grep -q "4 of 4 runs complete, 0 failed" "$tmp/b2.out"' "run again: 4 of 4 complete"
 /usr/bin/python3 "$root/tests/compare_studies.py" "$tmp/a" "$tmp/b" || fail=1
 
+# prepared_states = "equilibrated": every run starts from an equilibrated
+# state of its dynamics and ends bit for bit like the runs of study a.
+sed -e "s|\"../scenes/tiny.toml\"|\"$root/scenes/tiny.toml\"\nprepared_states = \"equilibrated\"|" \
+  "$root/studies/tiny.toml" >"$tmp/eq.toml"
+"${study[@]}" "$tmp/eq.toml" --out "$tmp/e" --jobs 2 >"$tmp/e.out" 2>&1 || { cat "$tmp/e.out"; exit 1; }
+check '[[ $(grep -l "initial_state = .*states/eq_n.*_t10.h5" "$tmp"/e/runs/*/scene.toml | wc -l) == 4 ]] &&
+  grep -q "equilibrated state .* from t = 0 to 10 " "$tmp"/e/states/eq_*.log' \
+  "prepared_states = \"equilibrated\": each run starts from its state equilibrated to t = 10"
+/usr/bin/python3 "$root/tests/compare_studies.py" "$tmp/a" "$tmp/e" || fail=1
+
 # A changed study file under an existing study directory is refused.
 sed -e 's/seed = \[1, 2\]/seed = [1, 2, 3]/' -e "s|\"../scenes/tiny.toml\"|\"$root/scenes/tiny.toml\"|" \
   "$root/studies/tiny.toml" >"$tmp/changed.toml"
