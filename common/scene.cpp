@@ -1,4 +1,5 @@
 #include "dynhet/scene.hpp"
+#include "dynhet/subbox.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -539,6 +540,13 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
   if (s.observables.empty())
     c.fail("observables.compute", "is empty; name at least one of the known observables");
   c.throw_if_failed();
+  // Sub-box sizes as the grids realise them: no size twice (notes say what
+  // was dropped, and which sizes lie far from what was asked).
+  s.chi4_subbox_particles = realisable_subbox_sizes(s.n_particles, s.chi4_subbox_particles, "chi4.subbox_particles",
+                                                    s.notes);
+  if (!s.s4_subbox_particles.empty())
+    s.s4_subbox_particles = realisable_subbox_sizes(s.n_particles, s.s4_subbox_particles, "s4.subbox_particles",
+                                                    s.notes);
   return s;
 }
 

@@ -91,48 +91,57 @@ public:
   }
   dynhet::sim_status_t& msg() { return msg_; }
 
-  // Publishes (and prints) if a second has passed, or if forced.
+  // Adds what happened since the last sample (every slice of events, at
+  // most a few N events apart) to the pressure and collision-frequency
+  // blocks, which are in simulation time. Then publishes (and prints) if a
+  // second has passed, or if forced.
   void update(const dynhet::engine::Engine& e, double remaining_sim_time, bool force = false) {
+    const auto& c = e.counters();
+    const long n = e.size();
+    const double ke = e.kinetic_energy_per_particle();
+    const double dsim = e.time() - s_time_;
+    if (dsim > 0 && msg_.phase != "compress") {
+      // Z = (N-1)/N (1 + sum virial / (2 N sum ke dt)) (engine.hpp): the
+      // blocks hold the virial and ke dt; the frequency 2 collisions / N and dt.
+      pressure_.add((c.virial - s_virial_) / (2.0 * n), 0.5 * (ke + s_ke_) * dsim, dsim);
+      frequency_.add(2.0 * (c.collisions - s_coll_) / double(n), dsim, dsim);
+    }
+    s_time_ = e.time(), s_coll_ = c.collisions, s_virial_ = c.virial, s_ke_ = ke;
     const double dt = seconds_since(last_);
     if (!force && dt < 1.0) return;
-    const auto& c = e.counters();
     msg_.utime = utime_now();
     msg_.sim_time = e.time();
     msg_.packing_fraction = e.packing_fraction();
     msg_.n_collisions = c.collisions;
     msg_.n_kicks = c.kicks;
-    const double dsim = e.time() - last_sim_;
+    const double dpub = e.time() - last_sim_;
     msg_.collisions_per_second = dt > 0 && c.collisions >= last_coll_ ? (c.collisions - last_coll_) / dt : 0;
-    const double ke = e.kinetic_energy_per_particle();
-    if (dsim > 0 && msg_.phase != "compress") {
-      // This interval is one block of the pressure and collision frequency.
-      const long n = e.size();
-      pressure_.add(dynhet::engine::reduced_pressure(c.virial - last_virial_, dsim, n, 0.5 * (ke + msg_.kinetic_energy)));
-      frequency_.add(2.0 * (c.collisions - last_coll_) / (double(n) * dsim));
-    }
-    msg_.reduced_pressure = pressure_.mean();
-    msg_.reduced_pressure_err = pressure_.standard_error();
+    const double f = (n - 1.0) / n;
+    msg_.reduced_pressure = f * (1.0 + pressure_.mean());
+    msg_.reduced_pressure_err = f * pressure_.standard_error();
     msg_.collision_frequency = frequency_.mean();
     msg_.collision_frequency_err = frequency_.standard_error();
     msg_.n_tc = c.tc;
     msg_.kinetic_energy = ke;
-    if (dsim > 0 && remaining_sim_time >= 0) msg_.eta_seconds = remaining_sim_time / (dsim / dt);
+    if (dpub > 0 && remaining_sim_time >= 0) msg_.eta_seconds = remaining_sim_time / (dpub / dt);
     lcm_.publish(dynhet::kChanSimStatus, &msg_);
     print();
     last_ = Clock::now();
     last_sim_ = e.time();
     last_coll_ = c.collisions;
-    last_virial_ = c.virial;
   }
-  // A new phase: rates and block averages start afresh.
-  void reset_rates(const dynhet::engine::Engine& e) {
-    last_sim_ = e.time();
-    last_coll_ = e.counters().collisions;
-    last_virial_ = e.counters().virial;
-    msg_.kinetic_energy = e.kinetic_energy_per_particle();
+  // Fine blocks of the pressure and frequency in this phase.
+  long blocks() const { return pressure_.blocks(); }
+  // A new phase of this length in simulation time: rates and block
+  // averages start afresh, with 256 fine blocks over the phase.
+  void reset_rates(const dynhet::engine::Engine& e, double phase_length) {
+    last_sim_ = s_time_ = e.time();
+    last_coll_ = s_coll_ = e.counters().collisions;
+    s_virial_ = e.counters().virial;
+    msg_.kinetic_energy = s_ke_ = e.kinetic_energy_per_particle();
     msg_.eta_seconds = -1;
-    pressure_.reset();
-    frequency_.reset();
+    pressure_.reset(phase_length / 256);
+    frequency_.reset(phase_length / 256);
   }
   void print() {
     std::fprintf(stderr, "%s[%-11s] t=%-10.4g/%-10.4g phi=%.4f  coll/s=%.3g  T=%.4f  Z=%.4g  frames %d/%d  ETA %s%s",
@@ -150,8 +159,9 @@ private:
   Clock::time_point last_ = Clock::now();
   double last_sim_ = 0;
   int64_t last_coll_ = 0;
-  double last_virial_ = 0;
-  dynhet::BlockAverage pressure_, frequency_;
+  double s_time_ = 0, s_virial_ = 0, s_ke_ = 0; // the last sample
+  int64_t s_coll_ = 0;
+  dynhet::RatioBlocks pressure_, frequency_;
 };
 
 dynhet::engine::Params engine_params(const dynhet::Scene& scene) {
@@ -353,12 +363,14 @@ int main(int argc, char** argv) {
     // One line per fact, for the launch scripts and for people.
     const auto sched = dynhet::make_schedule(scene.schedule, scene.equilibration_time);
     std::printf("scene %s: valid\n", scene_path.c_str());
+    for (const auto& note : scene.notes) std::printf("note: %s\n", note.c_str());
     std::printf("nodes:");
     for (const auto& n : dynhet::nodes_for(scene.observables)) std::printf(" %s", n.c_str());
     std::printf("\nframes: %zu\nparticles: %lld\nsim_time: %g\n", sched.frame_time.size(),
                 static_cast<long long>(scene.n_particles), scene.equilibration_time + scene.production_time);
     return 0;
   }
+  for (const auto& note : scene.notes) std::fprintf(stderr, "sim_node: note: %s\n", note.c_str());
   // Where a scene's initial_state is: relative to the scene file.
   if (!scene.initial_state.empty() && scene.initial_state[0] != '/' && resume_path.empty()) {
     const auto slash = scene_path.find_last_of('/');
@@ -460,11 +472,15 @@ int main(int argc, char** argv) {
     // Advance to time t in slices, so that status and run info go out and
     // signals are seen at least once a second; synchronise (and checkpoint)
     // at every slot on the way.
+    // Slices of a few N events (never more than 2e5): each is a sample of
+    // the pressure blocks; stopping after a count of events leaves the
+    // trajectory as it is.
+    const int64_t slice_events = std::clamp<int64_t>(2 * eng.size(), 500, 200000);
     auto advance = [&](double t) {
       for (;;) {
         const double slot = next_slot * interval;
         const double target = std::min(t, slot);
-        while (!eng.run_until(target, 200000)) {
+        while (!eng.run_until(target, slice_events)) {
           rep.update(eng, t_end - eng.time());
           if (seconds_since(last_info) > 2.0) publish_info();
           if (g_signal && checkpoint_path.empty())
@@ -492,13 +508,13 @@ int main(int argc, char** argv) {
     if (eng.time() < scene.equilibration_time) {
       rep.msg().phase = "equilibrate";
       rep.msg().phase_end_time = scene.equilibration_time;
-      rep.reset_rates(eng);
+      rep.reset_rates(eng, scene.equilibration_time - eng.time());
       advance(scene.equilibration_time);
     }
 
     rep.msg().phase = "production";
     rep.msg().phase_end_time = t_end;
-    rep.reset_rates(eng);
+    rep.reset_rates(eng, t_end - eng.time());
     const auto ranges = dynhet::chunk_ranges(static_cast<int>(eng.size()), scene.chunk_particles);
     std::vector<double> xy;
     dynhet::frame_chunk_t chunk{};
@@ -549,14 +565,16 @@ int main(int argc, char** argv) {
                  "\nsim_node: done in %.1f s: %lld collisions, %lld kicks (first particles drawn again %lld times, "
                  "%lld pairs from the whole system), %d frames, KE/N=%.4f, "
                  "total momentum (%.2g, %.2g), max overlap %.2g\n"
-                 "sim_node: production: Z = %.5g +- %.2g, collisions per particle per unit time %.5g +- %.2g, "
+                 "sim_node: production: Z = %.5g +- %.2g, collisions per particle per unit time %.5g +- %.2g%s, "
                  "TC model acted %lld times\n",
                  seconds_since(t_wall), static_cast<long long>(eng.counters().collisions),
                  static_cast<long long>(eng.counters().kicks), static_cast<long long>(eng.counters().kick_redraws),
                  static_cast<long long>(eng.counters().kick_far), info.n_frames,
                  eng.kinetic_energy_per_particle(), px, py, std::max(0.0, eng.max_overlap()),
                  rep.msg().reduced_pressure, rep.msg().reduced_pressure_err, rep.msg().collision_frequency,
-                 rep.msg().collision_frequency_err, static_cast<long long>(eng.counters().tc));
+                 rep.msg().collision_frequency_err,
+                 rep.blocks() < 2 ? " (no error: the production was shorter than two fine blocks)" : "",
+                 static_cast<long long>(eng.counters().tc));
   } catch (const std::exception& e) {
     if (g_signal && checkpoint_written) rep.msg().phase = "interrupted"; // nodes wait for --resume
     fail(e.what());

@@ -179,3 +179,26 @@ TEST(Scene, MsdAndDisplacementTablesAreValidated) {
   expect_error("[displacement]\nerror_blocks = 1\n", {"displacement.error_blocks", "2 <= value"});
   expect_error("[displacement]\ntail = 2\n", {"displacement.tail", "unknown key", "tail_sigmas"});
 }
+
+// Sub-box sizes as the nested grids realise them (paper's chi4 of sub-boxes):
+// at N = 4096, 2048 per box has no grid of its own nested in the finer ones
+// (the nearest divisor of 3 is 1, the whole box), which 8192 already asks
+// for: it is dropped, with a note, never computed twice.
+TEST(Scene, SubboxSizesThatNoGridRealisesAreDroppedOrNoted) {
+  const auto s = parse_scene_text(
+      "[system]\nn_particles = 4096\n[chi4]\nsubbox_particles = [32, 128, 512, 2048, 8192]\n", "subbox");
+  EXPECT_EQ(s.chi4_subbox_particles, (std::vector<int>{32, 128, 512, 8192}));
+  ASSERT_EQ(s.notes.size(), 1u);
+  EXPECT_NE(s.notes[0].find("chi4.subbox_particles: 2048 particles per sub-box is not realised at N = 4096"),
+            std::string::npos)
+      << s.notes[0];
+  // 1600 alone: a 2 x 2 grid, 1024 per box, 36% off: kept, and said.
+  const auto t = parse_scene_text("[system]\nn_particles = 4096\n[chi4]\nsubbox_particles = [1600]\n", "far");
+  EXPECT_EQ(t.chi4_subbox_particles, (std::vector<int>{1600}));
+  ASSERT_EQ(t.notes.size(), 1u);
+  EXPECT_NE(t.notes[0].find("realised as 1024.0"), std::string::npos) << t.notes[0];
+  // The default list at N = 10^5: every size within 25%, no note.
+  const auto d = parse_scene_text("[system]\nn_particles = 100000\n", "default sizes");
+  EXPECT_EQ(d.chi4_subbox_particles.size(), 6u);
+  EXPECT_TRUE(d.notes.empty());
+}

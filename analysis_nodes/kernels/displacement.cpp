@@ -1,4 +1,5 @@
 #include "dynhet/analysis/displacement.hpp"
+#include "dynhet/subbox.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -38,26 +39,9 @@ void plan_grids(const DisplacementSpec& spec, std::vector<int>& sides,
 } // namespace
 
 std::vector<SubboxGrid> nested_subbox_grids(long n_total, double box, const std::vector<int>& targets) {
-  auto ideal = [&](int t) { return std::sqrt(double(n_total) / t); };
-  std::vector<int> order(targets.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return targets[a] < targets[b]; });
-  std::vector<SubboxGrid> out(targets.size());
-  int finer = 0; // side of the next finer grid (0: none yet)
-  for (int g : order) {
-    const double want = std::max(1.0, ideal(targets[g]));
-    int best = 1;
-    // Candidates: the 2^a 3^b for the finest grid, divisors of the finer side after.
-    for (int m = 1; m <= (finer ? finer : 4 * static_cast<int>(want) + 4); ++m) {
-      int k = m;
-      while (k % 2 == 0) k /= 2;
-      while (k % 3 == 0) k /= 3;
-      const bool ok = finer ? finer % m == 0 : k == 1;
-      if (ok && std::abs(std::log(m / want)) < std::abs(std::log(best / want))) best = m;
-    }
-    finer = best;
-    out[g] = SubboxGrid{best, box, double(n_total) / (double(best) * best)};
-  }
+  const std::vector<int> sides = nested_subbox_sides(n_total, targets);
+  std::vector<SubboxGrid> out;
+  for (int m : sides) out.push_back(SubboxGrid{m, box, double(n_total) / (double(m) * m)});
   return out;
 }
 

@@ -27,6 +27,9 @@ struct ScheduleSpec {
 struct Scene {
   std::string path;
   std::string text; // the whole file, recorded in the HDF5 parameters
+  // What the parse changed from what the file asks, one line each (sub-box
+  // sizes that no grid realises): sim_node prints them at the start.
+  std::vector<std::string> notes;
 
   // [system]
   int64_t n_particles = 1000;

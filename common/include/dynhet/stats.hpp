@@ -4,8 +4,10 @@
 // correlation time.
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace dynhet {
 
@@ -27,6 +29,64 @@ public:
 private:
   long n_ = 0;
   double mean_ = 0, m2_ = 0;
+};
+
+// A ratio of two time integrals over a phase of a run, sum(num) / sum(den),
+// and its standard error, from blocks of simulation time (never of wall
+// clock, so the error does not depend on the machine or the schedule).
+// Samples (num, den over a time dt) gather into fine blocks of at least
+// `fine_length`; the error is that of batch means over (at most) 16 groups
+// of consecutive fine blocks, each the ratio over its group, weighted by its
+// den (Flyvbjerg and Petersen, J. Chem. Phys. 91, 461 (1989)): groups a
+// sixteenth of the phase long outlast the correlations of the pressure and
+// of the collision rate except at the glass transition itself. With fewer
+// than two fine blocks there is no error (NaN, and the caller says so).
+class RatioBlocks {
+public:
+  static constexpr int kGroups = 16;
+  void reset(double fine_length) {
+    *this = RatioBlocks{};
+    fine_ = fine_length;
+  }
+  void add(double num, double den, double dt) {
+    cur_num_ += num, cur_den_ += den, cur_dt_ += dt;
+    if (cur_dt_ >= fine_) {
+      num_.push_back(cur_num_), den_.push_back(cur_den_);
+      cur_num_ = cur_den_ = cur_dt_ = 0;
+    }
+  }
+  // Fine blocks, the one still open included if it holds any time.
+  long blocks() const { return static_cast<long>(num_.size()) + (cur_dt_ > 0); }
+  double mean() const {
+    double a = cur_num_, b = cur_den_;
+    for (size_t i = 0; i < num_.size(); ++i) a += num_[i], b += den_[i];
+    return b > 0 ? a / b : std::numeric_limits<double>::quiet_NaN();
+  }
+  double standard_error() const {
+    std::vector<double> n(num_), d(den_);
+    if (cur_dt_ > 0) n.push_back(cur_num_), d.push_back(cur_den_);
+    const long f = static_cast<long>(n.size());
+    const long g = std::min<long>(kGroups, f);
+    if (g < 2) return std::numeric_limits<double>::quiet_NaN();
+    std::vector<double> gn(g, 0.0), gd(g, 0.0);
+    for (long i = 0; i < f; ++i) {
+      const long k = i * g / f; // consecutive, nearly equal groups
+      gn[k] += n[i], gd[k] += d[i];
+    }
+    double a = 0, b = 0;
+    for (long k = 0; k < g; ++k) a += gn[k], b += gd[k];
+    if (!(b > 0)) return std::numeric_limits<double>::quiet_NaN();
+    const double r = a / b;
+    double s = 0;
+    for (long k = 0; k < g; ++k)
+      if (gd[k] > 0) s += gd[k] * gd[k] * (gn[k] / gd[k] - r) * (gn[k] / gd[k] - r);
+    return std::sqrt(s / (b * b) * g / (g - 1.0));
+  }
+
+private:
+  double fine_ = 0;
+  std::vector<double> num_, den_;
+  double cur_num_ = 0, cur_den_ = 0, cur_dt_ = 0;
 };
 
 } // namespace dynhet

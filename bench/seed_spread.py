@@ -1,0 +1,145 @@
+#!/usr/bin/python3
+"""Are dynhet's error bars honest? For every quantity a run records with an
+error, the spread between independent runs (seeds) of the same point against
+the error the runs quote.
+
+Reads a study directory (launch_scripts/run_study.sh): runs that differ only
+in their seed are one point. Per quantity, pooled over points,
+
+    ratio^2 = sum_points sum_seeds (x_i - mean_point)^2 / e_point^2 / sum_points (K - 1),
+
+e_point^2 the mean of the quoted errors squared over the point's seeds. An
+honest error gives 1; its own uncertainty is ratio / sqrt(2 dof) (a
+chi-square with dof = sum (K - 1) degrees of freedom). Values without an
+error (NaN) are counted, not pooled.
+
+Usage: bench/seed_spread.py STUDY_DIR [--cutoff 0.6] [--points]
+(--points: also one line per point and quantity).
+"""
+import argparse
+import math
+import os
+import sys
+import tomllib
+
+import h5py
+import numpy as np
+
+AXES_BUT_SEED = ("packing_fraction", "restitution", "n_particles", "pairs")
+
+
+def last(f, path):
+    """The final record of an H5MD element (or a plain dataset)."""
+    if path not in f:
+        return None
+    d = f[path]
+    d = d["value"] if isinstance(d, h5py.Group) else d
+    return np.asarray(d[-1] if d.shape and d.shape[0] > 0 else d[()], dtype=float)
+
+
+def quantities(path, a):
+    """{name: (value, error)} of one run.h5 (final records)."""
+    out = {}
+    with h5py.File(path, "r") as f:
+        o = "observables"
+
+        def pair(name, v, e):
+            vv, ee = last(f, v), last(f, e)
+            if vv is None or ee is None:
+                return
+            vv, ee = np.atleast_1d(vv), np.atleast_1d(ee)
+            if vv.size == 1:
+                out[name] = (float(vv[0]), float(ee[0]))
+            else:
+                for k in range(vv.size):
+                    out[f"{name}[{k}]"] = (float(vv[k]), float(ee[k]))
+
+        pair("tau_alpha", f"{o}/overlap/a{a}/tau_alpha", f"{o}/overlap/a{a}/tau_alpha_err")
+        pair("beta", f"{o}/overlap/a{a}/beta", f"{o}/overlap/a{a}/beta_err")
+        pair("tau0", f"{o}/overlap/a{a}/tau0", f"{o}/overlap/a{a}/tau0_err")
+        pair("D", f"{o}/msd/diffusion", f"{o}/msd/diffusion_err")
+        pair("Z", f"{o}/sim/reduced_pressure", f"{o}/sim/reduced_pressure_err")
+        pair("collision frequency", f"{o}/sim/collision_frequency", f"{o}/sim/collision_frequency_err")
+        # chi4(t) of every sub-box size at the lag of its largest value
+        # (the lag fixed per point below), value [lag * sizes + size].
+        c, ce = last(f, f"{o}/chi4/a{a}/chi4"), last(f, f"{o}/chi4/a{a}/chi4_err")
+        sizes = f.get(f"{o}/chi4/a{a}/subbox_particles")
+        if c is not None and sizes is not None:
+            ns = sizes.shape[0]
+            out["_chi4"] = (c.reshape(-1, ns), ce.reshape(-1, ns), np.asarray(sizes[()]))
+        for k in ("chi4_peak", "tau4"):
+            pair(k, f"{o}/chi4/a{a}/{k}", f"{o}/chi4/a{a}/{k}_err")
+        pair("xi", f"{o}/s4/a{a}/xi", f"{o}/s4/a{a}/xi_err")
+        pair("chi0", f"{o}/s4/a{a}/chi0", f"{o}/s4/a{a}/chi0_err")
+        pair("chi4 box (S4 node)", f"{o}/s4/a{a}/chi4_box", f"{o}/s4/a{a}/chi4_box_err")
+        pair("d_f slow", f"{o}/clusters/a{a}/slow_d_f", f"{o}/clusters/a{a}/slow_d_f_err")
+        pair("d_f fast", f"{o}/clusters/a{a}/fast_d_f", f"{o}/clusters/a{a}/fast_d_f_err")
+        pair("kappa", f"{o}/clusters/a{a}/slow_kappa", f"{o}/clusters/a{a}/slow_kappa_err")
+    return out
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("study_dir")
+    ap.add_argument("--cutoff", default="0.6")
+    ap.add_argument("--points", action="store_true")
+    args = ap.parse_args()
+    with open(os.path.join(args.study_dir, "index.toml"), "rb") as f:
+        runs = tomllib.load(f)["runs"]
+    points = {}
+    for name, r in runs.items():
+        if r.get("state") != "complete":
+            continue
+        key = tuple(r.get(k) for k in AXES_BUT_SEED)
+        points.setdefault(key, []).append(quantities(os.path.join(args.study_dir, r["path"], "run.h5"), args.cutoff))
+    points = {k: v for k, v in points.items() if len(v) >= 2}
+    if not points:
+        sys.exit("seed_spread: no point with two or more complete seeds")
+    # chi4(t) at the lag of the point's largest mean, per size.
+    for runs_ in points.values():
+        if not all("_chi4" in q for q in runs_):
+            continue
+        mean = np.mean([q["_chi4"][0] for q in runs_], axis=0)
+        sizes = runs_[0]["_chi4"][2]
+        for s in range(mean.shape[1]):
+            j = int(np.nanargmax(mean[:, s])) if np.isfinite(mean[:, s]).any() else 0
+            for q in runs_:
+                q[f"chi4 at its peak lag, N_box {sizes[s]:.0f}"] = (q["_chi4"][0][j, s], q["_chi4"][1][j, s])
+    names = []
+    for runs_ in points.values():
+        for q in runs_:
+            for n in q:
+                if not n.startswith("_") and n not in names:
+                    names.append(n)
+    print(f"study {os.path.abspath(args.study_dir)}: {len(points)} points, "
+          f"{sum(len(v) for v in points.values())} runs (seeds per point: "
+          f"{sorted(set(len(v) for v in points.values()))})")
+    print(f"{'quantity':44s} {'points':>6s} {'dof':>5s} {'spread/error':>13s} {'+-':>6s} {'no error':>8s}")
+    rows = []
+    for n in names:
+        num, dof, nan, used = 0.0, 0, 0, 0
+        for key, runs_ in points.items():
+            vals = [q[n] for q in runs_ if n in q]
+            ok = [(v, e) for v, e in vals if math.isfinite(v) and math.isfinite(e) and e > 0]
+            nan += len(vals) - len(ok)
+            if len(ok) < 2:
+                continue
+            x = np.array([v for v, _ in ok])
+            e2 = np.mean([e * e for _, e in ok])
+            num += np.sum((x - x.mean()) ** 2) / e2
+            dof += len(ok) - 1
+            used += 1
+            if args.points:
+                print(f"   {n} {key}: values {np.round(x, 5).tolist()}, sd {x.std(ddof=1):.4g}, "
+                      f"quoted {math.sqrt(e2):.4g}")
+        if dof == 0:
+            print(f"{n:44s} {used:6d} {dof:5d} {'-':>13s} {'':>6s} {nan:8d}")
+            continue
+        r = math.sqrt(num / dof)
+        rows.append((n, r))
+        flag = "" if 0.7 <= r <= 1.5 else "  <- outside 0.7-1.5"
+        print(f"{n:44s} {used:6d} {dof:5d} {r:13.2f} {r / math.sqrt(2 * dof):6.2f} {nan:8d}{flag}")
+
+
+if __name__ == "__main__":
+    main()
