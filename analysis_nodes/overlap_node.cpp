@@ -75,25 +75,31 @@ private:
     if (pass_on_) add_pass(k, j, pos0, f);
   }
 
-  // Q(t) = 1/((t/tau0)^beta + 1), weighted by the errors if every lag has one.
-  void fit_q(const an::OverlapAccumulator::Result& r, dynhet::overlap_t& m) const {
-    m.beta = m.beta_err = m.tau0 = m.tau0_err = std::numeric_limits<double>::quiet_NaN();
-    std::vector<double> t, q, e;
-    bool weighted = true;
-    for (size_t j = 0; j < r.q.size(); ++j) {
-      if (std::isnan(r.q[j])) continue;
-      t.push_back(info().lag_time[j]);
-      q.push_back(r.q[j]);
-      e.push_back(r.q_err[j]);
-      weighted = weighted && std::isfinite(r.q_err[j]) && r.q_err[j] > 0;
-    }
-    if (t.size() < 4) return;
-    try {
-      const auto f = an::fit_overlap(t, q, weighted ? e : std::vector<double>{});
-      m.beta = f.beta, m.beta_err = f.beta_err, m.tau0 = f.tau0, m.tau0_err = f.tau0_err;
-    } catch (const std::exception&) {
-      // not converged yet: NaN
-    }
+  // Q(t) = 1/((t/tau0)^beta + 1), eq. (8), over the lags where
+  // 0.1 <= Q <= 0.7 (overlap_fit_lags), unweighted: the errors of the lags
+  // are correlated (the same origins), so beta and tau0 take theirs from a
+  // jackknife over blocks of origins, each replicate fitted over the same lags.
+  void fit_q(const an::OverlapAccumulator& acc, const an::OverlapAccumulator::Result& r,
+             dynhet::overlap_t& m) const {
+    const double nan = std::numeric_limits<double>::quiet_NaN();
+    m.beta = m.beta_err = m.tau0 = m.tau0_err = nan;
+    const std::vector<int> lags = an::overlap_fit_lags(r.q);
+    if (lags.empty()) return;
+    auto fit = [&](const std::vector<double>& q) {
+      std::vector<double> t, y;
+      for (int j : lags) t.push_back(info().lag_time[j]), y.push_back(q[j]);
+      try {
+        const auto f = an::fit_overlap(t, y);
+        return std::vector<double>{f.beta, f.tau0};
+      } catch (const std::exception&) {
+        return std::vector<double>{nan, nan}; // not converged: NaN
+      }
+    };
+    const auto p = fit(r.q);
+    m.beta = p[0], m.tau0 = p[1];
+    if (std::isnan(m.beta)) return;
+    const auto e = an::origin_jackknife(acc.table(), acc.n_origins(), static_cast<int>(r.q.size()), fit);
+    if (e.size() == 2) m.beta_err = e[0], m.tau0_err = e[1];
   }
 
   // chi4 for every listed sub-box size (nested grids: one pass, see
@@ -163,8 +169,15 @@ private:
     origin_mean(msd_extreme_[3], m.msd_slow_small, m.msd_slow_small_err);
     m.diffusion = m.diffusion_err = std::numeric_limits<double>::quiet_NaN();
     if (std::isfinite(m.fit_t_min) && m.fit_t_min < m.fit_t_max) {
-      const auto d = an::fit_diffusion(m.lag_time, m.msd_all, m.fit_t_min, m.fit_t_max);
-      if (d.n >= 3) m.diffusion = d.d, m.diffusion_err = d.d_err;
+      // Unweighted over the range, the error from a jackknife over blocks
+      // of origins (the lags of one origin are correlated).
+      auto fit = [&](const std::vector<double>& msd) {
+        const auto d = an::fit_diffusion(m.lag_time, msd, m.fit_t_min, m.fit_t_max);
+        return std::vector<double>{d.n >= 3 ? d.d : std::numeric_limits<double>::quiet_NaN()};
+      };
+      m.diffusion = fit(m.msd_all)[0];
+      const auto e = an::origin_jackknife(msd_all_, info().n_origins, static_cast<int>(m.lag_time.size()), fit);
+      if (std::isfinite(m.diffusion) && e.size() == 1) m.diffusion_err = e[0];
     }
     out().publish(dynhet::kChanMsd, &m);
   }
@@ -226,7 +239,7 @@ private:
       m.qr_var = r.qr_var;
       m.tau_alpha = r.tau_alpha;
       m.tau_alpha_err = r.tau_alpha_err;
-      fit_q(r, m);
+      fit_q(acc_[c], r, m);
       for (int k = 0; k < info().n_origins; ++k) m.t0.push_back(info().frame_time[info().origin_frame[k]]);
       m.tau_alpha_t0 = an::tau_alpha_per_origin(acc_[c], info().lag_time, info().n_origins);
       m.n_t0 = static_cast<int32_t>(m.t0.size());

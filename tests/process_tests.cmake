@@ -46,3 +46,9 @@ set_tests_properties(study_slurm_tiny PROPERTIES LABELS process TIMEOUT 600)
 add_test(NAME prepared_state_bit_for_bit
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/prepared_state.sh ${PROJECT_SOURCE_DIR} $<TARGET_FILE_DIR:sim_node>)
 set_tests_properties(prepared_state_bit_for_bit PROPERTIES LABELS process TIMEOUT 300)
+
+# The Q(t) fit over its stated range follows a real run's data, is stable
+# when the range shifts by a lag, and has jackknife errors (tests/q_fit.sh).
+add_test(NAME q_fit_follows_the_data
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/q_fit.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(q_fit_follows_the_data PROPERTIES LABELS process TIMEOUT 120)

@@ -1,5 +1,7 @@
 #include "dynhet/analysis/fits.hpp"
 
+#include <functional>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -80,6 +82,53 @@ double jackknife_error(const std::vector<double>& x) {
   for (double v : x) mean += v / n;
   for (double v : x) s2 += (v - mean) * (v - mean);
   return std::sqrt(s2 * (n - 1) / n);
+}
+
+std::vector<double> origin_jackknife(const std::vector<double>& table, int n_origins, int n_lags,
+                                     const std::function<std::vector<double>(const std::vector<double>&)>& estimate) {
+  std::vector<int> used;
+  for (int k = 0; k < n_origins; ++k)
+    for (int j = 0; j < n_lags; ++j)
+      if (!std::isnan(table[size_t(k) * n_lags + j])) {
+        used.push_back(k);
+        break;
+      }
+  std::vector<double> err;
+  const int u = static_cast<int>(used.size());
+  for (int b : {1, 2}) {
+    const int blocks = (u + b - 1) / b;
+    if (blocks < (b == 1 ? 2 : 4)) continue;
+    std::vector<std::vector<double>> rep; // [estimate][block]
+    for (int blk = 0; blk < blocks; ++blk) {
+      std::vector<char> skip(n_origins, 0);
+      for (int i = blk * b; i < std::min(u, (blk + 1) * b); ++i) skip[used[i]] = 1;
+      std::vector<double> mean(n_lags, std::numeric_limits<double>::quiet_NaN());
+      for (int j = 0; j < n_lags; ++j) {
+        double s = 0;
+        int n = 0;
+        for (int k : used)
+          if (const double v = table[size_t(k) * n_lags + j]; !skip[k] && !std::isnan(v)) s += v, ++n;
+        if (n) mean[j] = s / n;
+      }
+      const std::vector<double> e = estimate(mean);
+      rep.resize(e.size());
+      for (size_t i = 0; i < e.size(); ++i) rep[i].push_back(e[i]);
+    }
+    err.resize(rep.size(), 0.0);
+    for (size_t i = 0; i < rep.size(); ++i) {
+      const double e = jackknife_error(rep[i]);
+      err[i] = std::isnan(e) || std::isnan(err[i]) ? std::numeric_limits<double>::quiet_NaN() : std::max(err[i], e);
+    }
+  }
+  return err;
+}
+
+std::vector<int> overlap_fit_lags(const std::vector<double>& q, double q_lo, double q_hi) {
+  std::vector<int> out;
+  for (size_t j = 0; j < q.size(); ++j)
+    if (q[j] >= q_lo && q[j] <= q_hi) out.push_back(static_cast<int>(j));
+  if (out.size() < 3) out.clear();
+  return out;
 }
 
 LinearFit linear_fit(const std::vector<double>& x, const std::vector<double>& y,

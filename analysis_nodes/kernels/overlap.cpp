@@ -108,14 +108,11 @@ OverlapAccumulator::Result OverlapAccumulator::result() const {
   const double level = std::exp(-1.0); // Q(tau_alpha) = 1/e
   r.tau_alpha = crossing_time(lag_, r.q, level);
 
-  // Jackknife over the origins that contributed.
-  std::vector<double> taus;
-  for (int k = 0; k < n_origins_; ++k) {
-    bool used = false;
-    for (size_t j = 0; j < nj && !used; ++j) used = !std::isnan(q_[index(k, static_cast<int>(j))]);
-    if (used) taus.push_back(crossing_time(lag_, mean_over_origins(k), level));
-  }
-  r.tau_alpha_err = std::isnan(r.tau_alpha) ? kNaN : jackknife_error(taus);
+  // Jackknife over blocks of the origins that contributed.
+  const auto e = origin_jackknife(q_, n_origins_, static_cast<int>(nj), [&](const std::vector<double>& q) {
+    return std::vector<double>{crossing_time(lag_, q, level)};
+  });
+  r.tau_alpha_err = std::isnan(r.tau_alpha) || e.empty() ? kNaN : e[0];
   return r;
 }
 

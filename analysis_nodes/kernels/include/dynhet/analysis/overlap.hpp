@@ -31,7 +31,7 @@ double crossing_time(const std::vector<double>& t, const std::vector<double>& q,
 
 // Q(t;t0) = <Q_r(t;t0)> per (origin, lag), for one cutoff, and the averages
 // over origins: Q(t) (eq. 7), its standard error, and tau_alpha with a
-// jackknife error over origins.
+// jackknife error over blocks of origins (origin_jackknife, fits.hpp).
 class OverlapAccumulator {
 public:
   OverlapAccumulator(int n_origins, std::vector<double> lag_time);
@@ -48,6 +48,9 @@ public:
 
   // Q(t;t0) of origin k at lag j (NaN if not yet measured).
   double q(int k, int j) const { return q_[index(k, j)]; }
+  // All of them, origin-major, for origin_jackknife.
+  const std::vector<double>& table() const { return q_; }
+  int n_origins() const { return n_origins_; }
 
 private:
   std::size_t index(int k, int j) const { return static_cast<size_t>(k) * lag_.size() + j; }
