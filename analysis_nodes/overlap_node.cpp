@@ -176,7 +176,14 @@ private:
         return std::vector<double>{d.n >= 3 ? d.d : std::numeric_limits<double>::quiet_NaN()};
       };
       m.diffusion = fit(m.msd_all)[0];
-      const auto e = an::origin_jackknife(msd_all_, info().n_origins, static_cast<int>(m.lag_time.size()), fit);
+      // Blocks at least as long as the fit's longest lag: origins closer
+      // than that measure overlapping windows of the same trajectories.
+      const auto& ft = info().frame_time;
+      const auto& of = info().origin_frame;
+      const double spacing = of.size() > 1 ? (ft[of.back()] - ft[of.front()]) / (of.size() - 1.0) : 0.0;
+      const int block = spacing > 0 ? static_cast<int>(std::ceil(m.fit_t_max / spacing - 1e-9)) : 1;
+      const auto e =
+          an::origin_jackknife(msd_all_, info().n_origins, static_cast<int>(m.lag_time.size()), fit, block);
       if (std::isfinite(m.diffusion) && e.size() == 1) m.diffusion_err = e[0];
     }
     out().publish(dynhet::kChanMsd, &m);

@@ -145,7 +145,8 @@ private:
     const int l = fit_slot(c, m.tau_alpha);
     m.lag_index = l, m.t_s4 = lags_[l];
     m.lag_time = lags_;
-    for (size_t g = 0; g < grids_.size(); ++g) add_grid(m, c, g, l);
+    std::vector<std::string> notes;
+    for (size_t g = 0; g < grids_.size(); ++g) add_grid(m, c, g, l, notes);
     m.n_origins = c.acc.back().mean(l).n_origins;
     const size_t whole = grids_.size() - 1;
     m.xi = m.oz_xi[whole], m.xi_err = m.oz_xi_err[whole], m.chi0 = m.oz_chi0[whole], m.chi0_err = m.oz_chi0_err[whole];
@@ -168,10 +169,12 @@ private:
     if (final)
       std::fprintf(stderr, "s4_node: a=%g t_s4=%.4g (tau_alpha %.4g), whole box xi=%.4g +- %.2g chi0=%.4g +- %.2g, chi4=%.4g +- %.2g (%d origins)\n",
                    m.cutoff_a, m.t_s4, m.tau_alpha, m.xi, m.xi_err, m.chi0, m.chi0_err, m.chi4_box, m.chi4_box_err, m.n_origins);
+    if (final)
+      for (const auto& n : notes) std::fprintf(stderr, "s4_node: a=%g %s\n", m.cutoff_a, n.c_str());
   }
 
   // Grid g's shells, fits and chi4 of cutoff c at computed lag l.
-  void add_grid(dynhet::s4_t& m, const Cutoff& c, size_t g, int l) const {
+  void add_grid(dynhet::s4_t& m, const Cutoff& c, size_t g, int l, std::vector<std::string>& notes) const {
     const an::S4Accumulator& a = c.acc[g];
     const an::S4Accumulator::Mean mean = a.mean(l);
     m.subbox_particles.push_back(grids_[g].mean_particles);
@@ -184,6 +187,10 @@ private:
     m.s4.insert(m.s4.end(), mean.s4.begin(), mean.s4.end());
     m.s4_err.insert(m.s4_err.end(), mean.s4_err.begin(), mean.s4_err.end());
     const an::S4FitAtLag f = an::fit_s4_at_lag(a, l, kQxiMax);
+    for (const auto* o : {&f.oz, &f.oz_a2})
+      if (!o->note.empty())
+        notes.push_back("N_box " + std::to_string(static_cast<long>(grids_[g].mean_particles + 0.5)) + ": xi of the " +
+                        (o == &f.oz ? "OZ" : "OZ + A^2") + " fit not determined (" + o->note + ")");
     m.oz_chi0.push_back(f.oz.chi0), m.oz_chi0_err.push_back(f.oz.chi0_err);
     m.oz_xi.push_back(f.oz.xi), m.oz_xi_err.push_back(f.oz.xi_err);
     m.oz_q_fit_max.push_back(f.oz.q_fit_max), m.oz_n_fit.push_back(f.oz.n);

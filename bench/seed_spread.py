@@ -8,9 +8,11 @@ in their seed are one point. Per quantity, pooled over points,
 
     ratio^2 = sum_points sum_seeds (x_i - mean_point)^2 / e_point^2 / sum_points (K - 1),
 
-e_point^2 the mean of the quoted errors squared over the point's seeds. An
-honest error gives 1; its own uncertainty is ratio / sqrt(2 dof) (a
-chi-square with dof = sum (K - 1) degrees of freedom). Values without an
+e_point the mean quoted error over the point's seeds: the ratio is the
+seed-to-seed standard deviation over the mean quoted error, pooled. An
+honest error gives about 1; its own uncertainty is ratio / sqrt(2 dof) (a
+chi-square with dof = sum (K - 1) degrees of freedom), more where the
+quoted errors scatter. Values without an
 error (NaN) are counted, not pooled.
 
 Usage: bench/seed_spread.py STUDY_DIR [--cutoff 0.6] [--points]
@@ -125,7 +127,7 @@ def main():
             if len(ok) < 2:
                 continue
             x = np.array([v for v, _ in ok])
-            e2 = np.mean([e * e for _, e in ok])
+            e2 = np.mean([e for _, e in ok]) ** 2
             num += np.sum((x - x.mean()) ** 2) / e2
             dof += len(ok) - 1
             used += 1

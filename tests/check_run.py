@@ -514,7 +514,7 @@ def check_clusters(f, unwrapped, L, origin_frame, pair_frame, lag, scene):
             check(same, f"clusters {name}: {kind} R_g per N_c bin (R_g at t0 + t, periodic) equals brute force")
             ok = np.isfinite(ln_n)
             d_f = float(g[f"{kind}_d_f"]["value"][-1])
-            if ok.sum() >= 2:
+            if ok.sum() >= 3:  # d_f needs 3 bins (clusters.hpp)
                 d_f_bf = 1 / np.polyfit(np.array(ln_n)[ok], np.array(ln_rg)[ok], 1)[0]
                 check(abs(d_f - d_f_bf) <= 1e-9 * abs(d_f_bf), f"clusters {name}: {kind} d_f = {d_f:.4g} (brute force {d_f_bf:.4g})")
             else:
@@ -573,18 +573,10 @@ def main(path, scene_path):
         check(same, f"{name}: tau_alpha(t0) per origin equals brute force")
         beta, tau0 = float(g["beta"]["value"][-1]), float(g["tau0"]["value"][-1])
         # The fit is a least-squares minimum of the node's objective: nudging
-        # either parameter by 0.1% does not lower the residual. The node weights
-        # by the recorded errors if every lag has a positive one, errors below
-        # 1e-9 of the largest (Q = 1 at every origin) raised to the smallest
-        # other; else it does not weight.
-        q_err = g["q_err"]["value"][-1]
-        use = np.isfinite(q_rec) & (lag > 0)
-        e = q_err[use]
-        if np.all(np.isfinite(e) & (e > 0)):
-            real = e[e > 1e-9 * e.max()]
-            e = np.maximum(e, real.min()) if len(real) else np.ones_like(e)
-        else:
-            e = np.ones_like(e)
+        # either parameter by 0.1% does not lower the residual. The node fits
+        # the lags with 0.1 <= Q <= 0.7, unweighted (fits.hpp, overlap_fit_lags).
+        use = np.isfinite(q_rec) & (lag > 0) & (q_rec >= 0.1) & (q_rec <= 0.7)
+        e = np.ones(int(use.sum()))
 
         def sse(b_, t_):
             return np.sum(((q_rec[use] - 1 / ((lag[use] / t_) ** b_ + 1)) / e) ** 2)

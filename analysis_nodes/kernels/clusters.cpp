@@ -372,7 +372,9 @@ FractalFit fit_fractal_dimension(const ClusterTally& t) {
       ln_n.push_back(t.sum_ln_n[b] / t.rg_count[b]), ln_rg.push_back(t.sum_ln_rg[b] / t.rg_count[b]);
       used += t.rg_count[b];
     }
-  if (ln_n.size() < 2) return {kNaN, kNaN, static_cast<int>(ln_n.size()), used};
+  // Two bins make a line but no test of it, and a slope near 0 then gives
+  // any d_f at all (11 +- 15 was seen for fast clusters): NaN below 3 bins.
+  if (ln_n.size() < 3) return {kNaN, kNaN, static_cast<int>(ln_n.size()), used};
   const LinearFit f = linear_fit(ln_n, ln_rg); // ln R_g = (1/d_f) ln N_c + c
   return {1 / f.slope, f.slope_err / (f.slope * f.slope), f.n, used};
 }

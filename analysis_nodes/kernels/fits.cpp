@@ -85,7 +85,8 @@ double jackknife_error(const std::vector<double>& x) {
 }
 
 std::vector<double> origin_jackknife(const std::vector<double>& table, int n_origins, int n_lags,
-                                     const std::function<std::vector<double>(const std::vector<double>&)>& estimate) {
+                                     const std::function<std::vector<double>(const std::vector<double>&)>& estimate,
+                                     int min_block) {
   std::vector<int> used;
   for (int k = 0; k < n_origins; ++k)
     for (int j = 0; j < n_lags; ++j)
@@ -95,9 +96,10 @@ std::vector<double> origin_jackknife(const std::vector<double>& table, int n_ori
       }
   std::vector<double> err;
   const int u = static_cast<int>(used.size());
-  for (int b : {1, 2}) {
+  const int b1 = std::clamp(min_block, 1, std::max(1, u / 2));
+  for (int b : {b1, 2 * b1}) {
     const int blocks = (u + b - 1) / b;
-    if (blocks < (b == 1 ? 2 : 4)) continue;
+    if (blocks < (b == b1 ? 2 : 4)) continue;
     std::vector<std::vector<double>> rep; // [estimate][block]
     for (int blk = 0; blk < blocks; ++blk) {
       std::vector<char> skip(n_origins, 0);
@@ -412,7 +414,7 @@ OzFit fit_oz(const std::vector<double>& q, const std::vector<double>& s4, const 
   bool ok = false;
   // Start: the linearised form over the five smallest q.
   std::vector<int> k = oz_range(q, s4, 0.0, qxi_max, 5, ok);
-  if (k.size() < 3) return OzFit{kNaN, kNaN, 0, kNaN, kNaN, 0, kNaN, static_cast<int>(k.size()), false};
+  if (k.size() < 3) return OzFit{kNaN, kNaN, 0, kNaN, kNaN, 0, kNaN, static_cast<int>(k.size()), false, ""};
   Eigen::VectorXd c = inverse_fit(q, s4, k, 2);
   Eigen::VectorXd p(2);
   p << -std::log(c[0]), 0.5 * std::log(std::max(c[1] / c[0], 1e-12));

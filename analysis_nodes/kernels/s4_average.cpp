@@ -1,5 +1,7 @@
 #include "dynhet/analysis/s4_average.hpp"
 
+#include <cstdio>
+
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -65,6 +67,21 @@ S4FitAtLag fit_s4_at_lag(const S4Accumulator& acc, int j, double qxi_max) {
   out.oz.chi0_err = jackknife_error_3(chi0), out.oz.xi_err = jackknife_error_3(xi);
   out.oz_a2.chi0_err = jackknife_error_3(chi0_a2), out.oz_a2.xi_err = jackknife_error_3(xi_a2);
   out.oz_a2.a_err = jackknife_error_3(a);
+  // Where xi is not determined, say so instead of printing a number.
+  for (OzFit* f : {&out.oz, &out.oz_a2}) {
+    if (!std::isfinite(f->xi)) continue;
+    char buf[200];
+    if (!f->range_ok) {
+      std::snprintf(buf, sizeof buf, "beyond the sub-box: fewer than 3 shells with q xi <= %g", qxi_max);
+      f->note = buf, f->xi = f->xi_err = f->chi0 = f->chi0_err = kNaN;
+    } else if (f->q_fit_max * f->xi < kQxiResolved) {
+      std::snprintf(buf, sizeof buf, "below the q range: q xi reaches only %.2g at q_max", f->q_fit_max * f->xi);
+      f->note = buf, f->xi = f->xi_err = kNaN;
+    } else if (!(f->xi_err < f->xi)) {
+      std::snprintf(buf, sizeof buf, "the jackknife error (%.3g) is not below xi (%.3g)", f->xi_err, f->xi);
+      f->note = buf, f->xi = f->xi_err = kNaN;
+    }
+  }
   return out;
 }
 

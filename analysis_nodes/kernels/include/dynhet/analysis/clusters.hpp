@@ -165,7 +165,7 @@ struct ClusterTally {
 // d_f from R_g ~ N_c^(1/d_f): a straight line through the mean ln R_g against
 // the mean ln N_c in each log bin of N_c (bins equally weighted, so the
 // many small clusters do not dominate), over the non-spanning clusters
-// with N_c >= n_min.
+// with N_c >= n_min. NaN (not determined) with fewer than 3 such bins.
 struct FractalFit {
   double d_f, d_f_err;
   int n_bins;

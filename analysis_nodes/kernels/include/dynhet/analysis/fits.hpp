@@ -6,6 +6,7 @@
 #pragma once
 
 #include <functional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Dense>
@@ -31,16 +32,20 @@ double jackknife_error(const std::vector<double>& leave_one_out);
 // jackknife over blocks of consecutive origins: `table` holds the curve of
 // each origin (origin k, lag j at k * n_lags + j; NaN where not measured),
 // `estimate` maps an origin-averaged curve to the estimates. Every origin
-// with a measured lag counts; the blocks are 1 and 2 origins long, and the
-// larger of the two errors is returned (2-origin blocks only if that leaves
-// at least 4): neighbouring origins are correlated where dynamic
-// heterogeneity outlives their spacing, which single-origin blocks miss.
-// Errors of lags taken one by one and propagated through a fit would miss
-// the correlation between lags of the same origin as well (10 times too
-// small for beta, tau0 and D against the spread of seeds). NaN where an
-// estimate is NaN in any replicate; empty with fewer than 2 origins.
+// with a measured lag counts. Blocks are `min_block` origins long and
+// twice that (the latter only if it leaves at least 4 blocks; never fewer
+// than 2 blocks), and the larger of the two errors is returned: origins
+// are correlated where the time windows they measure overlap (a lag longer
+// than their spacing) or where dynamic heterogeneity outlives the spacing,
+// which single-origin blocks miss; min_block should make a block at least
+// as long as the longest lag the estimate uses. Errors of lags taken one
+// by one and propagated through a fit would miss the correlation between
+// lags of the same origin as well (10 times too small for beta, tau0 and D
+// against the spread of seeds). NaN where an estimate is NaN in any
+// replicate; empty with fewer than 2 origins.
 std::vector<double> origin_jackknife(const std::vector<double>& table, int n_origins, int n_lags,
-                                     const std::function<std::vector<double>(const std::vector<double>&)>& estimate);
+                                     const std::function<std::vector<double>(const std::vector<double>&)>& estimate,
+                                     int min_block = 1);
 
 // Minimises |r(p)|^2 for residuals r already divided by their errors.
 struct LmResult {
@@ -147,6 +152,7 @@ struct OzFit {
   double q_fit_max; // largest q in the fit
   int n;
   bool range_ok; // false if the q xi <= qxi_max range held too few shells
+  std::string note; // why xi is NaN where the data gave a number (fit_s4_at_lag)
 };
 OzFit fit_oz(const std::vector<double>& q, const std::vector<double>& s4,
              const std::vector<double>& s4_err = {}, double qxi_max = 1.0);

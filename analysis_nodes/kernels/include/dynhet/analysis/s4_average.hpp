@@ -46,6 +46,12 @@ private:
 // residuals, since standard errors from a few origins are themselves
 // noisy); the parameter errors are the jackknife over origins (each fit
 // repeated without one origin), NaN with fewer than 3 origins.
+// xi is not determined, and NaN with a note in the fit's `note`, where the
+// sub-box cannot hold it (fewer than 3 shells with q xi <= qxi_max; chi0 is
+// then NaN too), where it lies below the q range (q xi < kQxiResolved at
+// the largest q fitted: S4 has hardly begun to fall; chi0 stays) or where
+// its jackknife error is not below it.
+constexpr double kQxiResolved = 0.5;
 struct S4FitAtLag {
   OzFit oz, oz_a2; // chi0_err, xi_err, a_err replaced by the jackknife errors
   int n_origins;
