@@ -209,6 +209,8 @@ private:
         m.chi4_err.insert(m.chi4_err.end(), e.begin(), e.end());
         m.chi4_peak.push_back(r.chi4_peak);
         m.tau4.push_back(r.tau4);
+        m.chi4_peak_err.push_back(r.chi4_peak_err);
+        m.tau4_err.push_back(r.tau4_err);
       }
       m.n_values = static_cast<int32_t>(m.chi4.size());
       out().publish(dynhet::kChanChi4, &m);

@@ -360,7 +360,7 @@ bool RunRecorder::on_chi4(const chi4_t &m) {
 }
 
 // chi4/a<cutoff>/{chi4, chi4_err}: value (records, grids, lags) flattened to
-// (records, grids * lags); chi4_peak, tau4: (records, grids).
+// (records, grids * lags); chi4_peak, tau4 and their errors: (records, grids).
 void RunRecorder::write_chi4(const chi4_t &m) {
   const std::string label = cutoff_label(m.cutoff_a);
   const std::string base = "chi4/" + label + "/";
@@ -379,6 +379,8 @@ void RunRecorder::write_chi4(const chi4_t &m) {
   writer_->append_observable(base + "chi4_err", step, t, m.chi4_err);
   writer_->append_observable(base + "chi4_peak", step, t, m.chi4_peak);
   writer_->append_observable(base + "tau4", step, t, m.tau4);
+  writer_->append_observable(base + "chi4_peak_err", step, t, m.chi4_peak_err);
+  writer_->append_observable(base + "tau4_err", step, t, m.tau4_err);
 }
 
 void RunRecorder::write_overlap(const overlap_t &m) {

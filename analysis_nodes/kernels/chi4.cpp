@@ -57,6 +57,59 @@ Chi4Accumulator::Result Chi4Accumulator::result() const {
   }
   const Peak p = find_peak(lag_, nb > 1 ? r.chi4 : r.chi4_pooled); // chi4^P at tau4
   r.chi4_peak = p.y, r.tau4 = p.t;
+  r.chi4_peak_err = r.tau4_err = kNaN;
+  if (std::isnan(p.y)) return r;
+  // Their errors: a jackknife over blocks of origins (fits.hpp,
+  // origin_jackknife), the peak found again in each replicate.
+  const int nl = static_cast<int>(nj);
+  std::vector<double> e;
+  if (nb > 1) {
+    std::vector<double> c(s1_.size(), kNaN); // per-origin chi4, the terms of eq. (14)
+    for (size_t i = 0; i < c.size(); ++i)
+      if (!std::isnan(s1_[i])) c[i] = big_n * (s2_[i] / nb - (s1_[i] / nb) * (s1_[i] / nb));
+    e = origin_jackknife(c, n_origins_, nl, [&](const std::vector<double>& chi4) {
+      const Peak q = find_peak(lag_, chi4);
+      return std::vector<double>{q.y, q.t};
+    });
+  } else {
+    // The whole box: the pooled variance is no mean over origins, so the
+    // replicates are made here, with the same blocks (1 and 2 origins, the
+    // larger error).
+    std::vector<int> used;
+    for (int k = 0; k < n_origins_; ++k)
+      for (size_t j = 0; j < nj; ++j)
+        if (!std::isnan(s1_[index(k, static_cast<int>(j))])) {
+          used.push_back(k);
+          break;
+        }
+    const int u = static_cast<int>(used.size());
+    for (int b : {1, 2}) {
+      const int blocks = (u + b - 1) / b;
+      if (blocks < (b == 1 ? 3 : 4)) continue;
+      std::vector<double> ys, ts;
+      for (int blk = 0; blk < blocks; ++blk) {
+        std::vector<double> v(nj, kNaN);
+        for (size_t j = 0; j < nj; ++j) {
+          double t1 = 0, t2 = 0;
+          int n = 0;
+          for (int i = 0; i < u; ++i) {
+            if (i / b == blk) continue;
+            const double a = s1_[index(used[i], static_cast<int>(j))];
+            if (std::isnan(a)) continue;
+            t1 += a, t2 += s2_[index(used[i], static_cast<int>(j))], ++n;
+          }
+          if (n > 1) v[j] = big_n * (t2 - t1 * t1 / n) / (n - 1);
+        }
+        const Peak q = find_peak(lag_, v);
+        ys.push_back(q.y), ts.push_back(q.t);
+      }
+      const double ey = jackknife_error(ys), et = jackknife_error(ts);
+      if (e.empty()) e = {ey, et};
+      else e = {std::isnan(ey) || std::isnan(e[0]) ? kNaN : std::max(e[0], ey),
+                std::isnan(et) || std::isnan(e[1]) ? kNaN : std::max(e[1], et)};
+    }
+  }
+  if (e.size() == 2) r.chi4_peak_err = e[0], r.tau4_err = e[1];
   return r;
 }
 

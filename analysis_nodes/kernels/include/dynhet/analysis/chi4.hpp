@@ -28,7 +28,11 @@ public:
     // fewer than 3 origins).
     std::vector<double> chi4_pooled_err;
     std::vector<int> n_origins;
-    double chi4_peak, tau4; // chi4^P and tau4 (of chi4, or of chi4_pooled for one sub-box)
+    // chi4^P and tau4 (of chi4, or of chi4_pooled for one sub-box): the
+    // vertex of the parabola in ln t through the largest point and its two
+    // neighbours (the largest point itself at either end of the lags), with
+    // jackknife errors over blocks of origins (NaN below 3 origins).
+    double chi4_peak, tau4, chi4_peak_err, tau4_err;
   };
   Result result() const;
 
