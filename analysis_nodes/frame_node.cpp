@@ -1,5 +1,8 @@
 #include "frame_node.hpp"
 
+#include "dynhet/lcm_guard.hpp"
+#include "dynhet/message_checks.hpp"
+
 #include <algorithm>
 #include <cstdio>
 
@@ -24,12 +27,49 @@ void FrameNode::check_sim_alive(double timeout) {
 }
 
 void FrameNode::input_ended() {
-  if (!finished_) finish(1, info_ ? "input ended before the run did" : "no run info in the input");
+  if (finished_) return;
+  if (done_said_) return finish(0, ""); // a replay that ends after the sim's "done"
+  finish(1, info_ ? "input ended before the run did" : "no run info in the input");
 }
 
-void FrameNode::on_run(const lcm::ReceiveBuffer*, const std::string&, const run_info_t* m) {
+void FrameNode::reject(const std::string& channel, const std::string& why) {
+  ++status_.messages_rejected;
+  status_.last_rejection = channel + ": " + why;
+  if (status_.messages_rejected <= 10 || status_.messages_rejected % 1000 == 0)
+    std::fprintf(stderr, "%s_node: dropped a message on %s (%s; %d so far)\n", name_.c_str(), channel.c_str(),
+                 why.c_str(), status_.messages_rejected);
+}
+
+// Decodes into m with every check, or rejects; any exception of the
+// handler itself is caught too: no message can end the process.
+template <class Msg, class Fn>
+static void guarded(FrameNode& node, const lcm::ReceiveBuffer* rb, const std::string& ch, Fn&& fn) {
+  Msg m;
+  std::string why;
+  if (!guard::safe_decode(rb->data, static_cast<int>(rb->data_size), m, why)) return node.reject(ch, why);
+  try {
+    fn(m);
+  } catch (const std::exception& e) {
+    node.reject(ch, std::string("handler: ") + e.what());
+  }
+}
+
+void FrameNode::on_run_raw(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+  guarded<run_info_t>(*this, rb, ch, [&](const run_info_t& m) { on_run(m); });
+}
+void FrameNode::on_chunk_raw(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+  guarded<frame_chunk_t>(*this, rb, ch, [&](const frame_chunk_t& m) { on_chunk(m); });
+}
+void FrameNode::on_sim_status_raw(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+  guarded<sim_status_t>(*this, rb, ch, [&](const sim_status_t& m) { on_sim_status(m); });
+}
+
+void FrameNode::on_run(const run_info_t& mm) {
+  const run_info_t* m = &mm;
   if (info_ || (run_filter_ && m->run_id != run_filter_)) return;
+  if (const std::string bad = run_info_problem(*m); !bad.empty()) return reject(kChanRun, "run info: " + bad);
   info_ = std::make_unique<run_info_t>(*m);
+  assembler_.expect(m->n_particles, m->n_frames, m->chunk_particles);
   last_sim_news_ = Clock::now();
   status_.run_id = m->run_id;
   status_.frames_expected = m->n_frames;
@@ -58,21 +98,50 @@ void FrameNode::on_run(const lcm::ReceiveBuffer*, const std::string&, const run_
   }
 }
 
-void FrameNode::on_chunk(const lcm::ReceiveBuffer*, const std::string&, const frame_chunk_t* m) {
-  if (!info_ || finished_ || m->run_id != info_->run_id || m->n_values != 2 * m->count) return;
-  last_sim_news_ = Clock::now();
+void FrameNode::on_chunk(const frame_chunk_t& mm) {
+  const frame_chunk_t* m = &mm;
+  if (!info_ || finished_ || m->run_id != info_->run_id) return;
+  if (int64_t(m->n_values) != 2 * int64_t(m->count)) {
+    ++status_.chunks_rejected;
+    return reject(kChanFrame, "chunk: n_values is not 2 x count");
+  }
   const ChunkHeader h{m->frame_index, m->time,           m->n_particles, m->chunk_index,
                       m->chunk_count, m->first_particle, m->count};
+  const int64_t bad = assembler_.chunks_malformed();
   auto frame = assembler_.add(h, m->position.data());
+  if (assembler_.chunks_malformed() > bad) {
+    ++status_.chunks_rejected;
+    return reject(kChanFrame, "chunk of frame " + std::to_string(m->frame_index) +
+                                  " is not one of this run's (N, frame, range) or has non-finite positions");
+  }
+  last_sim_news_ = Clock::now();
+  if (done_said_) done_said_ = Clock::now(); // frames still coming: wait on
   if (frame && frame->index < info_->n_frames) on_frame(*frame);
+  maybe_done();
 }
 
-void FrameNode::on_sim_status(const lcm::ReceiveBuffer*, const std::string&, const sim_status_t* m) {
+void FrameNode::on_sim_status(const sim_status_t& mm) {
+  const sim_status_t* m = &mm;
   if (!info_ || m->run_id != info_->run_id || finished_) return;
   last_sim_news_ = Clock::now();
   sim_interrupted_ = m->phase == "interrupted"; // checkpointed: wait for --resume
-  if (m->phase == "done") finish(0, "");
+  if (m->phase == "done") {
+    // Anyone on the bus can say "done": it ends the node at once only when
+    // every frame is here; else once the sim has been silent (no status, no
+    // chunk) for kDoneGrace seconds after it, which a forged "done" during
+    // a live run never is.
+    if (!done_said_) done_said_ = Clock::now();
+    maybe_done();
+  } else if (done_said_) {
+    done_said_.reset(); // the sim goes on: that "done" was not its own
+  }
   if (m->phase == "failed") finish(1, "sim failed: " + m->message);
+}
+
+void FrameNode::maybe_done() {
+  if (!done_said_ || finished_) return;
+  if (assembler_.frames_whole() >= info_->n_frames) return finish(0, "");
+  if (std::chrono::duration<double>(Clock::now() - *done_said_).count() > kDoneGrace) finish(0, "");
 }
 
 void FrameNode::on_frame(const Frame& f) {
@@ -115,6 +184,8 @@ void FrameNode::publish_status() {
 }
 
 void FrameNode::tick() {
+  if (info_) maybe_done();
+  if (finished_) return;
   if (std::chrono::duration<double>(Clock::now() - last_status_).count() >= 1.0) publish_status();
 }
 
@@ -155,9 +226,9 @@ int node_main(const std::string& program, const std::string& description, NodeFa
   }
 
   std::unique_ptr<FrameNode> node = make_node(out, run_id);
-  in.subscribe(kChanRun, &FrameNode::on_run, node.get());
-  in.subscribe(kChanFrame, &FrameNode::on_chunk, node.get())->setQueueCapacity(100000);
-  in.subscribe(kChanSimStatus, &FrameNode::on_sim_status, node.get());
+  in.subscribe(kChanRun, &FrameNode::on_run_raw, node.get());
+  in.subscribe(kChanFrame, &FrameNode::on_chunk_raw, node.get())->setQueueCapacity(100000);
+  in.subscribe(kChanSimStatus, &FrameNode::on_sim_status_raw, node.get());
 
   std::fprintf(stderr, "%s: ready, reading %s\n", program.c_str(), in_url.c_str());
   const auto start = FrameNode::Clock::now();

@@ -14,6 +14,8 @@
 // one, held_origins() and wants() of the other.)
 #pragma once
 
+#include <optional>
+
 #include <chrono>
 #include <cstdint>
 #include <map>
@@ -50,9 +52,13 @@ public:
   void input_ended();
   void tick(); // node status once a second
 
-  void on_run(const lcm::ReceiveBuffer*, const std::string&, const run_info_t* m);
-  void on_chunk(const lcm::ReceiveBuffer*, const std::string&, const frame_chunk_t* m);
-  void on_sim_status(const lcm::ReceiveBuffer*, const std::string&, const sim_status_t* m);
+  // The handlers take raw buffers: each message is checked (encoding,
+  // then contents) before use, and a bad one is dropped and counted
+  // (messages_rejected in the node status), never fatal.
+  void on_run_raw(const lcm::ReceiveBuffer* rb, const std::string& ch);
+  void on_chunk_raw(const lcm::ReceiveBuffer* rb, const std::string& ch);
+  void on_sim_status_raw(const lcm::ReceiveBuffer* rb, const std::string& ch);
+  void reject(const std::string& channel, const std::string& why);
 
 protected:
   // The run has started: set up. Throwing fails the node with the message
@@ -89,7 +95,12 @@ protected:
   const std::string& name() const { return name_; }
 
 private:
+  void on_run(const run_info_t& m);
+  void on_chunk(const frame_chunk_t& m);
+  void on_sim_status(const sim_status_t& m);
   void on_frame(const Frame& f);
+  void maybe_done();
+  static constexpr double kDoneGrace = 10.0; // s of silence after "done" before frames count as lost
   void publish_status();
   void finish(int code, const std::string& why);
 
@@ -104,6 +115,7 @@ private:
   node_status_t status_{};
   Clock::time_point last_status_ = Clock::now(), last_sim_news_ = Clock::now();
   bool sim_interrupted_ = false, started_ = false, finished_ = false;
+  std::optional<Clock::time_point> done_said_; // when a "done" of this run came, if one did
   int pairs_done_ = 0, last_frame_ = -1, exit_code_ = 0;
   double last_time_ = 0;
 };

@@ -1,5 +1,7 @@
 #include "dynhet/chunking.hpp"
 
+#include <cmath>
+
 #include <algorithm>
 
 namespace dynhet {
@@ -15,11 +17,23 @@ void FrameAssembler::mark_done(int index) {
   done_[index] = true;
 }
 
+void FrameAssembler::expect(int n_particles, int n_frames, int chunk_particles) {
+  n_ = n_particles, frames_ = n_frames, per_chunk_ = chunk_particles;
+  chunks_per_frame_ = static_cast<int>((int64_t(n_particles) + chunk_particles - 1) / chunk_particles);
+}
+
 std::optional<Frame> FrameAssembler::add(const ChunkHeader& h, const double* position) {
   ++chunks_;
-  const bool sane = h.frame_index >= 0 && h.n_particles > 0 && h.chunk_count > 0 &&
-                    h.chunk_index >= 0 && h.chunk_index < h.chunk_count && h.first_particle >= 0 &&
-                    h.count > 0 && h.first_particle + h.count <= h.n_particles;
+  bool sane = h.frame_index >= 0 && h.n_particles > 0 && h.chunk_count > 0 && h.chunk_index >= 0 &&
+              h.chunk_index < h.chunk_count && h.first_particle >= 0 && h.count > 0 &&
+              int64_t(h.first_particle) + h.count <= h.n_particles; // no int overflow
+  if (sane && n_ > 0) {
+    // Exactly one of the run's chunks: nothing else may size a frame.
+    const int64_t first = int64_t(h.chunk_index) * per_chunk_;
+    sane = h.n_particles == n_ && h.frame_index < frames_ && h.chunk_count == chunks_per_frame_ &&
+           h.first_particle == first && h.count == std::min<int64_t>(per_chunk_, n_ - first);
+  }
+  for (int i = 0; sane && i < 2 * h.count; ++i) sane = std::isfinite(position[i]);
   if (!sane) {
     ++malformed_;
     return std::nullopt;

@@ -16,12 +16,16 @@
 #                   checkpoint_before_frames.h5 (the last one before its
 #                   first frame, which every run keeps), so that the nodes
 #                   see every frame; the result equals the uninterrupted run
+#   --run-id ID     the run's id (default: random; with --resume, the
+#                   checkpoint's). Sim, nodes and recorder all get it, so
+#                   they take only this run's messages: two runs on one bus
+#                   never cross
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
-scene="" out="" bus=private url="" record="" build_first=1 resume="" 
+scene="" out="" bus=private url="" record="" build_first=1 resume="" run_id=""
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
@@ -30,7 +34,8 @@ while (($#)); do
   --record) record=$2; shift 2 ;;
   --no-build) build_first=0; shift ;;
   --resume) resume=$2; shift 2 ;;
-  -h | --help) sed -n '2,20p' "$0"; exit 0 ;;
+  --run-id) run_id=$2; shift 2 ;;
+  -h | --help) sed -n '2,24p' "$0"; exit 0 ;;
   -*) echo "run_scene: unknown option $1" >&2; exit 2 ;;
   *) [[ -z $scene ]] || { echo "run_scene: one scene only" >&2; exit 2; }; scene=$1; shift ;;
   esac
@@ -65,6 +70,7 @@ if [[ $bus == private && -z ${DYNHET_IN_NETNS:-} ]]; then
   [[ -z $resume ]] || args+=(--resume "$resume")
   [[ -z $url ]] || args+=(--url "$url")
   [[ -z $record ]] || args+=(--record "$record")
+  [[ -z $run_id ]] || args+=(--run-id "$run_id")
   exec "$root/launch_scripts/netns.sh" "$0" ${scene:+"$scene"} "${args[@]}"
 fi
 if [[ -n $url ]]; then export LCM_DEFAULT_URL=$url; fi
@@ -72,6 +78,14 @@ url=${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0}
 # Frames come in bursts of chunks: ask for a big socket receive buffer.
 [[ $url == udpm://* && $url != *recv_buf_size* ]] && url="$url&recv_buf_size=4194304"
 export LCM_DEFAULT_URL=$url
+
+# One run id for every process of this run (the checkpoint's when resuming).
+if [[ -n $resume ]]; then
+  run_id=$(/usr/bin/python3 -c "import h5py, sys; print(int(h5py.File(sys.argv[1], 'r').attrs['run_id'][0]))" "$resume")
+elif [[ -z $run_id ]]; then
+  run_id=$(( (RANDOM << 30 | RANDOM << 15 | RANDOM) + 1 ))
+fi
+[[ $run_id =~ ^[1-9][0-9]*$ ]] || { echo "run_scene: --run-id must be a positive integer, not $run_id" >&2; exit 2; }
 
 pids=() names=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
@@ -90,7 +104,7 @@ start() { # name, then the command; waits for its "ready" line
   echo "run_scene: $n did not get ready in 10 s" >&2; exit 1
 }
 
-echo "run_scene: ${scene:-resuming $resume} -> $out (bus $bus, $url)" >&2
+echo "run_scene: ${scene:-resuming $resume} -> $out (bus $bus, $url, run $run_id)" >&2
 if [[ -n $record ]]; then
   rm -f "$record"
   # Ahead of the other processes where allowed (root): a starved lcm-logger
@@ -98,8 +112,8 @@ if [[ -n $record ]]; then
   nice -n -5 lcm-logger --lcm-url="$url" --force "$record" >"$out/lcm-logger.log" 2>&1 &
   logger_pid=$!
 fi
-start recorder "$bin/recorder" --out "$out/run.h5"
-for n in $nodes; do start "$n" "$bin/$n"; done
+start recorder "$bin/recorder" --out "$out/run.h5" --run-id "$run_id"
+for n in $nodes; do start "$n" "$bin/$n" --run-id "$run_id"; done
 if [[ -n $record ]]; then
   # lcm-logger says nothing when it is ready. The nodes publish their status
   # every second from the start: once the log holds anything (it is flushed
@@ -113,7 +127,7 @@ fi
 # The sim in the foreground (its progress line goes to the terminal and
 # sim_node.log).
 set +e
-"$bin/sim_node" "${sim_input[@]}" --checkpoint "$out/checkpoint.h5" \
+"$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" --checkpoint "$out/checkpoint.h5" \
   --checkpoint-before-frames "$out/checkpoint_before_frames.h5" 2> >(tee ${resume:+-a} "$out/sim_node.log" >&2)
 sim_rc=$?
 set -e

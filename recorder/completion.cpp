@@ -33,7 +33,11 @@ Completion::Completion(const std::vector<std::string> &observables, const std::v
 }
 
 void Completion::sim_phase(const std::string &phase, const std::string &message) {
-  if (sim_ended()) return; // the first word on how the run ended stands
+  // The first word on how the run ended stands against other ends; but a
+  // status of a live phase after it means the sim goes on, and the "done"
+  // or "failed" was not its own (anyone on the bus can publish one).
+  const bool live = phase != "done" && phase != "failed" && phase != "interrupted";
+  if (sim_ended() && !live) return;
   phase_ = phase;
   sim_message_ = message;
 }

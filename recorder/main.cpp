@@ -23,6 +23,8 @@
 
 #include "dynhet/lcm_url.hpp"
 #include "dynhet/scene.hpp"
+#include "dynhet/lcm_guard.hpp"
+#include "dynhet/message_checks.hpp"
 #include "run_recorder.hpp"
 
 namespace {
@@ -36,11 +38,8 @@ double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::
 struct Options {
   std::string url, out, from_log;
   double timeout = 60, wait_run = 120;
+  int64_t run_id = 0; // 0: the first run seen
 };
-
-template <class Msg> bool decode(const lcm::LogEvent &e, Msg &m) {
-  return m.decode(e.data, 0, e.datalen) >= 0;
-}
 
 // The bus (and optionally a log) on one side, the RunRecorder on the
 // other, and the clocks that decide when to stop waiting.
@@ -69,33 +68,35 @@ private:
 
   void take_run(const dynhet::run_info_t &m);
   void take_sim(const dynhet::sim_status_t &m);
-  void on_run(const lcm::ReceiveBuffer *, const std::string &, const dynhet::run_info_t *m) { take_run(*m); }
-  void on_sim(const lcm::ReceiveBuffer *, const std::string &, const dynhet::sim_status_t *m) {
-    take_sim(*m);
+  void take_node(const dynhet::node_status_t &m) {
+    if (rec_.on_node_status(m)) last_progress_ = Clock::now();
   }
-  void on_node(const lcm::ReceiveBuffer *, const std::string &, const dynhet::node_status_t *m) {
-    if (rec_.on_node_status(*m)) last_progress_ = Clock::now();
+  template <class Msg, bool (dynhet::RunRecorder::*On)(const Msg &)> void take_result(const Msg &m) {
+    if ((rec_.*On)(m)) last_progress_ = Clock::now();
   }
-  void on_overlap(const lcm::ReceiveBuffer *, const std::string &, const dynhet::overlap_t *m) {
-    if (rec_.on_overlap(*m)) last_progress_ = Clock::now();
+  void take_frame(const dynhet::frame_chunk_t &m) { rec_.on_frame_chunk(m); }
+  // Every message is untrusted: decoded with every check (lcm_guard.hpp),
+  // a bad one dropped and counted, and no handler's exception escapes.
+  template <class Msg, void (Session::*Take)(const Msg &)>
+  void raw(const lcm::ReceiveBuffer *rb, const std::string &ch) {
+    take_bytes<Msg, Take>(rb->data, static_cast<int>(rb->data_size), ch);
   }
-  void on_chi4(const lcm::ReceiveBuffer *, const std::string &, const dynhet::chi4_t *m) {
-    if (rec_.on_chi4(*m)) last_progress_ = Clock::now();
+  template <class Msg, void (Session::*Take)(const Msg &)>
+  void take_bytes(const void *data, int size, const std::string &ch) {
+    Msg m;
+    std::string why;
+    if (!dynhet::guard::safe_decode(data, size, m, why)) return reject(ch, why);
+    try {
+      (this->*Take)(m);
+    } catch (const std::exception &e) {
+      reject(ch, std::string("handler: ") + e.what());
+    }
   }
-  void on_msd(const lcm::ReceiveBuffer *, const std::string &, const dynhet::msd_t *m) {
-    if (rec_.on_msd(*m)) last_progress_ = Clock::now();
-  }
-  void on_s4(const lcm::ReceiveBuffer *, const std::string &, const dynhet::s4_t *m) {
-    if (rec_.on_s4(*m)) last_progress_ = Clock::now();
-  }
-  void on_clusters(const lcm::ReceiveBuffer *, const std::string &, const dynhet::clusters_t *m) {
-    if (rec_.on_clusters(*m)) last_progress_ = Clock::now();
-  }
-  void on_displacement(const lcm::ReceiveBuffer *, const std::string &, const dynhet::displacement_t *m) {
-    if (rec_.on_displacement(*m)) last_progress_ = Clock::now();
-  }
-  void on_frame(const lcm::ReceiveBuffer *, const std::string &, const dynhet::frame_chunk_t *m) {
-    rec_.on_frame_chunk(*m);
+  void reject(const std::string &ch, const std::string &why) {
+    rec_.message_rejected(ch, why);
+    if (rec_.messages_rejected() <= 10 || rec_.messages_rejected() % 1000 == 0)
+      std::fprintf(stderr, "recorder: dropped a message on %s (%s; %lld so far)\n", ch.c_str(), why.c_str(),
+                   static_cast<long long>(rec_.messages_rejected()));
   }
 };
 
@@ -106,26 +107,46 @@ void Session::subscribe() {
     log_ = std::make_unique<lcm::LogFile>(opt_.from_log, "r");
     if (!log_->good()) fatal_ = "cannot read the log " + opt_.from_log;
   } else {
-    lcm_.subscribe(dynhet::kChanRun, &Session::on_run, this)->setQueueCapacity(100);
-    lcm_.subscribe(dynhet::kChanSimStatus, &Session::on_sim, this)->setQueueCapacity(1000);
+    lcm_.subscribe(dynhet::kChanRun, &Session::raw<dynhet::run_info_t, &Session::take_run>, this)
+        ->setQueueCapacity(100);
+    lcm_.subscribe(dynhet::kChanSimStatus, &Session::raw<dynhet::sim_status_t, &Session::take_sim>, this)
+        ->setQueueCapacity(1000);
     // Frames from the start: the first ones can follow the run info
     // closely, and LCM drops what arrives on a channel nobody subscribes.
-    frames_ = lcm_.subscribe(dynhet::kChanFrame, &Session::on_frame, this);
+    frames_ = lcm_.subscribe(dynhet::kChanFrame, &Session::raw<dynhet::frame_chunk_t, &Session::take_frame>, this);
     frames_->setQueueCapacity(10000);
   }
-  lcm_.subscribe(dynhet::kChanNodeStatus, &Session::on_node, this)->setQueueCapacity(1000);
-  lcm_.subscribe(dynhet::kChanOverlap, &Session::on_overlap, this)->setQueueCapacity(10000);
-  lcm_.subscribe(dynhet::kChanChi4, &Session::on_chi4, this)->setQueueCapacity(10000);
-  lcm_.subscribe(dynhet::kChanMsd, &Session::on_msd, this)->setQueueCapacity(10000);
-  lcm_.subscribe(dynhet::kChanS4, &Session::on_s4, this)->setQueueCapacity(1000);
-  lcm_.subscribe(dynhet::kChanClusters, &Session::on_clusters, this)->setQueueCapacity(10000);
-  lcm_.subscribe(dynhet::kChanDisplacement, &Session::on_displacement, this)->setQueueCapacity(1000);
+  using R = dynhet::RunRecorder;
+  lcm_.subscribe(dynhet::kChanNodeStatus, &Session::raw<dynhet::node_status_t, &Session::take_node>, this)
+      ->setQueueCapacity(1000);
+  lcm_.subscribe(dynhet::kChanOverlap,
+                 &Session::raw<dynhet::overlap_t, &Session::take_result<dynhet::overlap_t, &R::on_overlap>>, this)
+      ->setQueueCapacity(10000);
+  lcm_.subscribe(dynhet::kChanChi4, &Session::raw<dynhet::chi4_t, &Session::take_result<dynhet::chi4_t, &R::on_chi4>>,
+                 this)
+      ->setQueueCapacity(10000);
+  lcm_.subscribe(dynhet::kChanMsd, &Session::raw<dynhet::msd_t, &Session::take_result<dynhet::msd_t, &R::on_msd>>,
+                 this)
+      ->setQueueCapacity(10000);
+  lcm_.subscribe(dynhet::kChanS4, &Session::raw<dynhet::s4_t, &Session::take_result<dynhet::s4_t, &R::on_s4>>, this)
+      ->setQueueCapacity(1000);
+  lcm_.subscribe(dynhet::kChanClusters,
+                 &Session::raw<dynhet::clusters_t, &Session::take_result<dynhet::clusters_t, &R::on_clusters>>, this)
+      ->setQueueCapacity(10000);
+  lcm_.subscribe(
+         dynhet::kChanDisplacement,
+         &Session::raw<dynhet::displacement_t, &Session::take_result<dynhet::displacement_t, &R::on_displacement>>,
+         this)
+      ->setQueueCapacity(1000);
   // The launch scripts wait for this line before starting the sim.
   std::fprintf(stderr, "recorder: ready, waiting for run info%s%s\n", log_ ? " in " : "",
                log_ ? opt_.from_log.c_str() : "");
 }
 
 void Session::take_run(const dynhet::run_info_t &m) {
+  if (rec_.has_run() || (opt_.run_id && m.run_id != opt_.run_id)) return;
+  if (const std::string bad = dynhet::run_info_problem(m); !bad.empty())
+    return reject(dynhet::kChanRun, "run info: " + bad);
   try {
     if (!rec_.on_run(m)) return;
   } catch (const std::exception &e) {
@@ -150,13 +171,12 @@ bool Session::read_log(int max_events) {
   for (int i = 0; i < max_events; ++i) {
     const lcm::LogEvent *e = log_->readNextEvent();
     if (!e) return false;
-    dynhet::run_info_t run;
-    dynhet::sim_status_t sim;
-    dynhet::frame_chunk_t chunk;
-    if (e->channel == dynhet::kChanRun && decode(*e, run)) take_run(run);
-    if (e->channel == dynhet::kChanSimStatus && decode(*e, sim)) take_sim(sim);
-    if (e->channel == dynhet::kChanFrame && rec_.keep_frames() && decode(*e, chunk))
-      rec_.on_frame_chunk(chunk);
+    if (e->channel == dynhet::kChanRun)
+      take_bytes<dynhet::run_info_t, &Session::take_run>(e->data, e->datalen, e->channel);
+    if (e->channel == dynhet::kChanSimStatus)
+      take_bytes<dynhet::sim_status_t, &Session::take_sim>(e->data, e->datalen, e->channel);
+    if (e->channel == dynhet::kChanFrame && rec_.keep_frames())
+      take_bytes<dynhet::frame_chunk_t, &Session::take_frame>(e->data, e->datalen, e->channel);
   }
   return true;
 }
@@ -234,7 +254,10 @@ int list_nodes(const std::string &log_path) {
   }
   while (const lcm::LogEvent *e = log.readNextEvent()) {
     dynhet::run_info_t run;
-    if (e->channel != dynhet::kChanRun || !decode(*e, run)) continue;
+    std::string why;
+    if (e->channel != dynhet::kChanRun || !dynhet::guard::safe_decode(e->data, e->datalen, run, why) ||
+        !dynhet::run_info_problem(run).empty())
+      continue;
     std::string line;
     for (const std::string &n : dynhet::nodes_for(run.observables)) line += (line.empty() ? "" : " ") + n;
     std::printf("%s\n", line.c_str());
@@ -260,6 +283,7 @@ int main(int argc, char **argv) {
                  "last result or node progress), and for a silent sim")
       ->capture_default_str();
   app.add_option("--wait-run", o.wait_run, "seconds to wait for the run info")->capture_default_str();
+  app.add_option("--run-id", o.run_id, "record only this run (default: the first one seen)");
   app.add_option("--list-nodes", list_log,
                  "print the analysis nodes the run in this lcm-logger log needs, and exit");
   CLI11_PARSE(app, argc, argv);

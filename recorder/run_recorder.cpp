@@ -45,6 +45,7 @@ bool RunRecorder::on_run(const run_info_t &m) {
   if (info_) return false;
   writer_ = std::make_unique<H5mdWriter>(out_path_, "dynhet recorder", creator_version_);
   info_ = std::make_unique<run_info_t>(m);
+  assembler_.expect(m.n_particles, m.n_frames, m.chunk_particles);
   writer_->set_auto_flush(false); // one flush per message, in guarded()
   completion_ = Completion(m.observables, m.cutoff_a);
   write_run_info(m);
@@ -85,7 +86,9 @@ void RunRecorder::write_run_info(const run_info_t &m) {
 bool RunRecorder::on_sim_status(const sim_status_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
   if (sim_.take(m, m.phase)) guarded("sim status", [&] { write_sim(m); });
-  if (ended(m.phase) && !completion_.sim_ended()) sim_ended(m);
+  // The frames kept are counted at the end (finish), not at a "done": a
+  // forged one must not close the recorder's frames while the sim goes on.
+  if (ended(m.phase) && m.frames_published > 0) frames_published_ = m.frames_published;
   completion_.sim_phase(m.phase, m.message);
   return true;
 }
@@ -109,9 +112,9 @@ void RunRecorder::write_sim(const sim_status_t &m) {
 
 // All chunks the sim sent before saying it ended have been handled by
 // now, so frames still incomplete are lost.
-void RunRecorder::sim_ended(const sim_status_t &m) {
+void RunRecorder::count_frames() {
   if (!info_->keep_frames) return;
-  const int expected = m.frames_published > 0 ? m.frames_published : info_->n_frames;
+  const int expected = frames_published_ > 0 ? frames_published_ : info_->n_frames;
   assembler_.finish(expected);
   completion_.frames(assembler_.frames_lost(), expected);
 }
@@ -418,7 +421,12 @@ bool RunRecorder::on_frame_chunk(const frame_chunk_t &m) {
   if (m.n_values != 2 * m.count || static_cast<int>(m.position.size()) != m.n_values) return false;
   const ChunkHeader h{m.frame_index, m.time,           m.n_particles, m.chunk_index,
                       m.chunk_count, m.first_particle, m.count};
+  const int64_t bad = assembler_.chunks_malformed();
   std::optional<Frame> f = assembler_.add(h, m.position.data());
+  if (assembler_.chunks_malformed() > bad) {
+    message_rejected("DYNHET_FRAME", "a chunk that is not one of this run's, or non-finite positions");
+    return false;
+  }
   if (f) guarded("frame", [&] { writer_->append_frame(f->index, f->time, f->position); });
   return true;
 }
@@ -432,6 +440,7 @@ std::vector<std::string> RunRecorder::finish(const std::string &reason) {
   for (auto &[key, n] : nodes_)
     if (n.thin.held) guarded("node status", [&] { write_node(*n.thin.held); });
 
+  count_frames();
   for (const std::string &m : completion_.missing()) missing.push_back(m);
   if (write_errors_ > 0) missing.push_back(std::to_string(write_errors_) + " failed writes");
   write_summary(missing);
@@ -446,6 +455,8 @@ void RunRecorder::write_summary(const std::vector<std::string> &missing) {
     writer_->set_attribute("", "run_id", info_->run_id);
     writer_->set_attribute("", "sim_phase", completion_.phase());
     if (info_->keep_frames) writer_->set_attribute("", "frames_lost_recorder", assembler_.frames_lost());
+    writer_->set_attribute("", "messages_rejected_recorder", rejected_);
+    writer_->set_attribute("", "last_rejection_recorder", last_rejection_);
     for (const auto &[key, n] : nodes_) {
       const node_status_t &s = n.latest;
       const std::string g = "observables/nodes/" + key;
@@ -456,6 +467,9 @@ void RunRecorder::write_summary(const std::vector<std::string> &missing) {
       writer_->set_attribute(g, "frames_whole", s.frames_whole);
       writer_->set_attribute(g, "frames_lost", s.frames_lost);
       writer_->set_attribute(g, "chunks_received", s.chunks_received);
+      writer_->set_attribute(g, "messages_rejected", s.messages_rejected);
+      writer_->set_attribute(g, "chunks_rejected", s.chunks_rejected);
+      writer_->set_attribute(g, "last_rejection", s.last_rejection);
     }
   });
 }

@@ -78,6 +78,13 @@ public:
   bool on_clusters(const clusters_t &m);
   bool on_displacement(const displacement_t &m);
   bool on_frame_chunk(const frame_chunk_t &m);
+  // A message dropped as malformed or inconsistent (by the caller or here):
+  // counted, the last reason kept, both written to the file's summary.
+  void message_rejected(const std::string &channel, const std::string &why) {
+    ++rejected_;
+    last_rejection_ = channel + ": " + why;
+  }
+  int64_t messages_rejected() const { return rejected_; }
 
   bool has_run() const { return info_ != nullptr; }
   int64_t run_id() const { return info_ ? info_->run_id : 0; }
@@ -111,6 +118,9 @@ private:
   bool msd_started_ = false, displacement_started_ = false;
   std::optional<int64_t> node_clock_zero_;      // utime of the first node status
   int write_errors_ = 0;
+  int64_t rejected_ = 0;
+  int frames_published_ = 0; // from the sim's last "done" or "failed"
+  std::string last_rejection_;
 
   void write_run_info(const run_info_t &m);
   void write_sim(const sim_status_t &m);
@@ -122,7 +132,7 @@ private:
   void write_clusters(const clusters_t &m);
   void write_displacement(const displacement_t &m);
   void write_summary(const std::vector<std::string> &missing);
-  void sim_ended(const sim_status_t &m);
+  void count_frames();
   template <class F> void guarded(const char *what, F &&write);
 };
 

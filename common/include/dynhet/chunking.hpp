@@ -41,6 +41,12 @@ public:
   // is given up as lost.
   explicit FrameAssembler(int reorder_window = 1) : window_(reorder_window) {}
 
+  // The run the chunks belong to (from its run info): from now on a chunk
+  // is taken only if it is exactly one of the run's chunks (its N, a frame
+  // index below n_frames, the chunk count and the particle range
+  // chunk_ranges gives) with finite positions; anything else is malformed.
+  void expect(int n_particles, int n_frames, int chunk_particles);
+
   // Adds one chunk (positions of header.count particles). Returns the frame
   // when this chunk completes it. Malformed chunks are counted and dropped.
   std::optional<Frame> add(const ChunkHeader& h, const double* position);
@@ -61,6 +67,7 @@ private:
     int missing;
   };
   int window_;
+  int n_ = 0, frames_ = 0, per_chunk_ = 0, chunks_per_frame_ = 0; // expect(); 0: not known
   std::map<int, Pending> pending_;
   std::vector<bool> done_; // frame index -> completed or given up
   int whole_ = 0, lost_ = 0;

@@ -1,0 +1,74 @@
+#!/usr/bin/env bash
+# Every LCM message is untrusted input. In a private network namespace:
+# 1. a clean tiny run (run_scene.sh, run id 4242);
+# 2. the same scene as run 4243 while tests/hostile_publisher.cpp sends
+#    every class of bad message for it (random bytes after each type's
+#    fingerprint on every channel, impossible array lengths, run info with
+#    indices out of range, chunks that overflow, size a frame at 2^30
+#    particles, frames of 1 particle, 2^24 chunks, NaN positions, another
+#    run's run info, chunks and "done", and a forged "done" of this run):
+#    no process dies, the run is complete, every node and the recorder
+#    count what they dropped, and the results equal the clean run's bit
+#    for bit;
+# 3. two runs at once on one bus (the tiny scene and the same with another
+#    seed): both complete, the first equal to the clean run bit for bit.
+set -euo pipefail
+root=$1 build=$2 hostile=$3
+if [[ -z ${DYNHET_IN_NETNS:-} ]]; then exec "$root/launch_scripts/netns.sh" bash "$0" "$@"; fi
+export BUILD_DIR=$build
+export LCM_DEFAULT_URL='udpm://239.255.76.67:7695?ttl=0'
+tmp=$(mktemp -d)
+trap 'kill $(jobs -p) 2>/dev/null || true; [[ -n ${KEEP_TMP:-} ]] && echo "kept $tmp" || rm -rf "$tmp"' EXIT
+run=(bash "$root/launch_scripts/run_scene.sh" --no-build)
+fail=0
+check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
+py=/usr/bin/python3
+same() { # run.h5 A, run.h5 B: the final results equal bit for bit
+  PYTHONPATH="$root/tests" $py -c "
+import sys
+from compare_runs import final_results, same
+(a, la), (b, lb) = final_results(sys.argv[1]), final_results(sys.argv[2])
+sys.exit(0 if same(a, b) and la == lb == 0 and len(a) > 50 else 1)" "$1" "$2"
+}
+complete() { $py -c "import h5py, sys; sys.exit(0 if int(h5py.File(sys.argv[1], 'r').attrs['complete']) == 1 else 1)" "$1"; }
+
+"${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/clean" --run-id 4242 >"$tmp/clean.log" 2>&1 ||
+  { tail -20 "$tmp/clean.log"; exit 1; }
+check 'complete "$tmp/clean/run.h5"' "clean run complete"
+
+"$hostile" "$LCM_DEFAULT_URL" 4243 60 --forge-done >"$tmp/hostile.log" 2>&1 &
+hp=$!
+sleep 0.5
+"${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/attacked" --run-id 4243 >"$tmp/attacked.log" 2>&1 && rc=0 || rc=$?
+kill $hp 2>/dev/null || true
+check '[[ $rc == 0 ]]' "attacked run: run_scene.sh exits 0 (got $rc)"
+for p in sim_node overlap_node s4_node clusters_node recorder; do
+  check '! grep -qiE "terminate called|Aborted|Segmentation|core dumped|bad_alloc|length_error" "$tmp/attacked/$p.log"' \
+    "attacked run: $p did not crash"
+done
+check 'complete "$tmp/attacked/run.h5"' "attacked run: complete"
+check 'same "$tmp/clean/run.h5" "$tmp/attacked/run.h5"' "attacked run: results equal the clean run's bit for bit"
+$py - "$tmp/attacked/run.h5" >"$tmp/counts.txt" <<'PY' || true
+import h5py, sys
+f = h5py.File(sys.argv[1], "r")
+print("recorder", int(f.attrs["messages_rejected_recorder"]), f.attrs["last_rejection_recorder"])
+for n, g in f["observables/nodes"].items():
+    print(n, int(g.attrs["messages_rejected"]), int(g.attrs["chunks_rejected"]), g.attrs["last_rejection"])
+PY
+cat "$tmp/counts.txt"
+check '[[ $(awk "\$1 == \"recorder\" && \$2 > 100" "$tmp/counts.txt" | wc -l) == 1 ]]' "the recorder counted the bad messages it dropped"
+check '[[ $(awk "\$1 != \"recorder\" && \$2 > 50 && \$3 > 10" "$tmp/counts.txt" | wc -l) == 3 ]]' \
+  "each of the 3 nodes counted the bad messages and chunks it dropped"
+
+# Two runs at once on one bus.
+sed 's/^seed = 7/seed = 8/' "$root/scenes/tiny.toml" >"$tmp/tiny8.toml"
+"${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/two_a" --run-id 5001 >"$tmp/two_a.log" 2>&1 &
+pa=$!
+"${run[@]}" "$tmp/tiny8.toml" --out "$tmp/two_b" --run-id 5002 >"$tmp/two_b.log" 2>&1 && rb=0 || rb=$?
+wait $pa && ra=0 || ra=$?
+check '[[ $ra == 0 && $rb == 0 ]] && complete "$tmp/two_a/run.h5" && complete "$tmp/two_b/run.h5"' \
+  "two runs at once on one bus: both complete (exits $ra, $rb)"
+check 'same "$tmp/clean/run.h5" "$tmp/two_a/run.h5"' "two runs at once: the first equals the clean run bit for bit"
+check '! same "$tmp/two_a/run.h5" "$tmp/two_b/run.h5"' "two runs at once: the second has its own results"
+((fail == 0)) || { tail -5 "$tmp"/*.log; for f in "$tmp"/attacked/*.log; do echo "== $f"; tail -3 "$f"; done; }
+exit $fail

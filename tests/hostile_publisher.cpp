@@ -1,0 +1,171 @@
+// A hostile publisher on dynhet's channels, for tests/hostile.sh: for
+// `seconds` it sends, in rounds, every class of bad message a process on
+// the bus could send to the run `run_id`:
+//   - random bytes after each type's valid fingerprint, on its channel;
+//   - arrays declaring a negative or a huge length (2^31 - 1) in a short
+//     message;
+//   - run info of this run with frame indices out of range;
+//   - chunks of this run whose first particle is near 2^31 (int overflow),
+//     that declare N = 2^30, frames of 1 particle, 2^24 chunks per frame,
+//     or NaN positions;
+//   - messages of another run (run info, chunks, a "done" status).
+// Every one of them must be dropped (and counted) by every receiver; the
+// run's results must equal a clean run's bit for bit. With --forge-done it
+// also sends a well-formed "done" status of this run (a forgery no check
+// can tell from the sim's), which must not end a node before its frames.
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <random>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <lcm/lcm-cpp.hpp>
+
+#include "dynhet/chi4_t.hpp"
+#include "dynhet/clusters_t.hpp"
+#include "dynhet/displacement_t.hpp"
+#include "dynhet/frame_chunk_t.hpp"
+#include "dynhet/msd_t.hpp"
+#include "dynhet/node_status_t.hpp"
+#include "dynhet/overlap_t.hpp"
+#include "dynhet/run_info_t.hpp"
+#include "dynhet/s4_t.hpp"
+#include "dynhet/sim_status_t.hpp"
+
+namespace {
+
+// Big-endian writer for hand-made encodings.
+struct Bytes {
+  std::vector<uint8_t> b;
+  void i64(int64_t v) {
+    for (int s = 56; s >= 0; s -= 8) b.push_back(static_cast<uint8_t>(uint64_t(v) >> s));
+  }
+  void i32(int32_t v) {
+    for (int s = 24; s >= 0; s -= 8) b.push_back(static_cast<uint8_t>(uint32_t(v) >> s));
+  }
+  void f64(double v) {
+    int64_t u;
+    std::memcpy(&u, &v, 8);
+    i64(u);
+  }
+};
+
+template <class T> void random_after_fingerprint(lcm::LCM& lcm, const char* ch, std::mt19937_64& gen) {
+  Bytes m;
+  m.i64(T::getHash());
+  const int n = static_cast<int>(gen() % 400);
+  for (int i = 0; i < n; ++i) m.b.push_back(static_cast<uint8_t>(gen()));
+  lcm.publish(ch, m.b.data(), static_cast<unsigned>(m.b.size()));
+}
+
+// A frame chunk header of run `run`, then n_values as declared and `have`
+// positions actually present.
+void chunk(lcm::LCM& lcm, int64_t run, int frame, int n_particles, int index, int count_chunks, int first,
+           int count, int32_t n_values, int have, double value) {
+  Bytes m;
+  m.i64(dynhet::frame_chunk_t::getHash());
+  m.i64(0);
+  m.i64(run);
+  m.i32(frame);
+  m.f64(1.0);
+  m.i32(n_particles);
+  m.i32(index);
+  m.i32(count_chunks);
+  m.i32(first);
+  m.i32(count);
+  m.i32(n_values);
+  for (int i = 0; i < have; ++i) m.f64(value);
+  lcm.publish("DYNHET_FRAME", m.b.data(), static_cast<unsigned>(m.b.size()));
+}
+
+dynhet::run_info_t bad_run_info(int64_t run) {
+  dynhet::run_info_t m{};
+  m.run_id = run;
+  m.n_particles = 300;
+  m.box_length = 30;
+  m.packing_fraction = 0.6;
+  m.restitution = 0.9;
+  m.radius[0] = 1, m.radius[1] = 1.43, m.mass[0] = 1, m.mass[1] = 2.04;
+  m.n_small = 150;
+  m.n_frames = 3;
+  m.frame_time = {0, 1, 2};
+  m.n_origins = 1;
+  m.origin_frame = {1000000}; // out of range
+  m.n_lags = 2;
+  m.lag_time = {1, 2};
+  m.n_pairs = 2;
+  m.pair_frame = {1, 2000000}; // out of range
+  m.n_cutoffs = 1;
+  m.cutoff_a = {0.6};
+  m.n_observables = 1;
+  m.observables = {"overlap"};
+  m.overlap_subbox_particles = 30;
+  m.n_chi4_sizes = 0;
+  m.chunk_particles = 128;
+  return m;
+}
+
+} // namespace
+
+int main(int argc, char** argv) {
+  if (argc < 4) {
+    std::fprintf(stderr, "usage: hostile_publisher URL RUN_ID SECONDS [--forge-done]\n");
+    return 2;
+  }
+  lcm::LCM lcm(argv[1]);
+  if (!lcm.good()) return 3;
+  const int64_t run = std::stoll(argv[2]);
+  const double seconds = std::stod(argv[3]);
+  const bool forge_done = argc > 4 && std::string(argv[4]) == "--forge-done";
+  std::mt19937_64 gen(12345);
+  const auto t0 = std::chrono::steady_clock::now();
+  long rounds = 0;
+  const double nan = std::nan("");
+  while (std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < seconds) {
+    random_after_fingerprint<dynhet::run_info_t>(lcm, "DYNHET_RUN", gen);
+    random_after_fingerprint<dynhet::frame_chunk_t>(lcm, "DYNHET_FRAME", gen);
+    random_after_fingerprint<dynhet::sim_status_t>(lcm, "DYNHET_SIM_STATUS", gen);
+    random_after_fingerprint<dynhet::node_status_t>(lcm, "DYNHET_NODE_STATUS", gen);
+    random_after_fingerprint<dynhet::overlap_t>(lcm, "DYNHET_OVERLAP", gen);
+    random_after_fingerprint<dynhet::chi4_t>(lcm, "DYNHET_CHI4", gen);
+    random_after_fingerprint<dynhet::msd_t>(lcm, "DYNHET_MSD", gen);
+    random_after_fingerprint<dynhet::s4_t>(lcm, "DYNHET_S4", gen);
+    random_after_fingerprint<dynhet::clusters_t>(lcm, "DYNHET_CLUSTERS", gen);
+    random_after_fingerprint<dynhet::displacement_t>(lcm, "DYNHET_DISPLACEMENT", gen);
+    // Declared lengths the message cannot hold: negative, and 2^31 - 1.
+    chunk(lcm, run, 0, 300, 0, 3, 0, 128, -5, 0, 0.0);
+    chunk(lcm, run, 0, 300, 0, 3, 0, 128, 0x7fffffff, 4, 0.0);
+    // Chunk headers against the run: int overflow, N = 2^30, 1-particle
+    // frames, 2^24 chunks, NaN positions.
+    chunk(lcm, run, 1, 300, 0, 3, 0x7fffff00, 128, 256, 256, 1.0);
+    chunk(lcm, run, 1, 1 << 30, 0, 1, 0, 2, 4, 4, 1.0);
+    chunk(lcm, run, 2, 1, 0, 1, 0, 1, 2, 2, 1.0);
+    chunk(lcm, run, 3, 300, 5, 1 << 24, 640, 2, 4, 4, 1.0);
+    chunk(lcm, run, 4, 300, 0, 3, 0, 128, 256, 256, nan);
+    // Run info of this run with indices out of range.
+    dynhet::run_info_t bad = bad_run_info(run);
+    lcm.publish("DYNHET_RUN", &bad);
+    // Another run: its run info, a chunk and a "done".
+    dynhet::run_info_t other = bad_run_info(run + 1);
+    other.origin_frame = {0};
+    other.pair_frame = {1, 2};
+    lcm.publish("DYNHET_RUN", &other);
+    chunk(lcm, run + 1, 0, 300, 0, 3, 0, 128, 256, 256, 1.0);
+    dynhet::sim_status_t done{};
+    done.run_id = run + 1;
+    done.phase = "done";
+    lcm.publish("DYNHET_SIM_STATUS", &done);
+    if (forge_done) {
+      done.run_id = run;
+      lcm.publish("DYNHET_SIM_STATUS", &done);
+    }
+    ++rounds;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  std::printf("hostile_publisher: %ld rounds of %d bad messages\n", rounds, forge_done ? 20 : 19);
+  return 0;
+}
