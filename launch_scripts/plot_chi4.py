@@ -8,7 +8,7 @@ import math
 import sys
 
 import h5py
-from plot_common import cli
+from plot_common import cli, save
 import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
 import numpy as np
 
@@ -38,7 +38,7 @@ def main(path, png):
             ax.set_title(f"a = {g.attrs.get('cutoff_a', name)} (star: peak at $\\tau_4$)", fontsize=10)
             ax.legend(fontsize=7)
         fig.tight_layout()
-        fig.savefig(png, dpi=120)
+        save(fig, f, png, 120)
     print(f"plot_chi4: wrote {png}", file=sys.stderr)
     return 0
 

@@ -11,7 +11,7 @@ import math
 import sys
 
 import h5py
-from plot_common import cli, last
+from plot_common import cli, last, save
 import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
 import numpy as np
 
@@ -113,7 +113,7 @@ def main(path, png):
             plot_lags(row[3], g)
             row[0].text(0.02, 0.95, name, transform=row[0].transAxes, va="top", fontsize=10, weight="bold")
         fig.tight_layout()
-        fig.savefig(png, dpi=110)
+        save(fig, f, png, 110)
     print(f"plot_clusters: wrote {png}", file=sys.stderr)
     return 0
 

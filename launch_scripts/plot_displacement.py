@@ -16,6 +16,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from plot_common import save  # noqa: E402
 
 
 def last(g, key):
@@ -67,7 +68,7 @@ def main(path, png):
             ax.legend(fontsize=6)
         axes[0].set_ylabel(r"$P(\Delta x, t)$")
         fig.tight_layout()
-        fig.savefig(png, dpi=120)
+        save(fig, f, png, 120)
     print(f"plot_displacement: wrote {png}", file=sys.stderr)
     return 0
 

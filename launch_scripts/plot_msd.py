@@ -10,7 +10,7 @@ import math
 import sys
 
 import h5py
-from plot_common import cli
+from plot_common import cli, save
 import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
 import numpy as np
 
@@ -44,7 +44,7 @@ def main(path, png):
         ax.set_ylabel(r"$\Delta(t)$")
         ax.legend(fontsize=8)
         fig.tight_layout()
-        fig.savefig(png, dpi=120)
+        save(fig, f, png, 120)
     print(f"plot_msd: wrote {png}", file=sys.stderr)
     return 0
 

@@ -9,7 +9,7 @@ import math
 import sys
 
 import h5py
-from plot_common import cli, last
+from plot_common import cli, last, save
 import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
 import numpy as np
 
@@ -58,7 +58,7 @@ def main(path, png):
         ax2.set_title("aging check: flat if stationary", fontsize=10)
         ax2.legend(fontsize=8)
         fig.tight_layout()
-        fig.savefig(png, dpi=120)
+        save(fig, f, png, 120)
     print(f"plot_overlap: wrote {png}", file=sys.stderr)
     return 0
 

@@ -11,7 +11,7 @@ import math
 import sys
 
 import h5py
-from plot_common import cli, last
+from plot_common import cli, last, save
 import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
 import numpy as np
 
@@ -85,7 +85,7 @@ def main(path, png):
             for ax in row[ng + 1:]:
                 ax.set_visible(False)
         fig.tight_layout()
-        fig.savefig(png, dpi=120)
+        save(fig, f, png, 120)
     print(f"plot_s4: wrote {png}", file=sys.stderr)
     return 0
 

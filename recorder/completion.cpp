@@ -44,6 +44,10 @@ void Completion::sim_phase(const std::string &phase, const std::string &message)
 
 void Completion::node_state(const std::string &node, const std::string &state) { node_state_[node] = state; }
 
+void Completion::node_frames(const std::string &node, int whole, int lost, int expected) {
+  node_frames_[node] = {whole, lost, expected};
+}
+
 void Completion::frames(int lost, int expected) {
   frames_lost_ = lost;
   frames_expected_ = expected;
@@ -81,6 +85,12 @@ std::vector<std::string> Completion::missing() const {
   }
   for (const std::string &f : expected_finals_)
     if (!finals_.count(f)) out.push_back(f + ": no final result");
+  // Every result from every frame: a node that lost or never completed a
+  // frame computed its results from fewer.
+  for (const auto &[node, fr] : node_frames_)
+    if (fr.lost > 0 || fr.whole < fr.expected)
+      out.push_back(node + " node: " + std::to_string(fr.whole) + " of " + std::to_string(fr.expected) +
+                    " frames whole, " + std::to_string(fr.lost) + " lost");
   if (frames_lost_ > 0)
     out.push_back("frames: " + std::to_string(frames_lost_) + " of " + std::to_string(frames_expected_) +
                   " lost by the recorder");

@@ -23,6 +23,9 @@ public:
 
   void sim_phase(const std::string &phase, const std::string &message);
   void node_state(const std::string &node, const std::string &state);
+  // A node's frame counts from its last status: a node that did not
+  // reassemble every frame the sim published makes the file incomplete.
+  void node_frames(const std::string &node, int whole, int lost, int expected);
   // A final result of `observable` ("overlap", "chi4", "clusters", "s4") for
   // one cutoff, or of one with a single final result ("msd" and
   // "displacement", which do not depend on the cutoff; cutoff ignored).
@@ -49,6 +52,10 @@ private:
   std::vector<std::string> expected_finals_; // "overlap a0.6", ...
   std::string phase_ = "unknown", sim_message_;
   std::map<std::string, std::string> node_state_;
+  struct Frames {
+    int whole = 0, lost = 0, expected = 0;
+  };
+  std::map<std::string, Frames> node_frames_;
   std::set<std::string> finals_;
   int frames_lost_ = 0, frames_expected_ = 0;
 

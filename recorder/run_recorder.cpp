@@ -53,6 +53,12 @@ bool RunRecorder::on_run(const run_info_t &m) {
 }
 
 void RunRecorder::write_run_info(const run_info_t &m) {
+  // Incomplete from the start: a recorder killed before finish() leaves a
+  // file that says so (finish() overwrites both).
+  guarded("summary", [&] {
+    writer_->set_attribute("", "complete", int32_t{0});
+    writer_->set_attribute("", "missing", std::string("the recorder did not finish the file (killed?)"));
+  });
   guarded("parameters", [&] { writer_->write_parameters(m.scene_toml); });
   guarded("particles", [&] {
     const auto sp = dynhet::species_by_rule(m.n_particles, m.n_small);
@@ -126,6 +132,7 @@ bool RunRecorder::on_node_status(const node_status_t &m) {
                         m.frames_whole != n.latest.frames_whole || m.pairs_done != n.latest.pairs_done;
   n.latest = m;
   completion_.node_state(m.node, m.state);
+  completion_.node_frames(m.node, m.frames_whole, m.frames_lost, m.frames_expected);
   if (n.thin.take(m, m.state)) guarded("node status", [&] { write_node(m); });
   return progress;
 }

@@ -302,4 +302,30 @@ TEST(RunRecorder, FailedSimSettlesButIsIncomplete) {
   std::remove(path.c_str());
 }
 
+// complete means complete: a node that says done but lost a frame (or
+// never completed one) computed its results from fewer frames: the file
+// is incomplete and says which node and how many. A "done" of the sim
+// followed by a live status (a forgery, then the sim's own) is not the end.
+TEST(RunRecorder, ANodeThatLostFramesMakesTheFileIncomplete) {
+  const std::string path = temp_file("lost");
+  dynhet::RunRecorder rec(path, "test");
+  ASSERT_TRUE(rec.on_run(run_info()));
+  rec.on_sim_status(sim(0.5, "done", 0.5)); // forged, early
+  EXPECT_TRUE(rec.completion().sim_ended());
+  rec.on_sim_status(sim(0.9, "production", 0.9)); // the sim goes on
+  EXPECT_FALSE(rec.completion().sim_ended());
+  rec.on_sim_status(sim(1.0, "done", 100));
+  for (double a : {0.6, 1.8}) rec.on_overlap(overlap(a, true, 2));
+  auto n = node(1.5, "done", 2);
+  n.frames_lost = 1;
+  rec.on_node_status(n);
+  EXPECT_TRUE(rec.completion().settled());
+  const auto missing = rec.finish();
+  std::string all;
+  for (const auto& m : missing) all += m + "; ";
+  EXPECT_NE(all.find("overlap node: 2 of 3 frames whole, 1 lost"), std::string::npos) << all;
+  EXPECT_EQ(all.find("sim:"), std::string::npos) << all; // the sim's own "done" stands
+  std::remove(path.c_str());
+}
+
 } // namespace
