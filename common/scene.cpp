@@ -1,4 +1,6 @@
 #include "dynhet/scene.hpp"
+
+#include <charconv>
 #include "dynhet/subbox.hpp"
 
 #include <algorithm>
@@ -29,13 +31,18 @@ const char* type_name(const toml::node& n) {
   }
 }
 
+// A number as the shortest text that reads back as the same double (0.9,
+// 1.0000000000000002, 1e+300): what the file says, never rounded away.
+std::string num(double v) {
+  char buf[64];
+  const auto r = std::to_chars(buf, buf + sizeof buf, v);
+  return std::string(buf, r.ptr);
+}
+
 std::string show(const toml::node& n) {
   std::ostringstream s;
   if (n.is_table()) return "{...}";
-  if (auto d = n.value_exact<double>()) {
-    s << std::setprecision(12) << *d; // 0.9, not 0.90000000000000002
-    return s.str();
-  }
+  if (auto d = n.value_exact<double>()) return num(*d);
   n.visit([&](auto&& v) { s << v; });
   return s.str();
 }
@@ -69,8 +76,18 @@ public:
     return false;
   }
   bool get_double(const std::string& key, const toml::node& n, double& out) {
-    if (n.is_integer() || n.is_floating_point()) {
-      out = *n.value<double>();
+    if (n.is_integer()) {
+      // An integer beyond 2^53 has no exact double: refused, not rounded.
+      const int64_t i = *n.value_exact<int64_t>();
+      if (i > (int64_t{1} << 53) || i < -(int64_t{1} << 53)) {
+        bad_value(key, n, "an integer beyond 2^53 is not exactly a number here; write it as a float (1e18)");
+        return false;
+      }
+      out = static_cast<double>(i);
+      return true;
+    }
+    if (n.is_floating_point()) {
+      out = *n.value_exact<double>();
       if (std::isfinite(out)) return true;
       bad_value(key, n, "it must be a finite number");
       return false;
@@ -470,53 +487,81 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
   // Relations between keys.
   const auto& sch = s.schedule;
   if (sch.lag_min >= sch.lag_max)
-    c.fail("schedule.lag_min", "value " + std::to_string(sch.lag_min) +
+    c.fail("schedule.lag_min", "value " + num(sch.lag_min) +
                                    " must be smaller than schedule.lag_max = " +
-                                   std::to_string(sch.lag_max));
-  // Every (origin, lag) pair is a frame to publish and a pass to make.
+                                   num(sch.lag_max));
+  // Every (origin, lag) pair is a frame to publish and a pass to make, and
+  // the run info carries them all (4 bytes each, in one LCM message).
   const double n_lags = std::floor(std::log10(sch.lag_max / sch.lag_min) * sch.lags_per_decade) + 2;
-  if (sch.lag_min < sch.lag_max && sch.origins * n_lags > 2e7)
+  if (sch.lag_min < sch.lag_max && sch.origins * n_lags > 1e6)
     c.fail("schedule", "origins x lags = " + std::to_string(sch.origins) + " x " +
                            std::to_string(static_cast<long>(n_lags)) +
-                           " pairs is more than 2e7; use fewer origins or lags per decade");
+                           " pairs is more than 10^6 (the run info could not carry them); use fewer origins "
+                           "or lags per decade");
   const double needed = (sch.origins - 1) * sch.origin_spacing + sch.lag_max;
   if (s.production_time < 0) {
     s.production_time = needed;
   } else if (s.production_time < needed * (1 - 1e-12)) {
     c.fail("run.production_time",
-           "value " + std::to_string(s.production_time) + " is shorter than the schedule needs: " +
-               "(origins - 1) * origin_spacing + lag_max = " + std::to_string(needed));
+           "value " + num(s.production_time) + " is shorter than the schedule needs: " +
+               "(origins - 1) * origin_spacing + lag_max = " + num(needed));
   }
   const Model m = make_model(s.n_particles, s.packing_fraction, s.radius_ratio);
   const double min_box = 3 * 2 * std::max(m.radius[0], m.radius[1]);
   if (m.box_length < min_box)
     c.fail("system.n_particles",
            "value " + std::to_string(s.n_particles) + " is too small at this packing fraction: " +
-               "the box side " + std::to_string(m.box_length) +
-               " must hold 3 cells of the largest diameter (" + std::to_string(min_box) + ")");
+               "the box side " + num(m.box_length) +
+               " must hold 3 cells of the largest diameter (" + num(min_box) + ")");
   // The NUFFT grid must resolve q_max (Nyquist: h < pi / q_max).
   if (s.s4_grid_spacing > 0 && s.s4_grid_spacing * s.s4_q_max >= 3.14159265358979)
-    c.fail("s4.grid_spacing", "value " + std::to_string(s.s4_grid_spacing) +
-                                  " is too coarse for s4.q_max = " + std::to_string(s.s4_q_max) +
+    c.fail("s4.grid_spacing", "value " + num(s.s4_grid_spacing) +
+                                  " is too coarse for s4.q_max = " + num(s.s4_q_max) +
                                   "; allowed: 0 (the default, pi / (2 q_max)) or spacing < pi / q_max");
   for (double t : s.s4_lags)
     if (t < sch.lag_min * (1 - 1e-12) || t > sch.lag_max * (1 + 1e-12))
-      c.fail("s4.lags", "value " + std::to_string(t) + " is outside the scheduled lags [" +
-                            std::to_string(sch.lag_min) + ", " + std::to_string(sch.lag_max) + "]");
+      c.fail("s4.lags", "value " + num(t) + " is outside the scheduled lags [" +
+                            num(sch.lag_min) + ", " + num(sch.lag_max) + "]");
   if (cl.cutoff_frames > sch.origins)
     c.fail("clusters.cutoff_frames", "value " + std::to_string(cl.cutoff_frames) +
                                          " is more than the schedule's origins (" +
                                          std::to_string(sch.origins) + ")");
   if (cl.gr_r_max > m.box_length / 2)
-    c.fail("clusters.gr_r_max", "value " + std::to_string(cl.gr_r_max) + " is more than half the box side (" +
-                                    std::to_string(m.box_length / 2) + ")");
+    c.fail("clusters.gr_r_max", "value " + num(cl.gr_r_max) + " is more than half the box side (" +
+                                    num(m.box_length / 2) + ")");
+  if (cl.gr_r_max / cl.gr_bin > 1e5)
+    c.fail("clusters.gr_bin", "value " + num(cl.gr_bin) + " makes more than 10^5 bins below clusters.gr_r_max = " +
+                                  num(cl.gr_r_max));
+  // The whole box's NUFFT grid: L / h points per side, h the spacing.
+  if (s.wants("s4")) {
+    const double h = s.s4_grid_spacing > 0 ? s.s4_grid_spacing : 3.14159265358979 / (2 * s.s4_q_max);
+    if (m.box_length / h > 8192)
+      c.fail(s.s4_grid_spacing > 0 ? "s4.grid_spacing" : "s4.q_max",
+             "makes a NUFFT grid of " + num(std::ceil(m.box_length / h)) +
+                 " points per box side (more than 8192); allowed: grid_spacing >= box side / 8192 = " +
+                 num(m.box_length / 8192) + ", q_max <= " + num(8192 * 3.14159265358979 / (2 * m.box_length)));
+  }
+  // Kicks so frequent that simulated time hardly moves.
+  if (s.driving && s.restitution < 1 && scene_kick_rate(s) > 1e4)
+    c.fail("driving.kick_rate", "value " + num(scene_kick_rate(s)) +
+                                    " kicks per particle per unit time is more than 10^4: the clock would "
+                                    "hardly move (the Enskog rate, the default, is about 1-100)");
+  // Inelastic collapse: without the TC model, strongly inelastic disks
+  // collide infinitely often in finite time.
+  if (s.restitution < 0.3 && s.tc_time <= 0)
+    c.fail("system.restitution", "value " + num(s.restitution) +
+                                     " below 0.3 needs the TC model (system.tc_time > 0): without it "
+                                     "inelastic collapse stops the clock");
+  if ((s.equilibration_time + s.production_time) / s.checkpoint_interval > 1e6)
+    c.fail("run.checkpoint_interval", "value " + num(s.checkpoint_interval) +
+                                          " makes more than 10^6 checkpoints (and synchronisations) in the run");
   if (cl.gr_bin * 10 > cl.gr_r_max)
-    c.fail("clusters.gr_bin", "value " + std::to_string(cl.gr_bin) +
+    c.fail("clusters.gr_bin", "value " + num(cl.gr_bin) +
                                   " leaves fewer than 10 bins below clusters.gr_r_max = " +
-                                  std::to_string(cl.gr_r_max));
+                                  num(cl.gr_r_max));
   if (const auto& r = cl.neighbour_cutoffs; !r.empty() && *std::max_element(r.begin(), r.end()) * 3 > m.box_length)
     c.fail("clusters.neighbour_cutoffs", "the largest cutoff must be under a third of the box side (" +
-                                             std::to_string(m.box_length / 3) + ")");
+                                             num(m.box_length / 3) + ")");
   if (const auto& p = cl.power_law_sizes; !(p[0] >= 1 && p[0] < p[1]))
     c.fail("clusters.power_law_sizes", "[" + std::to_string(p[0]) + ", " + std::to_string(p[1]) +
                                            "] is not allowed; allowed: [lo, hi] with 1 <= lo < hi");
@@ -530,11 +575,11 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
     c.fail("displacement.lags_tau_alpha", "with displacement.lags names " + std::to_string(targets) +
                                               " lags; at most 16");
   if (!(bins >= 10 && bins <= 4000))
-    c.fail("displacement.bin_width", "value " + std::to_string(dp.bin_width) + " makes " +
+    c.fail("displacement.bin_width", "value " + num(dp.bin_width) + " makes " +
                                          std::to_string(static_cast<long>(bins)) +
                                          " bins over [-x_max, x_max); allowed: 10 to 4000 bins");
   else if (targets * dp.bins() > 4096)
-    c.fail("displacement.bin_width", "value " + std::to_string(dp.bin_width) + ": " + std::to_string(targets) +
+    c.fail("displacement.bin_width", "value " + num(dp.bin_width) + ": " + std::to_string(targets) +
                                          " lags x " + std::to_string(dp.bins()) +
                                          " bins is more than 4096 (the message would not survive UDP)");
   if (s.observables.empty())

@@ -7,27 +7,55 @@
 
 namespace dynhet {
 
-std::vector<int> nested_subbox_sides(long n_total, const std::vector<int>& targets) {
-  std::vector<int> order(targets.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return targets[a] < targets[b]; });
+namespace {
+
+bool smooth(int m) { // 2^a 3^b
+  while (m % 2 == 0) m /= 2;
+  while (m % 3 == 0) m /= 3;
+  return m == 1;
+}
+
+// The chain from a given finest side: every coarser target takes the
+// divisor of the next finer side nearest its ideal.
+std::vector<int> chain(long n_total, const std::vector<int>& targets, const std::vector<int>& order, int finest) {
   std::vector<int> sides(targets.size(), 1);
-  int finer = 0; // side of the next finer grid (0: none yet)
+  int finer = 0;
   for (int g : order) {
     const double want = std::max(1.0, std::sqrt(double(n_total) / targets[g]));
-    int best = 1;
-    // Candidates: the 2^a 3^b for the finest grid, divisors of the finer side after.
-    for (int m = 1; m <= (finer ? finer : 4 * static_cast<int>(want) + 4); ++m) {
-      int k = m;
-      while (k % 2 == 0) k /= 2;
-      while (k % 3 == 0) k /= 3;
-      const bool ok = finer ? finer % m == 0 : k == 1;
-      if (ok && std::abs(std::log(m / want)) < std::abs(std::log(best / want))) best = m;
-    }
+    int best = finer ? 1 : finest;
+    if (finer)
+      for (int m = 1; m <= finer; ++m)
+        if (finer % m == 0 && std::abs(std::log(m / want)) < std::abs(std::log(best / want))) best = m;
     finer = best;
     sides[g] = best;
   }
   return sides;
+}
+
+} // namespace
+
+std::vector<int> nested_subbox_sides(long n_total, const std::vector<int>& targets) {
+  std::vector<int> order(targets.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return targets[a] < targets[b]; });
+  if (order.empty()) return {};
+  // The finest side: the 2^a 3^b nearest its ideal among those whose chain
+  // gives no two targets (below N) the same grid, if any chain does.
+  const double want = std::max(1.0, std::sqrt(double(n_total) / targets[order[0]]));
+  std::vector<int> best;
+  double best_cost = 0, best_near = 0;
+  for (int m = 1; m <= 4 * static_cast<int>(want) + 4; ++m) {
+    if (!smooth(m)) continue;
+    const std::vector<int> sides = chain(n_total, targets, order, m);
+    double cost = 0; // targets that share a grid with another (below N)
+    for (size_t i = 0; i < targets.size(); ++i)
+      for (size_t j = 0; j < i; ++j)
+        if (sides[j] == sides[i] && targets[i] < n_total && targets[j] < n_total) cost += 1;
+    const double near = std::abs(std::log(m / want));
+    if (best.empty() || cost < best_cost - 1e-12 || (std::abs(cost - best_cost) <= 1e-12 && near < best_near))
+      best = sides, best_cost = cost, best_near = near;
+  }
+  return best;
 }
 
 std::vector<int> realisable_subbox_sizes(long n_total, const std::vector<int>& targets, const std::string& key,

@@ -360,6 +360,14 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (check) {
+    // The engine's own refusals (a box too small for its cells, ...) are
+    // the scene's: made here, not at run time.
+    try {
+      dynhet::engine::Engine probe(engine_params(scene));
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "sim_node: invalid scene (1 problem):\n  %s: system: %s\n", scene_path.c_str(), e.what());
+      return 2;
+    }
     // One line per fact, for the launch scripts and for people.
     const auto sched = dynhet::make_schedule(scene.schedule, scene.equilibration_time);
     std::printf("scene %s: valid\n", scene_path.c_str());

@@ -63,3 +63,10 @@ target_link_libraries(hostile_publisher PRIVATE dynhet_lcmtypes)
 add_test(NAME hostile_messages
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/hostile.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR} $<TARGET_FILE:hostile_publisher>)
 set_tests_properties(hostile_messages PROPERTIES LABELS process TIMEOUT 300)
+
+# Mutated scenes (tests/fuzz_scenes.py, 400 with a fixed seed): each is
+# refused by sim_node --check with a message or runs (private bus).
+add_test(NAME fuzz_scenes
+  COMMAND ${PROJECT_SOURCE_DIR}/launch_scripts/netns.sh /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/fuzz_scenes.py
+          $<TARGET_FILE:sim_node> ${PROJECT_SOURCE_DIR} 400)
+set_tests_properties(fuzz_scenes PROPERTIES LABELS process TIMEOUT 300)

@@ -99,7 +99,7 @@ TEST(Scene, ImpossibleValuesAreRefused) {
   expect_error("[system]\nn_particles = 2147483648\n", {"system.n_particles", "2147483647"});
   expect_error("[overlap]\nsubbox_particles = 2147483648\n", {"overlap.subbox_particles"});
   expect_error("[schedule]\norigins = 1000000\nlags_per_decade = 1000\nlag_min = 1e-9\nlag_max = 1e9\n",
-               {"schedule", "more than 2e7"});
+               {"schedule", "more than 10^6"});
   // Values are shown as written, not as the nearest double's long expansion.
   expect_error("[system]\npacking_fraction = 0.9\n", {"value 0.9 is"});
 }
@@ -201,4 +201,24 @@ TEST(Scene, SubboxSizesThatNoGridRealisesAreDroppedOrNoted) {
   const auto d = parse_scene_text("[system]\nn_particles = 100000\n", "default sizes");
   EXPECT_EQ(d.chi4_subbox_particles.size(), 6u);
   EXPECT_TRUE(d.notes.empty());
+}
+
+// Values --check used to accept that failed or hung at run time are refused
+// up front with a reason; numbers are printed as written; integers beyond
+// 2^53 in float keys are refused, not rounded.
+TEST(Scene, ValuesThatCannotRunAreRefusedUpFront) {
+  const std::string s4 = "[observables]\ncompute = [\"overlap\", \"s4\"]\n";
+  expect_error(s4 + "[s4]\nq_max = 1e9\n", {"s4.q_max", "points per box side"});
+  expect_error(s4 + "[s4]\ngrid_spacing = 1e-9\n", {"s4.grid_spacing", "points per box side"});
+  expect_error("[clusters]\ngr_bin = 1e-12\n", {"clusters.gr_bin", "10^5 bins"});
+  expect_error("[system]\nrestitution = 0.9\n[driving]\nkick_rate = 1e300\n", {"driving.kick_rate", "1e+300"});
+  expect_error("[run]\ncheckpoint_interval = 1e-300\n", {"run.checkpoint_interval", "1e-300", "10^6 checkpoints"});
+  expect_error("[system]\nrestitution = 1e-12\n", {"system.restitution", "TC model"});
+  expect_error("[schedule]\norigins = 1000000\n", {"schedule", "more than 10^6"});
+  expect_error("[system]\nrestitution = 1.0000000000000002\n", {"system.restitution", "1.0000000000000002"});
+  expect_error("[schedule]\norigin_spacing = 9007199254740993\n", {"schedule.origin_spacing", "2^53"});
+  // Exactly representable integers in float keys are read exactly.
+  const auto s = parse_scene_text(
+      "[schedule]\norigin_spacing = 9007199254740992\nlag_max = 10\n[run]\ncheckpoint_interval = 1e12\n", "exact");
+  EXPECT_EQ(s.schedule.origin_spacing, 9007199254740992.0);
 }

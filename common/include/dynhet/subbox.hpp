@@ -9,10 +9,13 @@
 
 namespace dynhet {
 
-// The side m of each target's grid, in the order given: the finest side is
-// the 2^a 3^b nearest sqrt(n_total / target) in ln, every coarser one the
-// divisor of the finer side nearest its own ideal. A target >= n_total
-// gives 1 (the whole box).
+// The side m of each target's grid, in the order given: every coarser side
+// is the divisor of the next finer one nearest its own ideal
+// sqrt(n_total / target), and the finest is the 2^a 3^b nearest its own
+// ideal among those whose chain gives no two targets the same grid, if
+// any does (so [64, 256, 1024, 4096, 16384] at N = 10^5 nest as 48, 24,
+// 12, 6, 3, not 36, 18, 9, 3, 3). A target >= n_total gives 1 (the whole
+// box).
 std::vector<int> nested_subbox_sides(long n_total, const std::vector<int>& targets);
 
 // What the grids of `targets` realise at n_total particles: targets whose
