@@ -1,5 +1,7 @@
 #include "run_recorder.hpp"
 
+#include <sys/statvfs.h>
+
 #include <cstdio>
 
 #include "dynhet/model.hpp"
@@ -24,6 +26,16 @@ std::string join(const std::vector<std::string> &lines, const char *sep) {
 
 bool ended(const std::string &phase) { return phase == "done" || phase == "failed"; }
 
+// Bytes free for an unprivileged writer on the file system holding `path`
+// (-1 if unknown).
+int64_t free_bytes(const std::string &path) {
+  const auto slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+  struct statvfs v {};
+  if (statvfs(dir.c_str(), &v) != 0) return -1;
+  return static_cast<int64_t>(v.f_bavail) * static_cast<int64_t>(v.f_frsize);
+}
+
 } // namespace
 
 RunRecorder::RunRecorder(std::string out_path, std::string creator_version)
@@ -31,13 +43,41 @@ RunRecorder::RunRecorder(std::string out_path, std::string creator_version)
 
 // A failed write costs that record, not the run: it is reported on
 // stderr (the first few times) and counted against completeness.
+// Every write goes through here. A disk that fills must not leave an
+// unreadable file: HDF5 that fails a write in mid-flush corrupts its own
+// metadata. So before each write the recorder checks the free space, and
+// below kDiskReserve it stops writing for good: it marks the file
+// incomplete ("no space left on device"), closes it while it still can,
+// and the run ends non-zero. A write that fails anyway stops writing too.
 template <class F> void RunRecorder::guarded(const char *what, F &&write) {
+  if (stopped_) return;
+  if (const int64_t free = free_bytes(out_path_); free >= 0 && free < kDiskReserve)
+    return stop_writing("no space left on device (ENOSPC): " + std::to_string(free / 1024) +
+                        " KiB free on the file system of " + out_path_ + ", below the " +
+                        std::to_string(kDiskReserve / (1024 * 1024)) + " MiB the recorder keeps to close the file");
   try {
     write();
     writer_->flush();
   } catch (const std::exception &e) {
-    if (++write_errors_ <= 10) std::fprintf(stderr, "recorder: %s: %s\n", what, e.what());
+    const std::string why = e.what();
+    if (++write_errors_ <= 10) std::fprintf(stderr, "recorder: %s: %s\n", what, why.substr(0, 400).c_str());
     if (write_errors_ == 10) std::fprintf(stderr, "recorder: further write errors not shown\n");
+    if (why.find("errno = 28") != std::string::npos || why.find("No space left") != std::string::npos)
+      stop_writing("no space left on device (ENOSPC) writing " + std::string(what));
+  }
+}
+
+void RunRecorder::stop_writing(const std::string &why) {
+  if (stopped_) return;
+  stopped_ = true;
+  stop_reason_ = why;
+  std::fprintf(stderr, "recorder: %s: stopped writing; the file stays readable and says incomplete\n", why.c_str());
+  try {
+    writer_->set_attribute("", "complete", int32_t{0});
+    writer_->set_attribute("", "missing", why);
+    writer_->flush();
+  } catch (const std::exception &) {
+    // what was flushed before stays; the summary says incomplete from the start
   }
 }
 
@@ -442,6 +482,15 @@ std::vector<std::string> RunRecorder::finish(const std::string &reason) {
   std::vector<std::string> missing;
   if (!reason.empty()) missing.push_back(reason);
   if (!info_) return missing;
+  if (stopped_) {
+    missing.push_back(stop_reason_);
+    try {
+      writer_->close(); // the reserve leaves room for it
+    } catch (const std::exception &e) {
+      std::fprintf(stderr, "recorder: closing after the disk filled: %s\n", std::string(e.what()).substr(0, 300).c_str());
+    }
+    return missing;
+  }
   // The last word of each status stream.
   if (sim_.held) guarded("sim status", [&] { write_sim(*sim_.held); });
   for (auto &[key, n] : nodes_)

@@ -119,6 +119,12 @@ private:
   std::optional<int64_t> node_clock_zero_;      // utime of the first node status
   int write_errors_ = 0;
   int64_t rejected_ = 0;
+  // Free space the recorder keeps on the file system of its file, so that
+  // it can still mark the file incomplete and close it when the disk fills.
+  static constexpr int64_t kDiskReserve = int64_t{4} << 20;
+  bool stopped_ = false; // writing stopped for good (disk full)
+  std::string stop_reason_;
+  void stop_writing(const std::string &why);
   int frames_published_ = 0; // from the sim's last "done" or "failed"
   std::string last_rejection_;
 

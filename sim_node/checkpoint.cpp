@@ -1,5 +1,9 @@
 #include "checkpoint.hpp"
 
+#include <sys/statvfs.h>
+
+#include <cstdio>
+
 #include <cmath>
 #include <cstdio>
 #include <stdexcept>
@@ -9,6 +13,8 @@
 #include <hdf5_hl.h>
 
 namespace dynhet {
+
+void write_checkpoint_file(const std::string& path, const Checkpoint& c);
 namespace {
 
 constexpr const char* kFormat = "dynhet checkpoint 1";
@@ -64,7 +70,39 @@ int64_t get_int(const File& f, const char* name) {
 
 } // namespace
 
+namespace {
+
+// Bytes free on the file system holding `path` (-1 if unknown).
+int64_t free_bytes(const std::string& path) {
+  const auto slash = path.find_last_of('/');
+  const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
+  struct statvfs v {};
+  if (statvfs(dir.c_str(), &v) != 0) return -1;
+  return static_cast<int64_t>(v.f_bavail) * static_cast<int64_t>(v.f_frsize);
+}
+
+} // namespace
+
 void write_checkpoint(const std::string& path, const Checkpoint& c) {
+  // A full disk is named as such, before HDF5 half-writes the file (the old
+  // checkpoint stays in place: the new one goes to .tmp and is renamed).
+  const int64_t need = static_cast<int64_t>(c.state.x.size()) * 64 + static_cast<int64_t>(c.scene_toml.size()) +
+                       (int64_t{1} << 20);
+  if (const int64_t free = free_bytes(path); free >= 0 && free < need)
+    throw std::runtime_error(path + ": no space left on device (ENOSPC) for the checkpoint: it needs about " +
+                             std::to_string(need / 1024) + " KiB, " + std::to_string(free / 1024) + " KiB are free");
+  try {
+    write_checkpoint_file(path, c);
+  } catch (const std::exception& e) {
+    std::remove((path + ".tmp").c_str());
+    if (const int64_t free = free_bytes(path); free >= 0 && free < need)
+      throw std::runtime_error(path + ": no space left on device (ENOSPC) while writing the checkpoint (" +
+                               std::to_string(free / 1024) + " KiB free)");
+    throw;
+  }
+}
+
+void write_checkpoint_file(const std::string& path, const Checkpoint& c) {
   const std::string tmp = path + ".tmp";
   {
     File f(H5Fcreate(tmp.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), tmp);

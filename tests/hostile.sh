@@ -11,7 +11,9 @@
 #    count what they dropped, and the results equal the clean run's bit
 #    for bit;
 # 3. two runs at once on one bus (the tiny scene and the same with another
-#    seed): both complete, the first equal to the clean run bit for bit.
+#    seed): both complete, the first equal to the clean run bit for bit;
+# 4. a recorder killed (SIGKILL) mid-run leaves a readable run.h5 that says
+#    incomplete, and run_scene.sh exits non-zero.
 set -euo pipefail
 root=$1 build=$2 hostile=$3
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then exec "$root/launch_scripts/netns.sh" bash "$0" "$@"; fi
@@ -70,5 +72,21 @@ check '[[ $ra == 0 && $rb == 0 ]] && complete "$tmp/two_a/run.h5" && complete "$
   "two runs at once on one bus: both complete (exits $ra, $rb)"
 check 'same "$tmp/clean/run.h5" "$tmp/two_a/run.h5"' "two runs at once: the first equals the clean run bit for bit"
 check '! same "$tmp/two_a/run.h5" "$tmp/two_b/run.h5"' "two runs at once: the second has its own results"
+# A killed recorder: the file it leaves says incomplete (set at creation).
+sed 's/^origins = 4/origins = 40/' "$root/scenes/tiny.toml" >"$tmp/long.toml"
+"${run[@]}" "$tmp/long.toml" --out "$tmp/killed" --run-id 6001 >"$tmp/killed.log" 2>&1 &
+pk=$!
+for _ in $(seq 200); do grep -qs "recorder: run 6001" "$tmp/killed/recorder.log" && break; sleep 0.05; done
+sleep 0.5
+pkill -9 -f "recorder --out $tmp/killed/run.h5" || true
+wait $pk && rk=0 || rk=$?
+check '[[ $rk != 0 ]]' "a killed recorder: run_scene.sh exits non-zero (got $rk)"
+check '$py -c "
+import h5py, sys
+f = h5py.File(\"$tmp/killed/run.h5\", \"r\")
+m = f.attrs[\"missing\"]
+m = m.decode() if isinstance(m, bytes) else str(m)
+sys.exit(0 if int(f.attrs[\"complete\"]) == 0 and \"did not finish\" in m else 1)"' \
+  "a killed recorder leaves a readable file that says incomplete"
 ((fail == 0)) || { tail -5 "$tmp"/*.log; for f in "$tmp"/attacked/*.log; do echo "== $f"; tail -3 "$f"; done; }
 exit $fail

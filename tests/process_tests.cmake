@@ -70,3 +70,10 @@ add_test(NAME fuzz_scenes
   COMMAND ${PROJECT_SOURCE_DIR}/launch_scripts/netns.sh /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/fuzz_scenes.py
           $<TARGET_FILE:sim_node> ${PROJECT_SOURCE_DIR} 400)
 set_tests_properties(fuzz_scenes PROPERTIES LABELS process TIMEOUT 300)
+
+# A full disk (tests/full_disk.sh: a 12 MB tmpfs in a private mount
+# namespace): the recorder stops writing, keeps run.h5 readable and marked
+# incomplete with ENOSPC named; a checkpoint on a full disk names ENOSPC.
+add_test(NAME full_disk
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/full_disk.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(full_disk PROPERTIES LABELS process TIMEOUT 120)
