@@ -169,7 +169,9 @@ void FrameNode::on_frame(const Frame& f) {
       ++it;
     }
   if (added) publish_results(false);
-  tick();
+  // Right away, not at the next second: the sim paces its frames on it
+  // (flow control, sim_node --pace-nodes).
+  publish_status();
 }
 
 void FrameNode::publish_status() {

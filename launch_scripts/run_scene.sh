@@ -127,7 +127,7 @@ fi
 # The sim in the foreground (its progress line goes to the terminal and
 # sim_node.log).
 set +e
-"$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" --checkpoint "$out/checkpoint.h5" \
+"$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" --pace-nodes --checkpoint "$out/checkpoint.h5" \
   --checkpoint-before-frames "$out/checkpoint_before_frames.h5" 2> >(tee ${resume:+-a} "$out/sim_node.log" >&2)
 sim_rc=$?
 set -e

@@ -11,6 +11,7 @@
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <map>
 #include <random>
 #include <string>
 #include <thread>
@@ -23,6 +24,8 @@
 #include "dynhet/chunking.hpp"
 #include "dynhet/engine/engine.hpp"
 #include "dynhet/frame_chunk_t.hpp"
+#include "dynhet/lcm_guard.hpp"
+#include "dynhet/node_status_t.hpp"
 #include "dynhet/lcm_url.hpp"
 #include "dynhet/model.hpp"
 #include "dynhet/run_info_t.hpp"
@@ -305,6 +308,84 @@ int prepare_only(const dynhet::Scene& scene, const std::string& path, bool equil
   }
 }
 
+// Flow control: the sim does not publish frame f until every node it paces
+// on has reassembled frame f - window (from their node status, which they
+// publish after every frame), so that a slow or stopped node finds at most
+// `window` frames waiting in its socket buffer (half of the 4 MiB
+// run_scene.sh asks for) and loses none. A node that failed or finished
+// is not waited for; one silent for `give_up` seconds is dropped from the
+// pacing with a warning (its losses are then its own, and counted).
+class Pacer {
+public:
+  Pacer(lcm::LCM& lcm, int64_t run_id, std::vector<std::string> nodes, long n_particles)
+      : lcm_(lcm), run_id_(run_id) {
+    for (auto& n : nodes) nodes_[n] = Node{};
+    window_ = std::max<long>(1, (2L << 20) / (16 * n_particles + 64));
+    if (!nodes_.empty()) sub_ = lcm_.subscribe(dynhet::kChanNodeStatus, &Pacer::on_status, this);
+  }
+  ~Pacer() {
+    if (sub_) lcm_.unsubscribe(sub_);
+  }
+  long window() const { return window_; }
+  // Waits until frame f may go out; `idle` is called every ~20 ms meanwhile.
+  template <class Idle> void before_frame(int f, Idle&& idle) {
+    if (nodes_.empty()) return;
+    for (;;) {
+      lcm_.handleTimeout(0);
+      const auto now = Clock::now();
+      bool wait = false;
+      for (auto& [name, n] : nodes_) {
+        if (n.gone) continue;
+        if (n.state == "failed" || n.state == "done") continue;
+        if (n.whole >= f - window_ && n.seen) continue;
+        const double silent = std::chrono::duration<double>(now - (n.seen ? n.last : start_)).count();
+        if (silent > kGiveUp) {
+          std::fprintf(stderr, "\nsim_node: node %s silent for %.0f s at frame %d: no longer waited for\n",
+                       name.c_str(), silent, f);
+          n.gone = true;
+          continue;
+        }
+        wait = true;
+      }
+      if (!wait) return;
+      if (!waited_) std::fprintf(stderr, "\nsim_node: waiting for slow nodes (flow control, window %ld frames)\n", window_);
+      waited_ = true;
+      idle();
+      lcm_.handleTimeout(20);
+    }
+  }
+
+private:
+  using Clock = std::chrono::steady_clock;
+  static constexpr double kGiveUp = 300.0;
+  struct Node {
+    int whole = -1;
+    std::string state;
+    bool seen = false, gone = false;
+    Clock::time_point last;
+  };
+  void on_status(const lcm::ReceiveBuffer* rb, const std::string&) {
+    dynhet::node_status_t m;
+    std::string why;
+    if (!dynhet::guard::safe_decode(rb->data, static_cast<int>(rb->data_size), m, why)) return;
+    if (m.run_id != run_id_) return;
+    auto it = nodes_.find(m.node);
+    if (it == nodes_.end()) return;
+    Node& n = it->second;
+    n.whole = std::max(n.whole, m.frames_whole + m.frames_lost - 1); // the last frame index it is past
+    n.state = m.state;
+    n.seen = true;
+    n.last = Clock::now();
+  }
+  lcm::LCM& lcm_;
+  int64_t run_id_;
+  std::map<std::string, Node> nodes_;
+  long window_ = 1;
+  lcm::Subscription* sub_ = nullptr;
+  Clock::time_point start_ = Clock::now();
+  bool waited_ = false;
+};
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -331,6 +412,10 @@ int main(int argc, char** argv) {
                "runs of the same dynamics from it equal the runs that equilibrate themselves, bit for bit");
   app.add_option("--lcm-url", url, "LCM URL (default $LCM_DEFAULT_URL or " + std::string(dynhet::kDefaultLcmUrl) + ")");
   app.add_option("--run-id", run_id, "run id (default: random)");
+  bool pace = false;
+  app.add_flag("--pace-nodes", pace,
+               "flow control: hold each frame until the scene's nodes (their status on DYNHET_NODE_STATUS) have "
+               "caught up to within a socket buffer's worth of frames (run_scene.sh sets it)");
   bool check = false;
   app.add_flag("--check", check, "validate the scene, print what it needs (nodes, frames) and exit");
   CLI11_PARSE(app, argc, argv);
@@ -529,8 +614,17 @@ int main(int argc, char** argv) {
     chunk.run_id = run_id;
     chunk.n_particles = static_cast<int32_t>(eng.size());
     chunk.chunk_count = static_cast<int32_t>(ranges.size());
+    std::vector<std::string> paced;
+    if (pace)
+      for (const auto& n : dynhet::nodes_for(scene.observables)) paced.push_back(n.substr(0, n.size() - 5));
+    Pacer pacer(lcm, run_id, paced, eng.size());
     for (int f = next_frame; f < info.n_frames; ++f) {
       advance(sched.frame_time[f]);
+      pacer.before_frame(f, [&] {
+        if (seconds_since(last_info) > 2.0) publish_info();
+        rep.update(eng, t_end - eng.time());
+        if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
+      });
       eng.unwrapped_positions(xy);
 #ifndef NDEBUG
       // Debug builds: a full overlap scan at every frame.

@@ -77,3 +77,9 @@ set_tests_properties(fuzz_scenes PROPERTIES LABELS process TIMEOUT 300)
 add_test(NAME full_disk
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/full_disk.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(full_disk PROPERTIES LABELS process TIMEOUT 120)
+
+# Flow control (tests/stopped_node.sh): a node stopped for 4 s loses no
+# frame; the sim waits for it (sim_node --pace-nodes).
+add_test(NAME stopped_node_loses_nothing
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/stopped_node.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(stopped_node_loses_nothing PROPERTIES LABELS process TIMEOUT 120)
