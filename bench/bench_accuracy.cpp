@@ -44,7 +44,7 @@ int main(int argc, char** argv) {
     e.run_until(t_eq);
 
     // Lags up to 20 (several tau_alpha at these densities); origins every `spacing`.
-    dynhet::ScheduleSpec spec{static_cast<int>((t_max - 20.0) / spacing) + 1, spacing, 0.05, 20.0, 8};
+    dynhet::ScheduleSpec spec{static_cast<int>((t_max - 20.0) / spacing) + 1, spacing, 0.05, 20.0, 8, {}};
     const auto s = dynhet::make_schedule(spec, t_eq);
     an::OverlapAccumulator acc(s.n_origins(), s.lag_time);
     const auto grid = an::make_subbox_grid(n, e.box_length(), static_cast<int>(n)); // whole box

@@ -290,6 +290,19 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
       {"lag_min", positive(s.schedule.lag_min)},
       {"lag_max", positive(s.schedule.lag_max)},
       {"lags_per_decade", int_in(s.schedule.lags_per_decade, 1, 1000)},
+      {"extra_lags",
+       [&](const std::string& key, const toml::node& n) {
+         const auto* arr = n.as_array();
+         if (!arr) return c.bad_type(key, n, "an array of lag times > 0");
+         if (arr->size() > 16) return c.bad_value(key, n, "at most 16 extra lags");
+         s.schedule.extra_lags.clear();
+         for (const auto& e : *arr) {
+           double v;
+           if (!c.get_double(key, e, v)) return;
+           if (v <= 0) return c.bad_value(key, e, "every extra lag must be > 0");
+           s.schedule.extra_lags.push_back(v);
+         }
+       }},
   };
   schema["observables"] = {
       {"compute",
@@ -486,6 +499,10 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
 
   // Relations between keys.
   const auto& sch = s.schedule;
+  for (double t : sch.extra_lags)
+    if (t < sch.lag_min || t > sch.lag_max)
+      c.fail("schedule.extra_lags", "value " + num(t) + " is outside [lag_min, lag_max] = [" + num(sch.lag_min) +
+                                        ", " + num(sch.lag_max) + "]");
   if (sch.lag_min >= sch.lag_max)
     c.fail("schedule.lag_min", "value " + num(sch.lag_min) +
                                    " must be smaller than schedule.lag_max = " +

@@ -20,6 +20,13 @@ std::vector<double> log_spaced_lags(double lag_min, double lag_max, int per_deca
 FrameSchedule make_schedule(const ScheduleSpec& spec, double t_start) {
   FrameSchedule s;
   s.lag_time = log_spaced_lags(spec.lag_min, spec.lag_max, spec.lags_per_decade);
+  // Extra lags join the list in order; one within 1e-9 (relative) of a
+  // log-spaced lag is that lag.
+  for (double t : spec.extra_lags) {
+    bool have = false;
+    for (double l : s.lag_time) have = have || std::abs(l - t) <= 1e-9 * t;
+    if (!have) s.lag_time.insert(std::upper_bound(s.lag_time.begin(), s.lag_time.end(), t), t);
+  }
   const int nk = spec.origins, nj = s.n_lags();
 
   // Every wanted time, then the distinct ones in order.

@@ -749,6 +749,16 @@ def do_run(sd, p, log=print):
             tau_est = rl["pilot_margin"] * pilot(sd, p)
             source = "pilot" if rl["pilot_margin"] == 1.0 else f"pilot x {rl['pilot_margin']:g}"
         sc = st.scene(p, tau_est)
+        # A lag at the best tau_alpha estimate (the pilot's, or the previous
+        # attempt's, without the margin), so that what the paper takes at
+        # tau_alpha (clusters, S4) is taken there rather than up to a lag
+        # spacing away.
+        if tau_est is not None:
+            best = tau_est / (rl["pilot_margin"] if source.startswith("pilot") else
+                              1.3 if source.startswith("1.3 x") else 1.0)
+            sch = sc["schedule"]
+            if sch["lag_min"] <= best <= sch["lag_max"]:
+                sch["extra_lags"] = [round(best, 6)]
         prepared_state(sd, sc)
         equilibrated_state(sd, sc)
         write_atomic(os.path.join(d, "scene.toml"),

@@ -18,7 +18,7 @@ TEST(Schedule, LagsAreLogSpacedAndEndAtLagMax) {
 }
 
 TEST(Schedule, EveryPairAndOriginHasItsFrameAndNothingElseIsPublished) {
-  ScheduleSpec spec{5, 2.0, 0.5, 8.0, 2}; // lags 0.5 ... 8, origins every 2 (coinciding times)
+  ScheduleSpec spec{5, 2.0, 0.5, 8.0, 2, {}}; // lags 0.5 ... 8, origins every 2 (coinciding times)
   const auto s = make_schedule(spec, 10.0);
   for (size_t f = 1; f < s.frame_time.size(); ++f) EXPECT_GT(s.frame_time[f], s.frame_time[f - 1] + 1e-9);
   std::vector<bool> used(s.frame_time.size(), false);
@@ -34,4 +34,14 @@ TEST(Schedule, EveryPairAndOriginHasItsFrameAndNothingElseIsPublished) {
   for (size_t f = 0; f < used.size(); ++f) EXPECT_TRUE(used[f]) << "frame " << f << " serves nothing";
   // Lag 2 and 8 of one origin meet other origins' times: fewer frames than pairs.
   EXPECT_LT(s.frame_time.size(), size_t(s.n_origins()) * (s.n_lags() + 1));
+}
+
+// An extra lag (a tau_alpha estimate) joins the log-spaced lags in order,
+// and every origin gets a frame at it; one equal to a log-spaced lag adds
+// nothing.
+TEST(Schedule, ExtraLagsJoinTheLogSpacedOnes) {
+  ScheduleSpec spec{3, 10.0, 1.0, 100.0, 1, {4.2, 10.0}};
+  const FrameSchedule s = make_schedule(spec, 0.0);
+  EXPECT_EQ(s.lag_time, (std::vector<double>{1.0, 4.2, 10.0, 100.0}));
+  for (int k = 0; k < 3; ++k) EXPECT_DOUBLE_EQ(s.frame_time[s.pair(k, 1)], 10.0 * k + 4.2);
 }

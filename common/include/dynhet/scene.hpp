@@ -22,6 +22,10 @@ struct ScheduleSpec {
   double lag_min = 0.1;         // smallest lag tau
   double lag_max = 100.0;       // largest lag tau
   int lags_per_decade = 8;      // log spacing of the lags
+  // Lags added to the log-spaced ones (e.g. at a tau_alpha estimate, so
+  // that what the paper takes at tau_alpha is taken there, not up to a
+  // lag spacing away); within [lag_min, lag_max].
+  std::vector<double> extra_lags;
 };
 
 struct Scene {
