@@ -23,7 +23,28 @@ bool FrameNode::wants(const std::string& o) const {
 void FrameNode::check_sim_alive(double timeout) {
   if (!info_ || finished_ || sim_interrupted_) return;
   const double silent = std::chrono::duration<double>(Clock::now() - last_sim_news_).count();
-  if (silent > timeout) finish(1, "the sim has been silent for " + std::to_string(static_cast<int>(silent)) + " s");
+  if (silent <= timeout) return;
+  // Frames missing and no word from the sim: the frames, and likely the
+  // sim's last status with them, were lost here, not the sim silent.
+  assembler_.finish(info_->n_frames);
+  if (assembler_.frames_lost() > 0)
+    return finish(1, std::to_string(assembler_.frames_lost()) + " frames lost, and no word from the sim for " +
+                         std::to_string(static_cast<int>(silent)) + " s (its final status lost with them?): " +
+                         loss_cause());
+  finish(1, "the sim has been silent for " + std::to_string(static_cast<int>(silent)) + " s");
+}
+
+void FrameNode::loop_gap(double seconds) {
+  if (seconds > longest_gap_) longest_gap_ = seconds;
+}
+
+std::string FrameNode::loss_cause() const {
+  if (longest_gap_ > 2.0)
+    return "this node took no frames for " + std::to_string(static_cast<int>(longest_gap_)) +
+           " s at a stretch (stopped, starved of CPU, or busy with one frame) while frames kept coming, and its "
+           "socket buffer overflowed";
+  return "its socket buffer overflowed (frames came faster than this node took them; run_scene.sh's flow control "
+         "prevents that, a bare sim_node without --pace-nodes does not)";
 }
 
 void FrameNode::input_ended() {
@@ -199,6 +220,8 @@ void FrameNode::finish(int code, const std::string& why) {
   publish_status();
   std::fprintf(stderr, "%s_node: %s: %d frames whole, %d lost%s%s\n", name_.c_str(), status_.state.c_str(),
                assembler_.frames_whole(), assembler_.frames_lost(), why.empty() ? "" : "; ", why.c_str());
+  if (code == 0 && assembler_.frames_lost() > 0)
+    std::fprintf(stderr, "%s_node: frames lost: %s\n", name_.c_str(), loss_cause().c_str());
   finished_ = true;
   exit_code_ = code;
 }
@@ -234,7 +257,13 @@ int node_main(const std::string& program, const std::string& description, NodeFa
 
   std::fprintf(stderr, "%s: ready, reading %s\n", program.c_str(), in_url.c_str());
   const auto start = FrameNode::Clock::now();
+  auto last_turn = FrameNode::Clock::now();
   while (!node->finished()) {
+    // A turn of this loop that took seconds: the process was stopped or
+    // starved (frames lost meanwhile are then explained by it).
+    const auto turn = FrameNode::Clock::now();
+    node->loop_gap(std::chrono::duration<double>(turn - last_turn).count());
+    last_turn = turn;
     if (in.handleTimeout(200) < 0) { // a replayed log has ended
       node->input_ended();
       break;

@@ -50,6 +50,9 @@ public:
   void check_sim_alive(double timeout);
   // The input ended (log replayed to its end) before the sim said done.
   void input_ended();
+  // The wall time one turn of the receive loop took: a turn of seconds
+  // means the node was stopped or starved, the likely cause of lost frames.
+  void loop_gap(double seconds);
   void tick(); // node status once a second
 
   // The handlers take raw buffers: each message is checked (encoding,
@@ -100,6 +103,8 @@ private:
   void on_sim_status(const sim_status_t& m);
   void on_frame(const Frame& f);
   void maybe_done();
+  std::string loss_cause() const;
+  double longest_gap_ = 0;
   static constexpr double kDoneGrace = 10.0; // s of silence after "done" before frames count as lost
   void publish_status();
   void finish(int code, const std::string& why);
