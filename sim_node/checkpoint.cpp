@@ -253,6 +253,15 @@ Checkpoint read_checkpoint(const std::string& path) {
   std::vector<uint64_t> rng;
   get(f, "rng", H5T_NATIVE_UINT64, rng, 4);
   for (int k = 0; k < 4; ++k) s.rng[k] = rng[k];
+  // A state with a non-finite number would run on as garbage (a NaN
+  // position is never in contact with anything): refused here.
+  if (!std::isfinite(s.time) || !std::isfinite(s.counters.virial))
+    throw std::runtime_error(path + ": time or virial is not a finite number");
+  for (const auto* v : {&s.x, &s.y, &s.vx, &s.vy})
+    for (size_t i = 0; i < v->size(); ++i)
+      if (!std::isfinite((*v)[i]))
+        throw std::runtime_error(path + ": particle " + std::to_string(i) +
+                                 " has a non-finite position or velocity; not a usable state");
   return c;
 }
 

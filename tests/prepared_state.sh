@@ -102,6 +102,20 @@ check '[[ $rc != 0 ]] && grep -q "equilibrated with another system.restitution" 
 scene 0.9 'initial_state = "eq6.h5"' 4.0 >bad.toml
 "$bin/sim_node" bad.toml --lcm-url "$url" 2>bad.log && rc=0 || rc=$?
 check '[[ $rc != 0 ]] && grep -q "equilibrated to t = 6.*beyond the scene.s run.equilibration_time = 4" bad.log' "a state equilibrated beyond the scene's equilibration is refused"
+# A state with a NaN position is refused, as a start and as a resume.
+cp state.h5 nan.h5
+cp self0.9.h5 nanresume.h5
+$py -c "
+import h5py, sys
+for p in ('nan.h5', 'nanresume.h5'):
+    with h5py.File(p, 'r+') as f:
+        x = f['x'][()]
+        x[3] = float('nan')
+        f['x'][...] = x
+"
+refused 'initial_state = "nan.h5"' "particle 3 has a non-finite position or velocity" "a state with a NaN position is refused"
+"$bin/sim_node" --resume nanresume.h5 --lcm-url "$url" 2>bad.log && rc=0 || rc=$?
+check '[[ $rc != 0 ]] && grep -q "non-finite position" bad.log' "a checkpoint with a NaN position is not resumed (exit $rc)"
 scene 0.9 'initial_state = "state.h5"' | sed 's/^seed = 5/seed = 6/' >bad.toml
 "$bin/sim_node" bad.toml --lcm-url "$url" 2>bad.log && rc=0 || rc=$?
 check '[[ $rc != 0 ]] && grep -q "prepared for system.seed = 5, the scene has 6" bad.log' "a state prepared for another seed is refused"
