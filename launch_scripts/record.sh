@@ -7,4 +7,8 @@
 set -euo pipefail
 [[ $# -ge 1 ]] || { echo "usage: record.sh LOG [LCM_URL]" >&2; exit 2; }
 url=${2:-${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0}}
-exec lcm-logger --lcm-url="$url" --force "$1"
+# Frames come in bursts of chunks: without a big socket buffer the logger
+# drops some (9 and 4 of 180 frames were seen lost while the nodes lost none).
+[[ $url == udpm://* && $url != *recv_buf_size* ]] && url="$url$([[ $url == *\?* ]] && echo '&' || echo '?')recv_buf_size=8388608"
+# Ahead of the other processes where allowed (root).
+exec nice -n -5 lcm-logger --lcm-url="$url" --force "$1" 2>/dev/null || exec lcm-logger --lcm-url="$url" --force "$1"

@@ -5,31 +5,50 @@
 # results on a private bus, where the recorder picks them up (run info and
 # status it reads from the log too).
 #
-# Usage: launch_scripts/replay.sh LOG --out DIR [--no-build]
+# Usage: launch_scripts/replay.sh LOG --out DIR [--run-id ID] [--no-build]
+#        launch_scripts/replay.sh LOG --list    the runs in the log, and how
+#                                               many of each run's frames it holds
+# A log holding several runs needs --run-id. Before it starts, the replay
+# says how many of the run's frames the log lacks; a replay of an
+# incomplete log is itself marked incomplete.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
-log="" out="" build_first=1
+log="" out="" build_first=1 run_id="" list=0
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
   --no-build) build_first=0; shift ;;
-  -h | --help) sed -n '2,9p' "$0"; exit 0 ;;
+  --run-id) run_id=$2; shift 2 ;;
+  --list) list=1; shift ;;
+  -h | --help) sed -n '2,14p' "$0"; exit 0 ;;
   -*) echo "replay: unknown option $1" >&2; exit 2 ;;
   *) log=$1; shift ;;
   esac
 done
-[[ -n $log && -n $out ]] || { echo "usage: replay.sh LOG --out DIR" >&2; exit 2; }
+[[ -n $log ]] || { echo "usage: replay.sh LOG --out DIR [--run-id ID] | replay.sh LOG --list" >&2; exit 2; }
 [[ -f $log ]] || { echo "replay: no log file $log" >&2; exit 2; }
+runs=$root/launch_scripts/lcmlog_runs.py
+if ((list)); then exec /usr/bin/python3 "$runs" "$log"; fi
+[[ -n $out ]] || { echo "usage: replay.sh LOG --out DIR [--run-id ID]" >&2; exit 2; }
+if [[ -z $run_id ]]; then
+  run_id=$(/usr/bin/python3 "$runs" "$log" --only) || exit 2
+fi
+summary=$(/usr/bin/python3 "$runs" "$log" --run-id "$run_id") || exit 2
+echo "replay: $summary" >&2
+read -r whole expected < <(sed -E 's/.*, ([0-9]+) of ([0-9]+) frames.*/\1 \2/' <<<"$summary")
+if ((whole < expected)); then
+  echo "replay: the log lacks $((expected - whole)) of $expected frames of run $run_id: the replay will be incomplete" >&2
+fi
 log=$(cd "$(dirname "$log")" && pwd)/$(basename "$log")
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then
   ((build_first)) && BUILD_DIR=$build "$root/launch_scripts/setup.sh"
-  exec "$root/launch_scripts/netns.sh" "$0" "$log" --out "$out" --no-build
+  exec "$root/launch_scripts/netns.sh" "$0" "$log" --out "$out" --run-id "$run_id" --no-build
 fi
 
 # Which nodes ran: the observables named in the run info of the log. The
@@ -37,12 +56,12 @@ fi
 nodes=$("$bin/recorder" --list-nodes "$log") || { echo "replay: cannot read run info from $log" >&2; exit 1; }
 bus="udpm://239.255.76.67:7670?ttl=0&recv_buf_size=4194304"
 
-"$bin/recorder" --lcm-url "$bus" --from-log "$log" --out "$out/run.h5" 2>"$out/recorder.log" &
+"$bin/recorder" --lcm-url "$bus" --from-log "$log" --out "$out/run.h5" --run-id "$run_id" 2>"$out/recorder.log" &
 rec=$!
 for _ in $(seq 100); do grep -q ready "$out/recorder.log" && break; sleep 0.1; done
 status=0
 for n in $nodes; do
-  "$bin/$n" --lcm-url "file://$log?speed=0" --publish-url "$bus" 2>"$out/$n.log" || {
+  "$bin/$n" --lcm-url "file://$log?speed=0" --publish-url "$bus" --run-id "$run_id" 2>"$out/$n.log" || {
     echo "replay: $n failed; log $out/$n.log" >&2; tail -3 "$out/$n.log" >&2; status=1; }
 done
 wait $rec || { echo "replay: recorder failed; log $out/recorder.log" >&2; tail -3 "$out/recorder.log" >&2; status=1; }

@@ -83,3 +83,9 @@ set_tests_properties(full_disk PROPERTIES LABELS process TIMEOUT 120)
 add_test(NAME stopped_node_loses_nothing
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/stopped_node.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(stopped_node_loses_nothing PROPERTIES LABELS process TIMEOUT 120)
+
+# Logs of several runs (tests/replay_runs.sh): replay.sh --list, --run-id,
+# bit for bit; a log that lacks frames is said to and replays incomplete.
+add_test(NAME replay_runs_from_one_log
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/replay_runs.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(replay_runs_from_one_log PROPERTIES LABELS process TIMEOUT 300)

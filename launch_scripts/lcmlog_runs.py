@@ -1,0 +1,95 @@
+#!/usr/bin/python3
+"""The runs in an lcm-logger log, and how many of each run's frames the log
+holds whole (every chunk of the frame present), read from the log's bytes
+(the LCM log format and the encodings of dynhet's run_info_t and
+frame_chunk_t headers; no LCM bindings needed).
+
+Usage: lcmlog_runs.py LOG              one line per run: id, N, frames in the log / expected
+       lcmlog_runs.py LOG --run-id ID  that run's line; exit 1 if the log does not hold it
+       lcmlog_runs.py LOG --only       the id of the only run; exit 1 (with the list) if there are several
+"""
+import struct
+import sys
+
+SYNC = 0xEDA1DA01
+
+
+def events(path):
+    with open(path, "rb") as f:
+        data = f.read()
+    pos, n = 0, len(data)
+    while pos + 28 <= n:
+        sync, _event, _utime, clen, dlen = struct.unpack_from(">IqqII", data, pos)
+        if sync != SYNC:  # resynchronise on damage
+            nxt = data.find(struct.pack(">I", SYNC), pos + 1)
+            if nxt < 0:
+                return
+            pos = nxt
+            continue
+        pos += 28
+        if pos + clen + dlen > n:
+            return
+        channel = data[pos:pos + clen].decode("latin-1")
+        yield channel, data[pos + clen:pos + clen + dlen]
+        pos += clen + dlen
+
+
+def scan(path):
+    """{run_id: {"n": N, "frames": n_frames, "chunks": {frame: set(chunk)}, "count": {frame: chunk_count}}}"""
+    runs = {}
+    for channel, d in events(path):
+        if channel == "DYNHET_RUN" and len(d) >= 92:
+            # hash utime run_id n_particles box phi eps radius[2] mass[2] n_small n_frames
+            run_id, n = struct.unpack_from(">qi", d, 16)
+            n_frames = struct.unpack_from(">i", d, 88)[0]
+            r = runs.setdefault(run_id, {"chunks": {}, "count": {}})
+            r.setdefault("n", n)
+            r.setdefault("frames", n_frames)
+        elif channel == "DYNHET_FRAME" and len(d) >= 60:
+            # hash utime run_id frame_index time n_particles chunk_index chunk_count
+            run_id, frame = struct.unpack_from(">qi", d, 16)
+            chunk, count = struct.unpack_from(">ii", d, 40)
+            r = runs.setdefault(run_id, {"chunks": {}, "count": {}})
+            r["chunks"].setdefault(frame, set()).add(chunk)
+            r["count"][frame] = count
+    return runs
+
+
+def line(run_id, r):
+    whole = sum(1 for f, c in r["chunks"].items() if len(c) == r["count"][f])
+    expected = r.get("frames")
+    return whole, expected, (f"run {run_id}: N = {r.get('n', '?')}, {whole} of "
+                             f"{expected if expected is not None else '?'} frames whole in the log")
+
+
+def main():
+    if len(sys.argv) < 2:
+        print(__doc__, file=sys.stderr)
+        return 2
+    runs = {k: v for k, v in scan(sys.argv[1]).items() if "frames" in v}
+    args = sys.argv[2:]
+    if not runs:
+        print(f"{sys.argv[1]}: no dynhet run info in the log", file=sys.stderr)
+        return 1
+    if args[:1] == ["--run-id"]:
+        rid = int(args[1])
+        if rid not in runs:
+            print(f"{sys.argv[1]}: no run {rid}; the log holds: " + ", ".join(map(str, runs)), file=sys.stderr)
+            return 1
+        print(line(rid, runs[rid])[2])
+        return 0
+    if args[:1] == ["--only"]:
+        if len(runs) > 1:
+            print(f"{sys.argv[1]} holds {len(runs)} runs; choose one with --run-id:", file=sys.stderr)
+            for rid, r in runs.items():
+                print("  " + line(rid, r)[2], file=sys.stderr)
+            return 1
+        print(next(iter(runs)))
+        return 0
+    for rid, r in runs.items():
+        print(line(rid, r)[2])
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,52 @@
+#!/usr/bin/env bash
+# Logs as users have them: two runs recorded (run_scene.sh --record) and
+# joined into one log. replay.sh --list names both with their frame counts;
+# without --run-id the replay is refused with the list; --run-id replays
+# that run bit for bit like its live run; a log that lacks frames is said
+# to before the replay starts, and the replay ends incomplete (non-zero).
+# Private network namespaces throughout.
+set -euo pipefail
+root=$1 build=$2
+export BUILD_DIR=$build
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fail=0
+check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
+for id in 111 222; do
+  bash "$root/launch_scripts/run_scene.sh" "$root/scenes/tiny.toml" --no-build --out "$tmp/live$id" \
+    --record "$tmp/r$id.lcmlog" --run-id $id >"$tmp/live$id.log" 2>&1 || { tail -5 "$tmp/live$id.log"; exit 1; }
+done
+cat "$tmp/r111.lcmlog" "$tmp/r222.lcmlog" >"$tmp/two.lcmlog"
+replay=(bash "$root/launch_scripts/replay.sh")
+"${replay[@]}" "$tmp/two.lcmlog" --list >"$tmp/list.txt"
+check 'grep -q "run 111: N = 300, 56 of 56 frames whole" "$tmp/list.txt" && grep -q "run 222: N = 300, 56 of 56" "$tmp/list.txt"' \
+  "--list names both runs and their frames"
+"${replay[@]}" "$tmp/two.lcmlog" --out "$tmp/r0" --no-build >"$tmp/r0.log" 2>&1 && rc=0 || rc=$?
+check '[[ $rc == 2 ]] && grep -q "holds 2 runs; choose one with --run-id" "$tmp/r0.log"' "a log of two runs without --run-id is refused (exit $rc)"
+"${replay[@]}" "$tmp/two.lcmlog" --out "$tmp/r222" --run-id 222 --no-build >"$tmp/r222.log" 2>&1 && rc=0 || rc=$?
+check '[[ $rc == 0 ]] && PYTHONPATH="$root/tests" /usr/bin/python3 -c "
+import sys
+from compare_runs import final_results, same
+(a, _), (b, _) = final_results(sys.argv[1]), final_results(sys.argv[2])
+sys.exit(0 if same(a, b) else 1)" "$tmp/live222/run.h5" "$tmp/r222/run.h5"' "--run-id 222 replays that run bit for bit like its live run"
+# A log without the chunks of frames 10 and 11 of run 222.
+/usr/bin/python3 - "$tmp/r222.lcmlog" "$tmp/holes.lcmlog" <<'PY'
+import struct, sys
+data = open(sys.argv[1], "rb").read()
+out, pos = bytearray(), 0
+while pos + 28 <= len(data):
+    _, _, _, clen, dlen = struct.unpack_from(">IqqII", data, pos)
+    ev = data[pos:pos + 28 + clen + dlen]
+    ch = data[pos + 28:pos + 28 + clen]
+    d = data[pos + 28 + clen:pos + 28 + clen + dlen]
+    if not (ch == b"DYNHET_FRAME" and struct.unpack_from(">i", d, 24)[0] in (10, 11)):
+        out += ev
+    pos += 28 + clen + dlen
+open(sys.argv[2], "wb").write(out)
+PY
+"${replay[@]}" "$tmp/holes.lcmlog" --out "$tmp/rh" --no-build >"$tmp/rh.log" 2>&1 && rc=0 || rc=$?
+check 'grep -q "the log lacks 2 of 56 frames of run 222" "$tmp/rh.log"' "a log lacking frames is said to before the replay"
+check '[[ $rc != 0 ]] && /usr/bin/python3 -c "import h5py, sys; sys.exit(0 if int(h5py.File(sys.argv[1], \"r\").attrs[\"complete\"]) == 0 else 1)" "$tmp/rh/run.h5"' \
+  "its replay is marked incomplete and exits non-zero (exit $rc)"
+((fail == 0)) || tail -20 "$tmp"/r*.log
+exit $fail
