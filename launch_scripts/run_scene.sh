@@ -6,9 +6,11 @@
 #   --out DIR       where run.h5, plots and logs go (default runs/<scene>-<time>)
 #   --bus private   (default) a private network namespace: no packet leaves
 #                   the machine, nothing else on the host sees the run
-#   --bus host      the host's LCM bus ($LCM_DEFAULT_URL or the default URL),
-#                   so lcm-spy (spy.sh) and other hosts can watch
-#   --url URL       LCM URL (default udpm://239.255.76.67:7667?ttl=0)
+#   --bus host      the host's LCM bus ($LCM_DEFAULT_URL, else
+#                   udpm://239.255.76.67:7667?ttl=1: lcm-spy (spy.sh) on this
+#                   host and other hosts on the LAN can watch)
+#   --url URL       LCM URL (default udpm://239.255.76.67:7667?ttl=0, and
+#                   ttl=1 with --bus host)
 #   --record LOG    also record everything with lcm-logger into LOG
 #   --no-build      skip setup.sh (packages and build)
 #   --resume CKPT   continue the run saved in checkpoint CKPT (instead of a
@@ -35,7 +37,7 @@ while (($#)); do
   --no-build) build_first=0; shift ;;
   --resume) resume=$2; shift 2 ;;
   --run-id) run_id=$2; shift 2 ;;
-  -h | --help) sed -n '2,24p' "$0"; exit 0 ;;
+  -h | --help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   -*) echo "run_scene: unknown option $1" >&2; exit 2 ;;
   *) [[ -z $scene ]] || { echo "run_scene: one scene only" >&2; exit 2; }; scene=$1; shift ;;
   esac
@@ -74,7 +76,10 @@ if [[ $bus == private && -z ${DYNHET_IN_NETNS:-} ]]; then
   exec "$root/launch_scripts/netns.sh" "$0" ${scene:+"$scene"} "${args[@]}"
 fi
 if [[ -n $url ]]; then export LCM_DEFAULT_URL=$url; fi
-url=${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0}
+# On the host's bus other hosts should see the run (ttl=1, the LAN); a
+# private bus never leaves the namespace anyway.
+if [[ $bus == host ]]; then default_ttl=1; else default_ttl=0; fi
+url=${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=$default_ttl}
 # Frames come in bursts of chunks: ask for a big socket receive buffer.
 [[ $url == udpm://* && $url != *recv_buf_size* ]] && url="$url&recv_buf_size=4194304"
 export LCM_DEFAULT_URL=$url
