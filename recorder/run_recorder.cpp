@@ -1,6 +1,6 @@
 #include "run_recorder.hpp"
 
-#include <sys/statvfs.h>
+#include "dynhet/disk.hpp"
 
 #include <cstdio>
 
@@ -26,15 +26,6 @@ std::string join(const std::vector<std::string> &lines, const char *sep) {
 
 bool ended(const std::string &phase) { return phase == "done" || phase == "failed"; }
 
-// Bytes free for an unprivileged writer on the file system holding `path`
-// (-1 if unknown).
-int64_t free_bytes(const std::string &path) {
-  const auto slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
-  struct statvfs v {};
-  if (statvfs(dir.c_str(), &v) != 0) return -1;
-  return static_cast<int64_t>(v.f_bavail) * static_cast<int64_t>(v.f_frsize);
-}
 
 } // namespace
 
@@ -465,7 +456,8 @@ void RunRecorder::write_overlap(const overlap_t &m) {
 
 bool RunRecorder::on_frame_chunk(const frame_chunk_t &m) {
   if (!info_ || !info_->keep_frames || m.run_id != info_->run_id) return false;
-  if (m.n_values != 2 * m.count || static_cast<int>(m.position.size()) != m.n_values) return false;
+  if (int64_t(m.n_values) != 2 * int64_t(m.count) || static_cast<int64_t>(m.position.size()) != m.n_values)
+    return false;
   const ChunkHeader h{m.frame_index, m.time,           m.n_particles, m.chunk_index,
                       m.chunk_count, m.first_particle, m.count};
   const int64_t bad = assembler_.chunks_malformed();

@@ -1,8 +1,6 @@
 #include "checkpoint.hpp"
 
-#include <sys/statvfs.h>
-
-#include <cstdio>
+#include "dynhet/disk.hpp"
 
 #include <cmath>
 #include <cstdio>
@@ -66,19 +64,6 @@ int64_t get_int(const File& f, const char* name) {
   long long v;
   f.check(H5LTget_attribute_long_long(f.id(), "/", name, &v), name);
   return v;
-}
-
-} // namespace
-
-namespace {
-
-// Bytes free on the file system holding `path` (-1 if unknown).
-int64_t free_bytes(const std::string& path) {
-  const auto slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : slash == 0 ? "/" : path.substr(0, slash);
-  struct statvfs v {};
-  if (statvfs(dir.c_str(), &v) != 0) return -1;
-  return static_cast<int64_t>(v.f_bavail) * static_cast<int64_t>(v.f_frsize);
 }
 
 } // namespace
