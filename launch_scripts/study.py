@@ -949,7 +949,21 @@ def run_local(sd, jobs):
           f"in {fmt_time(time.time() - t_start)} -> {sd.dir}/index.toml", flush=True)
     for name, msg in failures:
         print(f"  failed: {name}: {msg}", flush=True)
-    return 0 if state["failed"] == 0 else 1
+    if state["failed"]:
+        return 1
+    return analyse(sd)
+
+
+def analyse(sd):
+    """The study analysis (analyse_study.py) once every run is complete:
+    study.h5, figures/ and reproduction.md in the study directory."""
+    script = os.path.join(ROOT, "launch_scripts", "analyse_study.py")
+    print(f"study {sd.study.name}: analysing ({os.path.relpath(script, ROOT)} {sd.dir})", flush=True)
+    rc = subprocess.run([sys.executable, script, sd.dir]).returncode
+    if rc:
+        print(f"study {sd.study.name}: the analysis failed (exit {rc}); the runs are complete, "
+              f"run launch_scripts/analyse_study.sh {sd.dir} again after a fix", flush=True)
+    return 1 if rc else 0
 
 
 def run_slurm(sd, a):
@@ -997,7 +1011,7 @@ def run_slurm(sd, a):
         "#!/bin/bash", f"#SBATCH --job-name=dynhet-{sd.study.name}-index",
         f"#SBATCH --output={sdir}/index-%j.out", *common,
         "# After every task: the study's index (and what must follow the runs).",
-        f"exec /usr/bin/python3 {me} index {sd.dir}", ""]))
+        f"exec /usr/bin/python3 {me} index {sd.dir} --analyse", ""]))
     r = subprocess.run(["sbatch", "--parsable", array], capture_output=True, text=True)
     if r.returncode != 0:
         raise StudyError(f"sbatch refused the job array: {r.stderr.strip()}")
@@ -1056,6 +1070,7 @@ def main():
     t.add_argument("name")
     i = sub.add_parser("index")
     i.add_argument("dir")
+    i.add_argument("--analyse", action="store_true", help="then, if every run is complete, the study analysis")
     a = ap.parse_args()
     try:
         if a.cmd == "run":
@@ -1080,7 +1095,9 @@ def main():
         for row in rows.values():
             states[row["state"]] = states.get(row["state"], 0) + 1
         print(f"study {sd.study.name}: " + ", ".join(f"{v} {k}" for k, v in sorted(states.items())))
-        return 0 if set(states) == {"complete"} else 1
+        if set(states) != {"complete"}:
+            return 1
+        return analyse(sd) if a.analyse else 0
     except StudyError as e:
         print(f"run_study: {e}", file=sys.stderr)
         return 2

@@ -89,3 +89,10 @@ set_tests_properties(stopped_node_loses_nothing PROPERTIES LABELS process TIMEOU
 add_test(NAME replay_runs_from_one_log
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/replay_runs.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(replay_runs_from_one_log PROPERTIES LABELS process TIMEOUT 300)
+
+# Every cross-run fit of the study analysis against synthetic studies with
+# known parameters: recovered within its jackknife error over seeds, and
+# the error honest (tests/test_study_fits.py).
+add_test(NAME study_fits_synthetic
+  COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/test_study_fits.py ${PROJECT_SOURCE_DIR}/launch_scripts)
+set_tests_properties(study_fits_synthetic PROPERTIES LABELS unit TIMEOUT 120)

@@ -51,6 +51,13 @@ print(\"ok\")"' "each run has a lag at its tau_alpha estimate, and its clusters 
 check '[[ $(ls "$tmp"/a/states/*.h5 | wc -l) == 5 ]] && grep -q "initial_state = .*states/n300_phi0.6_r1.43_seed1.h5" "$tmp"/a/runs/phi0.6000_eps0.900_n300_seed1/scene.toml' \
   "each system compressed once (5 prepared states for 4 runs and 2 pilots), the runs start from them"
 
+# The study analysis ran at the end (run_study.sh): study.h5, figures and
+# the reproduction table, checked against the runs themselves.
+check 'grep -q "analyse_study: .* rows" "$tmp/a.out"' "the study analysis ran when the runs were done"
+/usr/bin/python3 "$root/tests/check_study_analysis.py" "$tmp/a" || fail=1
+bash "$root/launch_scripts/analyse_study.sh" "$tmp/nothing" >"$tmp/n.out" 2>&1 && rc=0 || rc=$?
+check '[[ $rc == 1 ]] && grep -q "index.toml does not exist: is .* a study directory" "$tmp/n.out"' "analysing a directory that is no study: a clear error"
+
 stamp=$(stat -c %Y "$tmp"/a/runs/*/status.toml | sort | tail -1)
 sleep 1
 "${study[@]}" "$root/studies/tiny.toml" --out "$tmp/a" --jobs 2 >"$tmp/a2.out" 2>&1

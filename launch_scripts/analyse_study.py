@@ -1,0 +1,1309 @@
+#!/usr/bin/env python3
+"""The paper's results from a study's runs (issue: the paper from our own runs).
+
+Usage: analyse_study.py STUDY_DIR [--table FILE] [--quiet]
+
+Reads STUDY_DIR/index.toml and every complete run's run.h5 and writes
+  STUDY_DIR/study.h5         every per-run and per-point quantity used, every
+                             fit with its error, range and quality
+  STUDY_DIR/figures/*.png    one figure per result of the paper (sec. 3)
+  STUDY_DIR/reproduction.md  one row per result: the paper's number, ours
+                             with its error, agreement, the CPU time behind it
+(--table FILE writes the table there as well, e.g. docs/reproduction.md).
+
+Conventions (docs/analysis.md, "Study analysis"):
+- A point is (driving.pairs, restitution, packing fraction, N); its value is
+  the mean over seeds, its error the standard error of that mean from the
+  runs' own quoted errors (checked against the spread of seeds in
+  bench/seed_spread.py); the seeds' own spread is recorded beside it.
+- Cross-run fits are weighted by those errors and quoted with the
+  jackknife error over seeds (each seed left out of every point in turn);
+  their chi2/dof and range are recorded.
+- "At tau_alpha" means at the run's own tau_alpha (a = 0.6, the overlap
+  node's): chi4, S4, xi and chi0 are interpolated linearly in ln t between
+  the two computed lags around it; the interpolation error (against a
+  parabola through the three nearest lags) is recorded and added in
+  quadrature. Clusters and P(dx) are taken at the lag nearest tau_alpha
+  that the nodes used (the study schedules a lag at the pilot's tau_alpha);
+  its distance from tau_alpha is recorded.
+- chi4(tau_alpha) is the largest proper sub-box's (the paper's chi4 comes
+  from sub-boxes; the whole box of fixed N lacks the number fluctuations);
+  xi is the whole box's OZ xi (the finest q).
+"""
+import argparse
+import math
+import os
+import sys
+import time
+import tomllib
+
+import h5py
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import study_fits as sf  # noqa: E402
+
+import matplotlib  # noqa: E402
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+A_MAIN = 0.6          # the paper's cutoff, "unless stated otherwise"
+EPS_MAIN = 0.9        # the paper's restitution, "unless stated otherwise"
+PHI_SNAP = (0.60, 0.78, 0.805)   # the paper's snapshot densities (nearest available are used)
+PHI_AGE = (0.78, 0.805)          # the paper's ageing densities
+PHI_PDX = (0.60, 0.72, 0.78)     # three densities for P(dx) (the paper's fig. 8a shows several)
+PHI_INTERMEDIATE = (0.0, 0.77)   # D against tau_alpha: "not too close to dynamical arrest"
+PHI_HIGH = (0.775, 1.0)          # ... "at the highest densities"
+A_THREE = (0.6, 1.4, 3.0)        # the paper's fig. diff-a cutoffs
+
+
+def say(*a):
+    print(*a, flush=True)
+
+
+# ---------------------------------------------------------------- reading runs
+
+def last(g, name):
+    if name not in g:
+        return None
+    v = g[name]["value"]
+    return v[-1] if v.shape[0] else None
+
+
+def fnum(v):
+    return float(v) if v is not None else math.nan
+
+
+def cutoff_groups(obs, kind):
+    out = {}
+    if kind in obs:
+        for k in obs[kind]:
+            if k.startswith("a"):
+                out[float(k[1:])] = obs[kind][k]
+    return out
+
+
+def read_run(path, meta):
+    """Everything the analysis uses from one run.h5, as plain numpy."""
+    r = dict(meta)
+    with h5py.File(path, "r") as f:
+        r["complete"] = int(f.attrs.get("complete", 0))
+        obs = f["observables"]
+        r["N"] = int(meta["n_particles"])
+        r["cut"] = {}
+        ov, ch, s4g, cl = (cutoff_groups(obs, k) for k in ("overlap", "chi4", "s4", "clusters"))
+        for a, g in ov.items():
+            c = {"lag": g["lag_time"][:], "q": last(g, "q"), "q_err": last(g, "q_err")}
+            for k in ("tau_alpha", "tau_alpha_err", "beta", "beta_err", "tau0", "tau0_err"):
+                c[k] = fnum(last(g, k))
+            c["tau_t0"] = last(g, "tau_alpha_t0")
+            c["t0"] = g["t0"][:] if "t0" in g else None
+            if a in ch:
+                h = ch[a]
+                n_sub = h["subbox_particles"][:]
+                nl = len(h["lag_time"][:])
+                c["chi4_lag"] = h["lag_time"][:]
+                c["chi4_N"] = n_sub
+                c["chi4"] = last(h, "chi4").reshape(len(n_sub), nl)
+                c["chi4_err"] = last(h, "chi4_err").reshape(len(n_sub), nl)
+                for k in ("chi4_peak", "chi4_peak_err", "tau4", "tau4_err"):
+                    c[k] = last(h, k)
+            if a in s4g:
+                s = s4g[a]
+                q = s["q"][:]
+                lag = s["lag_time"][:]
+                ng = len(s["subbox_particles"][:])
+                c["s4_q"], c["s4_lag"] = q, lag
+                c["s4_nshells"] = s["n_shells"][:]
+                c["s4_N"] = s["subbox_particles"][:]
+                c["s4_t"] = last(s, "s4_lag").reshape(len(lag), len(q))
+                c["xi_t"] = last(s, "xi_lag").reshape(len(lag), ng)
+                c["chi0_t"] = last(s, "chi0_lag").reshape(len(lag), ng)
+                for k in ("oz_chi0", "oz_chi0_err", "a2_chi0", "a2_chi0_err", "chi4", "chi4_err", "oz_xi", "oz_xi_err",
+                          "oz_q_fit_max"):
+                    c["s4_" + k] = last(s, k)
+                for k in ("t_s4", "xi", "xi_err", "chi0", "chi0_err"):
+                    c["s4_" + k] = fnum(last(s, k))
+            if a in cl:
+                g2 = cl[a]
+                c["cl_size"] = g2["size_centre"][:]
+                c["cl_width"] = (g2["size_hi"][:] - g2["size_lo"][:] + 1).astype(float)
+                for k in ("p_slow", "p_fast", "rg_slow", "rg_fast", "rg_size_slow", "rg_size_fast"):
+                    c["cl_" + k] = last(g2, k)
+                for k in ("slow_d_f", "slow_d_f_err", "fast_d_f", "fast_d_f_err", "slow_kappa", "slow_kappa_err",
+                          "fast_sigma", "fast_n_sigma", "fast_p0", "lag"):
+                    c["cl_" + k] = fnum(last(g2, k))
+            r["cut"][a] = c
+        m = obs["msd"] if "msd" in obs else None
+        if m is not None:
+            r["D"], r["D_err"] = fnum(last(m, "diffusion")), fnum(last(m, "diffusion_err"))
+            r["D_t"] = (fnum(last(m, "fit_t_min")), fnum(last(m, "fit_t_max")))
+            r["msd_lag"], r["msd"] = m["lag_time"][:], last(m, "msd_all")
+        if "displacement" in obs:
+            d = obs["displacement"]
+            x = d["x"][:]
+            lt = last(d, "lag_time")
+            r["pdx_x"], r["pdx_lag"] = x, lt
+            r["pdx"] = last(d, "p").reshape(-1, len(lt), len(x))
+            r["pdx_target"] = last(d, "target_tau_alpha")
+        if "sim" in obs:
+            s = obs["sim"]
+            r["Z"], r["Z_err"] = fnum(last(s, "reduced_pressure")), fnum(last(s, "reduced_pressure_err"))
+        r["has_frames"] = "particles" in f and "position" in f["particles/all"]
+    return r
+
+
+def snapshot(path, a, t_target):
+    """Positions at an origin frame and slow/fast flags over the pair whose lag
+    is nearest t_target: (xy, radius class, slow, fast, box, lag)."""
+    with h5py.File(path, "r") as f:
+        pos = f["particles/all/position/value"]
+        img = f["particles/all/image/value"]
+        ftime = f["particles/all/position/time"][:]
+        box = f["particles/all/box/edges"][:]
+        species = f["particles/all/species"][:]
+        i0 = 0
+        j = int(np.argmin(np.abs(np.log(np.maximum(ftime - ftime[i0], 1e-300)) - math.log(t_target))))
+        u0 = pos[i0].reshape(-1, 2) + img[i0].reshape(-1, 2) * box
+        u1 = pos[j].reshape(-1, 2) + img[j].reshape(-1, 2) * box
+        d = np.linalg.norm(u1 - u0, axis=1)
+        return pos[i0].reshape(-1, 2), species, d < a, d > 3 * a, box, float(ftime[j] - ftime[i0])
+
+
+# ---------------------------------------------------------------- points
+
+class Point:
+    def __init__(self, key):
+        self.pairs, self.eps, self.phi, self.N = key
+        self.runs = []
+
+    def values(self, fn):
+        """[(seed, value, quoted error)] over the runs; fn(run) -> (value, error)."""
+        out = []
+        for r in self.runs:
+            try:
+                v, e = fn(r)
+            except (KeyError, TypeError, IndexError, ValueError):
+                v, e = math.nan, math.nan
+            out.append((r["seed"], float(v), float(e)))
+        return out
+
+    def mean(self, fn, drop=None):
+        """(mean over seeds, error from the quoted errors (or from the seeds' spread
+        where no run quotes one), the seeds' own standard error, seeds used)."""
+        vals = [(s, v, e) for s, v, e in self.values(fn) if s != drop and np.isfinite(v)]
+        if not vals:
+            return math.nan, math.nan, math.nan, 0
+        m, sem, n = sf.seed_mean([v for _, v, _ in vals])
+        q = sf.quoted_mean_error([e for _, _, e in vals])
+        err = q if np.isfinite(q) else sem
+        return m, err, sem, n
+
+
+def series_arrays(points, fn, drop=None):
+    """x = phi, the per-point means of fn and their errors (points with data only)."""
+    return paired_arrays(points, fn, None, drop)
+
+
+def paired_arrays(points, fn, xrun=None, drop=None, xpoint=lambda p: p.phi):
+    """Per-point means of fn against x: a per-point function (xpoint) or the
+    per-point mean of a per-run quantity (xrun, e.g. tau_alpha)."""
+    xs, ys, es = [], [], []
+    for p in points:
+        mx = p.mean(xrun, drop)[0] if xrun is not None else xpoint(p)
+        my, ey, semy, n = p.mean(fn, drop)
+        if n and np.isfinite(mx) and np.isfinite(my):
+            xs.append(mx)
+            ys.append(my)
+            es.append(ey if np.isfinite(ey) and ey > 0 else (semy if np.isfinite(semy) and semy > 0 else abs(my) * 0.1))
+    return np.array(xs), np.array(ys), np.array(es)
+
+
+def seeds_of(points):
+    return sorted({r["seed"] for p in points for r in p.runs})
+
+
+def fit_series(points, fn, form, xrun=None, xpoint=lambda p: p.phi, **kw):
+    """A cross-run fit of the per-point means of fn against x (see
+    paired_arrays), jackknifed over seeds: each seed left out of every point."""
+    def one(drop):
+        return form(*paired_arrays(points, fn, xrun, drop, xpoint), **kw)
+    return sf.jackknife_over_seeds(one, seeds_of(points))
+
+
+# ------------------------------------------------------ per-run quantities
+
+def cut(r, a=A_MAIN):
+    return r["cut"][a]
+
+
+def tau(r, a=A_MAIN):
+    c = cut(r, a)
+    return c["tau_alpha"], c["tau_alpha_err"]
+
+
+def proper_subbox(c, N):
+    """Index of the largest sub-box grid smaller than the whole box (or the largest)."""
+    ns = np.asarray(c["chi4_N"], float)
+    ok = np.where(ns < 0.999 * N)[0]
+    return int(ok[np.argmax(ns[ok])]) if len(ok) else int(np.argmax(ns))
+
+
+def whole_box_s4(c):
+    return int(np.argmax(np.asarray(c["s4_N"], float)))
+
+
+def chi4_at_tau(r, a=A_MAIN, g=None):
+    c = cut(r, a)
+    t = tau(r)[0]
+    if g is None:
+        g = proper_subbox(c, r["N"])
+    v, ie = sf.interp_ln_t(c["chi4_lag"], c["chi4"][g], t)
+    _, e = sf.interp_ln_t(c["chi4_lag"], c["chi4_err"][g], t)
+    return v, math.hypot(e, ie if np.isfinite(ie) else 0.0)
+
+
+def xi_at_tau(r, a=A_MAIN):
+    c = cut(r, a)
+    t = tau(r)[0]
+    g = whole_box_s4(c)
+    v, ie = sf.interp_ln_t(c["s4_lag"], c["xi_t"][:, g], t)
+    rel = c["s4_oz_xi_err"][g] / c["s4_oz_xi"][g] if np.isfinite(c["s4_oz_xi"][g]) and c["s4_oz_xi"][g] > 0 else math.nan
+    return v, math.hypot(abs(v) * rel if np.isfinite(rel) else math.nan, ie if np.isfinite(ie) else 0.0)
+
+
+def chi0_at_tau(r, a=A_MAIN, g=None):
+    c = cut(r, a)
+    t = tau(r)[0]
+    if g is None:
+        g = whole_box_s4(c)
+    v, ie = sf.interp_ln_t(c["s4_lag"], c["chi0_t"][:, g], t)
+    rel = c["s4_oz_chi0_err"][g] / c["s4_oz_chi0"][g] if c["s4_oz_chi0"][g] > 0 else math.nan
+    return v, math.hypot(abs(v) * rel if np.isfinite(rel) else math.nan, ie if np.isfinite(ie) else 0.0)
+
+
+def s4_at_tau(r, a=A_MAIN, g=None):
+    """(q, S4) of grid g (default the whole box) at tau_alpha, q = 0 left out."""
+    c = cut(r, a)
+    if g is None:
+        g = whole_box_s4(c)
+    off = int(np.sum(c["s4_nshells"][:g]))
+    n = int(c["s4_nshells"][g])
+    q = c["s4_q"][off:off + n]
+    t = tau(r)[0]
+    s = np.array([sf.interp_ln_t(c["s4_lag"], c["s4_t"][:, off + k], t)[0] for k in range(n)])
+    m = q > 0
+    return q[m], s[m]
+
+
+def n_star(r, a=A_MAIN):
+    """The slow-cluster cutoff size: <N_c^2>/<N_c> of P(N_c)."""
+    c = cut(r, a)
+    p, n, w = c["cl_p_slow"], c["cl_size"], c["cl_width"]
+    m = np.isfinite(p)
+    s1, s2 = np.sum((p * n * w)[m]), np.sum((p * n * n * w)[m])
+    return (s2 / s1 if s1 > 0 else math.nan), math.nan
+
+
+def oz_fit(q, s, q_max):
+    """S4 = chi0/(1 + (q xi)^2) over 0 < q <= q_max, relative residuals (as the node)."""
+    from scipy.optimize import least_squares
+    m = (q > 0) & (q <= q_max) & np.isfinite(s) & (s > 0)
+    if m.sum() < 3:
+        return math.nan, math.nan
+    qq, ss = q[m], s[m]
+    res = least_squares(lambda p: (p[0] / (1 + (qq * p[1]) ** 2) - ss) / ss, [ss[0] * 1.2, 2.0],
+                        bounds=([0, 0], [np.inf, 1e4]))
+    return float(res.x[0]), float(res.x[1])
+
+
+# ---------------------------------------------------------------- the study
+
+class Analysis:
+    def __init__(self, d):
+        self.dir = os.path.abspath(d)
+        idx = os.path.join(self.dir, "index.toml")
+        if not os.path.exists(idx):
+            raise SystemExit(f"analyse_study: {idx} does not exist: is {d} a study directory (run_study.sh --out)?")
+        with open(idx, "rb") as fh:
+            runs = tomllib.load(fh).get("runs", {})
+        self.points = {}
+        self.skipped = []
+        self.cpu = {}
+        for name, m in sorted(runs.items()):
+            path = os.path.join(self.dir, m["path"], "run.h5")
+            if m.get("state") != "complete" or not os.path.exists(path):
+                self.skipped.append((name, m.get("state", "?")))
+                continue
+            try:
+                r = read_run(path, m)
+            except (OSError, KeyError, ValueError) as e:
+                self.skipped.append((name, f"unreadable: {e}"))
+                continue
+            if r["complete"] != 1 or A_MAIN not in r["cut"]:
+                self.skipped.append((name, "run.h5 not complete" if r["complete"] != 1 else f"no cutoff a = {A_MAIN}"))
+                continue
+            r["name"], r["path"] = name, path
+            key = (m.get("pairs", "neighbours"), float(m["restitution"]), float(m["packing_fraction"]), int(m["n_particles"]))
+            self.points.setdefault(key, Point(key)).runs.append(r)
+            self.cpu[key] = self.cpu.get(key, 0.0) + float(m.get("cpu_s", 0.0))
+        self.pilot_cpu = 0.0
+        for sub in ("pilots",):
+            for root, _, files in os.walk(os.path.join(self.dir, sub)):
+                if "status.toml" in files:
+                    with open(os.path.join(root, "status.toml"), "rb") as fh:
+                        self.pilot_cpu += float(tomllib.load(fh).get("cpu_s", 0.0))
+        self.fits = {}
+        self.rows = []
+        self.figdir = os.path.join(self.dir, "figures")
+        os.makedirs(self.figdir, exist_ok=True)
+
+    # -- selections
+    def series(self, pairs="neighbours", eps=EPS_MAIN, N=None):
+        """The points of one (pairs, eps) series, one per density: at a density
+        run at several N, the largest (or N if given)."""
+        by_phi = {}
+        for k, p in self.points.items():
+            if k[0] == pairs and abs(k[1] - eps) < 1e-9 and (N is None or k[3] == N):
+                if p.phi not in by_phi or p.N > by_phi[p.phi].N:
+                    by_phi[p.phi] = p
+        return [by_phi[phi] for phi in sorted(by_phi)]
+
+    def restitutions(self, pairs="neighbours"):
+        return sorted({k[1] for k in self.points if k[0] == pairs}, reverse=True)
+
+    def cpu_of(self, pts):
+        return sum(self.cpu.get((p.pairs, p.eps, p.phi, p.N), 0.0) for p in pts)
+
+    def nearest(self, pts, phi):
+        return min(pts, key=lambda p: abs(p.phi - phi)) if pts else None
+
+    def save(self, fig, name):
+        path = os.path.join(self.figdir, name)
+        for ax in fig.axes:
+            if not ax.has_data():
+                ax.set_xscale("linear")
+                ax.set_yscale("linear")
+                ax.text(0.5, 0.5, "no data in this study", ha="center", transform=ax.transAxes)
+        fig.savefig(path, dpi=110, bbox_inches="tight")
+        plt.close(fig)
+        return os.path.relpath(path, self.dir)
+
+    def row(self, item, section, paper, ours, verdict, figure, pts, note=""):
+        self.rows.append(dict(item=item, section=section, paper=paper, ours=ours, verdict=verdict, figure=figure,
+                              cpu=self.cpu_of(pts), note=note))
+
+    def fit(self, name, f):
+        self.fits[name] = f
+        return f
+
+
+def fmt(v, e=math.nan, digits=3):
+    if not np.isfinite(v):
+        return "not determined"
+    if not np.isfinite(e):
+        return f"{v:.{digits}g}"
+    return f"{v:.{digits}g} ± {e:.2g}"
+
+
+def verdict(v, e, paper):
+    """Agreement with the paper's number: within 2 of our standard errors."""
+    if not (np.isfinite(v) and np.isfinite(e) and e > 0):
+        return "no error: not judged" if np.isfinite(v) else "not determined"
+    z = abs(v - paper) / e
+    return f"{'agrees' if z <= 2 else 'differs'} ({z:.1f} σ)"
+
+
+def colours(n):
+    return plt.cm.viridis(np.linspace(0, 0.95, max(n, 1)))
+
+
+def fit_label(f, names, fmtp="{:.3g}"):
+    return ", ".join(f"{n} = {fmtp.format(f.p[n])}" for n in names) if f.ok else "fit not made"
+
+
+# ------------------------------------------------------------ the results
+
+def overlap_results(A):
+    pts = A.series()
+    cs = colours(len(pts))
+    fig, ax = plt.subplots(1, 3, figsize=(16, 4.6))
+    for p, col in zip(pts, cs):
+        r = p.runs[0]
+        c = cut(r)
+        qm = np.nanmean([cut(x)["q"] for x in p.runs], axis=0)
+        ax[0].semilogx(c["lag"], qm, "-o", ms=2, color=col, label=f"φ = {p.phi:g}")
+        t = p.mean(tau)[0]
+        ax[1].semilogx(c["lag"] / t, qm, "-", color=col)
+    for a_ in ax[:2]:
+        a_.axhline(1 / math.e, color="k", lw=0.6, ls=":")
+        a_.set_ylabel("Q(t)")
+    ax[0].set_xlabel("t")
+    ax[1].set_xlabel("t / τ_α")
+    ax[0].legend(fontsize=7, ncol=2)
+    ax[0].set_title("Fig. Q-t: Q(t), ε = 0.9, a = 0.6")
+    ax[1].set_title("Fig. Qoftovertaualpha: against t/τ_α")
+    allp = [p for k, p in A.points.items() if k[0] == "neighbours"]
+    xs = np.linspace(-6, 6, 200)
+    for p in allp:
+        b, t0 = p.mean(lambda r: (cut(r)["beta"], cut(r)["beta_err"]))[0], p.mean(lambda r: (cut(r)["tau0"], cut(r)["tau0_err"]))[0]
+        if not (np.isfinite(b) and np.isfinite(t0)):
+            continue
+        c = cut(p.runs[0])
+        qm = np.nanmean([cut(x)["q"] for x in p.runs], axis=0)
+        ax[2].plot(b * np.log(c["lag"] / t0), qm, ".", ms=2, color=plt.cm.plasma((p.eps - 0.65) / 0.4))
+    ax[2].plot(xs, 1 / (np.exp(xs) + 1), "k-", lw=1, label="1/(e^x + 1)")
+    ax[2].plot(xs[xs > 0], np.exp(-xs[xs > 0]), "k--", lw=0.8, label="(t/τ0)^-β")
+    ax[2].set_yscale("log")
+    ax[2].set_ylim(1e-3, 1.2)
+    ax[2].set_xlabel("x = β ln(t/τ0)")
+    ax[2].set_ylabel("Q")
+    ax[2].set_title("Fig. Qofbetalntovertau0: all φ and ε (colour: ε)")
+    ax[2].legend(fontsize=8)
+    fq = A.save(fig, "overlap.png")
+    # beta(tau0), tau_alpha(tau0) (inset of the collapse figure), eps = 0.9
+    fb = A.fit("beta_of_tau0", fit_series(pts, lambda r: (cut(r)["beta"], cut(r)["beta_err"]), sf.power,
+                                          xrun=lambda r: (cut(r)["tau0"], cut(r)["tau0_err"])))
+    ft = A.fit("tau_alpha_of_tau0", fit_series(pts, tau, sf.power, xrun=lambda r: (cut(r)["tau0"], cut(r)["tau0_err"])))
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    for fn, lab, m in ((lambda r: (cut(r)["beta"], cut(r)["beta_err"]), "β", "o"), (tau, "τ_α", "s")):
+        x, y, e = [], [], []
+        for p in pts:
+            x.append(p.mean(lambda r: (cut(r)["tau0"], 0))[0])
+            mm = p.mean(fn)
+            y.append(mm[0])
+            e.append(mm[1])
+        ax.errorbar(x, y, e, fmt=m, ms=4, label=lab)
+    for f, lab in ((fb, "β"), (ft, "τ_α")):
+        if f.ok:
+            xx = np.geomspace(*f.x_range, 50)
+            ax.plot(xx, f.p["A"] * xx ** f.p["s"], "k-", lw=0.7)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("τ0")
+    ax.legend()
+    ax.set_title(f"inset: β ∝ τ0^{fb.p['s']:.3g}, τ_α ∝ τ0^{ft.p['s']:.3g} (ε = 0.9)")
+    fi = A.save(fig, "beta_tau0.png")
+    A.row("Q(t) for all φ; Q against t/τ_α (no time-density superposition)", "3.1, figs. Q-t, Qoftovertaualpha",
+          "figure only", f"{len(pts)} densities, {sum(len(p.runs) for p in pts)} runs", "figure", fq, pts)
+    A.row("Q against β ln(t/τ0): collapse for all φ and ε", "3.1, fig. Qofbetalntovertau0", "figure only",
+          f"{len(allp)} points", "figure", fq, allp)
+    A.row("β(τ0): power-law exponent (ε = 0.9)", "3.1, inset of fig. Qofbetalntovertau0", "figure only (power law)",
+          fmt(fb.p["s"], fb.error("s")) + f", χ²/dof {fb.chi2_dof():.2g}", "figure", fi, pts, fb.note)
+    A.row("τ_α(τ0): power-law exponent (ε = 0.9)", "3.1, inset of fig. Qofbetalntovertau0", "figure only (power law)",
+          fmt(ft.p["s"], ft.error("s")) + f", χ²/dof {ft.chi2_dof():.2g}", "figure", fi, pts, ft.note)
+
+
+def tau_fits(A, pts, tag):
+    """Power law and VFT for tau_alpha(phi), over every density of the series."""
+    fp = A.fit(f"tau_power_{tag}", fit_series(pts, tau, sf.critical))
+    fv = A.fit(f"tau_vft_{tag}", fit_series(pts, tau, sf.vft))
+    return fp, fv
+
+
+def better(fp, fv):
+    """Which form fits better: the smaller chi2 over the same points (both have three parameters)."""
+    if not (fp.ok and fv.ok):
+        return "not compared"
+    w = "VFT" if fv.chi2 < fp.chi2 else "power law"
+    return f"{w} (χ²/dof {fv.chi2_dof():.2g} VFT, {fp.chi2_dof():.2g} power law, {fp.n} points)"
+
+
+def tau_results(A):
+    pts = A.series()
+    fp, fv = tau_fits(A, pts, "eps0.9")
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    x, y, e = series_arrays(pts, tau)
+    ax.errorbar(x, y, e, fmt="o", ms=4, color="k", label="ε = 0.9, neighbour pairs")
+    xx = np.linspace(x.min() if len(x) else 0.6, x.max() if len(x) else 0.8, 200)
+    if fp.ok:
+        ax.plot(xx, fp.p["A"] * (fp.p["xc"] - xx) ** -fp.p["g"], "--", label=f"(φc-φ)^-γ: φc = {fp.p['xc']:.4f}, γ = {fp.p['g']:.3g}")
+    if fv.ok:
+        ax.plot(xx, fv.p["A"] * np.exp(fv.p["B"] / (fv.p["x0"] - xx)), "-", label=f"exp[B/(φ0-φ)]: φ0 = {fv.p['x0']:.4f}, B = {fv.p['B']:.3g}")
+    ax.set_yscale("log")
+    ax.set_xlabel("φ")
+    ax.set_ylabel("τ_α")
+    ax.legend(fontsize=8)
+    ax.set_title("Fig. taueps09")
+    f = A.save(fig, "tau_alpha_phi.png")
+    A.row("τ_α(φ) power law: φ_c", "3.1, fig. taueps09", "0.82", fmt(fp.p["xc"], fp.error("xc"), 4), verdict(fp.p["xc"], fp.error("xc"), 0.82), f, pts, fp.note)
+    A.row("τ_α(φ) power law: γ", "3.1, fig. taueps09", "not given", fmt(fp.p["g"], fp.error("g")), "—", f, pts, fp.note)
+    A.row("τ_α(φ) VFT: φ_0", "3.1, fig. taueps09", "0.83", fmt(fv.p["x0"], fv.error("x0"), 4), verdict(fv.p["x0"], fv.error("x0"), 0.83), f, pts, fv.note)
+    A.row("τ_α(φ) VFT: B", "3.1, fig. taueps09", "not given", fmt(fv.p["B"], fv.error("B")), "—", f, pts, fv.note)
+    A.row("τ_α(φ): which form fits better (smaller χ² over the same points)", "3.1", "VFT", better(fp, fv),
+          ("agrees" if "VFT (" in better(fp, fv) else "differs") if fp.ok and fv.ok else "not determined", f, pts)
+    return fp, fv
+
+
+def ageing_results(A):
+    pts = A.series()
+    fig, ax = plt.subplots(figsize=(6, 4.2))
+    out = []
+    used = []
+    for phi in PHI_AGE:
+        p = A.nearest(pts, phi)
+        if p is None or p in used:
+            continue
+        used.append(p)
+        slopes = []
+        for r in p.runs:
+            c = cut(r)
+            t0, tt = np.asarray(c["t0"], float), np.asarray(c["tau_t0"], float)
+            m = np.isfinite(tt)
+            ax.plot(t0[m], tt[m], "o-", ms=3, label=f"φ = {p.phi:g}, seed {r['seed']}")
+            if m.sum() >= 3:
+                tm = c["tau_alpha"]
+                slopes.append(np.polyfit(t0[m] / tm, tt[m] / tm, 1)[0])
+        s, se, n = sf.seed_mean(slopes)
+        out.append((p, s, se))
+    ax.set_xlabel("t0")
+    ax.set_ylabel("τ_α(t0)")
+    ax.legend(fontsize=6, ncol=2)
+    ax.set_title("inset of fig. Q-t-t0: no ageing")
+    f = A.save(fig, "tau_alpha_t0.png")
+    for p, s, se in out:
+        A.row(f"τ_α(t0) at φ = {p.phi:g}: slope d(τ_α/τ̄_α)/d(t0/τ̄_α)", "3.1, inset of fig. Q-t-t0", "0 (no ageing)",
+              fmt(s, se, 2), verdict(s, se, 0.0), f, [p])
+
+
+def d_results(A):
+    pts = A.series()
+    dfn = lambda r: (r["D"], r["D_err"])
+    fi = A.fit("D_tau_intermediate", fit_series([p for p in pts if PHI_INTERMEDIATE[0] <= p.phi <= PHI_INTERMEDIATE[1]], dfn, sf.power, xrun=tau))
+    fh = A.fit("D_tau_high", fit_series([p for p in pts if PHI_HIGH[0] <= p.phi <= PHI_HIGH[1]], dfn, sf.power, xrun=tau))
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    xs, ys, es = [], [], []
+    for p in pts:
+        xs.append(p.mean(tau)[0])
+        m = p.mean(dfn)
+        ys.append(m[0])
+        es.append(m[1])
+    ax.errorbar(xs, ys, es, fmt="o", ms=4, color="k")
+    for f, ls, lab in ((fi, "-", "θ"), (fh, "--", "θ'")):
+        if f.ok:
+            xx = np.geomspace(*f.x_range, 20)
+            ax.plot(xx, f.p["A"] * xx ** f.p["s"], ls, label=f"{lab} = {-f.p['s']:.3g} (τ_α {f.x_range[0]:.3g}-{f.x_range[1]:.3g})")
+    if len(xs):
+        xx = np.geomspace(min(xs), max(xs), 10)
+        ax.plot(xx, ys[0] * xs[0] / xx, ":", color="gray", label="Stokes-Einstein D ∝ 1/τ_α")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("τ_α")
+    ax.set_ylabel("D")
+    ax.legend(fontsize=8)
+    ax.set_title("Fig. D-vs-tau (D: long-time MSD/4t, msd node)")
+    f = A.save(fig, "D_tau_alpha.png")
+    sub_i = [p for p in pts if PHI_INTERMEDIATE[0] <= p.phi <= PHI_INTERMEDIATE[1]]
+    sub_h = [p for p in pts if PHI_HIGH[0] <= p.phi <= PHI_HIGH[1]]
+    A.row(f"D ∝ τ_α^-θ at intermediate densities (φ ≤ {PHI_INTERMEDIATE[1]})", "3.2, fig. D-vs-tau", "θ ≈ 1.47",
+          fmt(-fi.p["s"], fi.error("s")), verdict(-fi.p["s"], fi.error("s"), 1.47), f, sub_i, fi.note)
+    A.row(f"D ∝ τ_α^-θ' at the highest densities (φ ≥ {PHI_HIGH[0]})", "3.2, fig. D-vs-tau", "θ' ≈ 0.91",
+          fmt(-fh.p["s"], fh.error("s")), verdict(-fh.p["s"], fh.error("s"), 0.91), f, sub_h, fh.note)
+
+
+def pdx_results(A):
+    pts = A.series()
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    used = []
+    for phi, col in zip(PHI_PDX, ("C0", "C1", "C3")):
+        p = A.nearest(pts, phi)
+        if p is None or p in used or "pdx" not in p.runs[0]:
+            continue
+        used.append(p)
+        r = p.runs[0]
+        tgt = np.asarray(r["pdx_target"], float)
+        li = int(np.nanargmin(np.abs(tgt - 1.0))) if np.any(np.isfinite(tgt)) else 1
+        pm = np.nanmean([x["pdx"][1, li] for x in p.runs], axis=0)  # small particles, as the paper
+        ax.semilogy(r["pdx_x"], pm, "-", color=col, label=f"φ = {p.phi:g}, t = {r['pdx_lag'][li]:.3g} (τ_α {r['cut'][A_MAIN]['tau_alpha']:.3g})")
+    ax.set_xlim(-6, 6)
+    ax.set_ylim(1e-5, None)
+    ax.set_xlabel("Δx (small particles)")
+    ax.set_ylabel("P(Δx, τ_α)")
+    ax.legend(fontsize=8)
+    ax.set_title("Fig. tails(a): P(Δx) at τ_α")
+    f = A.save(fig, "pdx.png")
+    A.row("P(Δx) at τ_α for three densities: exponential tails", "3.2, fig. tails(a)", "figure only",
+          ", ".join(f"φ = {p.phi:g}" for p in used), "figure", f, used)
+
+
+def cluster_results(A, phi_c):
+    pts = A.series()
+    dfs = lambda r: (cut(r)["cl_slow_d_f"], cut(r)["cl_slow_d_f_err"])
+    dff = lambda r: (cut(r)["cl_fast_d_f"], cut(r)["cl_fast_d_f_err"])
+    fig, ax = plt.subplots(1, 3, figsize=(16, 4.5))
+    top = pts[-1] if pts else None
+    if top:
+        for kind, col in (("slow", "C3"), ("fast", "C7")):
+            rr, nn = [], []
+            for r in top.runs:
+                c = cut(r)
+                rr.append(c[f"cl_rg_{kind}"])
+                nn.append(c[f"cl_rg_size_{kind}"])
+            ax[0].loglog(np.nanmean(nn, axis=0), np.nanmean(rr, axis=0), "o", color=col, label=f"{kind}, φ = {top.phi:g}")
+        ax[0].set_xlabel("N_c")
+        ax[0].set_ylabel("R_g")
+        ax[0].legend(fontsize=8)
+        ax[0].set_title("Fig. clusters-VF805: R_g(N_c)")
+    x, y, e = series_arrays(pts, dfs)
+    ax[1].errorbar(x, y, e, fmt="o", color="C3", label="slow")
+    x2, y2, e2 = series_arrays(pts, dff)
+    ax[1].errorbar(x2, y2, e2, fmt="s", color="C7", label="fast")
+    ax[1].set_xlabel("φ")
+    ax[1].set_ylabel("d_f")
+    ax[1].legend(fontsize=8)
+    ax[1].set_title("inset of fig. clusters-VF805: d_f(φ)")
+    for p, col in zip(pts, colours(len(pts))):
+        c0 = cut(p.runs[0])
+        pm = np.nanmean([cut(r)["cl_p_slow"] for r in p.runs], axis=0)
+        m = pm > 0
+        ax[2].loglog(c0["cl_size"][m], pm[m], "-o", ms=2, color=col, label=f"{p.phi:g}")
+    nn = np.geomspace(1, 1e3, 10)
+    ax[2].loglog(nn, 0.4 * nn ** -1.8, "k:", label="N_c^-1.8 (paper)")
+    ax[2].set_xlabel("N_c")
+    ax[2].set_ylabel("P(N_c), slow")
+    ax[2].legend(fontsize=6, ncol=2)
+    ax[2].set_title("Fig. dist(a)")
+    f1 = A.save(fig, "clusters.png")
+    lo, hi = (pts[0], pts[-1]) if pts else (None, None)
+    if lo:
+        m, e, sem, n = lo.mean(dfs)
+        A.row(f"d_f of slow clusters at φ = {lo.phi:g}", "3.3, inset of fig. clusters-VF805", "1.65 (φ = 0.60)", fmt(m, e),
+              verdict(m, e, 1.65) if abs(lo.phi - 0.60) < 1e-9 else "other φ", f1, [lo])
+        m, e, sem, n = hi.mean(dfs)
+        A.row(f"d_f of slow clusters at φ = {hi.phi:g} (highest run)", "3.3, fig. clusters-VF805(a)", "1.91 (φ = 0.805)", fmt(m, e),
+              verdict(m, e, 1.91) + ("" if abs(hi.phi - 0.805) < 1e-9 else f"; our φ is {hi.phi:g}"), f1, [hi])
+        m, e, sem, n = hi.mean(dff)
+        A.row(f"d_f of fast clusters at φ = {hi.phi:g} (highest run)", "3.3, fig. clusters-VF805(b)", "1.73 (φ = 0.805)", fmt(m, e),
+              verdict(m, e, 1.73) + ("" if abs(hi.phi - 0.805) < 1e-9 else f"; our φ is {hi.phi:g}"), f1, [hi])
+    # kappa: the node's power-law exponent of P(N_c), slow, over the densities from 0.76 up
+    dense = [p for p in pts if p.phi >= 0.76]
+    kap = lambda r: (cut(r)["cl_slow_kappa"], cut(r)["cl_slow_kappa_err"])
+    ks = [p.mean(kap) for p in dense]
+    kv = np.array([k[0] for k in ks])
+    ke = np.array([k[1] for k in ks])
+    m = np.isfinite(kv) & np.isfinite(ke) & (ke > 0)
+    kappa = float(np.sum(kv[m] / ke[m] ** 2) / np.sum(1 / ke[m] ** 2)) if m.any() else math.nan
+    kappa_e = float(1 / math.sqrt(np.sum(1 / ke[m] ** 2))) if m.any() else math.nan
+    A.row("κ: P(N_c) ∝ N_c^-κ, slow clusters (weighted mean over φ ≥ 0.76)", "3.3, fig. dist(a), dist-collapse", "≈ 1.8",
+          fmt(kappa, kappa_e), verdict(kappa, kappa_e, 1.8), f1, dense)
+    # rho: N* = <N_c^2>/<N_c> against (phi_c - phi), phi_c from the tau_alpha power law
+    frho = Fitless = None
+    if np.isfinite(phi_c):
+        frho = A.fit("n_star", fit_series([p for p in pts if p.phi < phi_c], n_star, sf.power, xpoint=lambda p: phi_c - p.phi))
+    rho = -1 / frho.p["s"] if frho and frho.ok else math.nan
+    rho_e = abs(frho.error("s")) / frho.p["s"] ** 2 if frho and frho.ok else math.nan
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.5))
+    for p, col in zip(pts, colours(len(pts))):
+        c0 = cut(p.runs[0])
+        pm = np.nanmean([cut(r)["cl_p_slow"] for r in p.runs], axis=0)
+        ns = p.mean(n_star)[0]
+        mm = pm > 0
+        if np.isfinite(kappa) and np.isfinite(ns):
+            ax[0].loglog(c0["cl_size"][mm] / ns, pm[mm] * c0["cl_size"][mm] ** kappa, "-o", ms=2, color=col, label=f"{p.phi:g}")
+        pf = np.nanmean([cut(r)["cl_p_fast"] for r in p.runs], axis=0)
+        sg, nsig, p0 = (p.mean(lambda r, k=k: (cut(r)[k], math.nan))[0] for k in ("cl_fast_sigma", "cl_fast_n_sigma", "cl_fast_p0"))
+        mf = pf > 0
+        if all(np.isfinite(v) and v > 0 for v in (sg, nsig, p0)):
+            ax[1].semilogx(c0["cl_size"][mf] / nsig, (pf[mf] / p0) ** (2 * sg * sg), "o", ms=3, color=col, label=f"{p.phi:g}")
+    u = np.geomspace(0.05, 50, 100)
+    ax[1].semilogx(u, np.exp(-np.log(u) ** 2), "k-", lw=0.8, label="exp(-ln²(N_c/N_σ))")
+    ax[0].set_xlabel("N_c / N*  (N* = <N_c²>/<N_c>)")
+    ax[0].set_ylabel(f"P(N_c) N_c^κ, κ = {kappa:.3g}")
+    ax[0].set_title(f"Fig. dist-collapse; N* ∝ (φc-φ)^(-1/ρ), ρ = {rho:.3g}")
+    ax[1].set_xlabel("N_c / N_σ")
+    ax[1].set_ylabel("[P(N_c)/P_0]^(2σ²)")
+    ax[1].set_title("Fig. lognormal-scaled (fast clusters)")
+    for a_ in ax:
+        a_.legend(fontsize=6, ncol=2)
+    f2 = A.save(fig, "clusters_collapse.png")
+    A.row("ρ: N* ∝ (φ_c - φ)^(-1/ρ), slow clusters (φ_c from τ_α's power law)", "3.3, fig. dist-collapse", "≈ 1.63",
+          fmt(rho, rho_e), verdict(rho, rho_e, 1.63), f2, pts, frho.note if frho else "no φ_c")
+    A.row("fast clusters: log-normal collapse", "3.3, fig. lognormal-scaled", "figure only", "per-point fits of the clusters node",
+          "figure", f2, pts)
+    # snapshots
+    fig, ax = plt.subplots(1, 3, figsize=(16, 5.4))
+    shown = []
+    for k, phi in enumerate(PHI_SNAP):
+        cands = [p for p in pts if any(r.get("has_frames") for r in p.runs)]
+        p = A.nearest(cands, phi)
+        if p is None or p in shown:
+            ax[k].set_axis_off()
+            continue
+        shown.append(p)
+        r = next(r for r in p.runs if r.get("has_frames"))
+        xy, sp, slow, fast, box, lag = snapshot(r["path"], A_MAIN, cut(r)["tau_alpha"])
+        rad = np.where(sp == 0, 1.0, 1.43)
+        ax[k].scatter(xy[:, 0], xy[:, 1], s=0.2, c="#dddddd")
+        ax[k].scatter(xy[slow, 0], xy[slow, 1], s=1.2, c="#b2182b", label=f"slow ({slow.mean():.2f})")
+        ax[k].scatter(xy[fast, 0], xy[fast, 1], s=1.2, c="#555555", label=f"fast ({fast.mean():.2f})")
+        ax[k].set_aspect("equal")
+        ax[k].set_xlim(0, box[0])
+        ax[k].set_ylim(0, box[1])
+        ax[k].set_title(f"φ = {p.phi:g}, t = {lag:.3g} (τ_α = {cut(r)['tau_alpha']:.3g})", fontsize=9)
+        ax[k].legend(fontsize=7, loc="upper right")
+        del rad
+    f3 = A.save(fig, "snapshots.png")
+    A.row("snapshots of slow and fast particles at τ_α, three densities", "3.3, fig. SD-2", "figure only",
+          ", ".join(f"φ = {p.phi:g}" for p in shown) or "no run kept its frames", "figure", f3, shown)
+    return kappa
+
+
+def chi4_results(A, phi_c_tau):
+    pts = A.series()
+    fig, ax = plt.subplots(1, 3, figsize=(16, 4.5))
+    for p, col in zip(pts, colours(len(pts))):
+        c = cut(p.runs[0])
+        g = proper_subbox(c, p.N)
+        cm = np.nanmean([cut(r)["chi4"][g] for r in p.runs], axis=0)
+        ax[0].semilogx(c["chi4_lag"], cm, "-", color=col, label=f"{p.phi:g}")
+    ax[0].set_xlabel("t")
+    ax[0].set_ylabel("χ4(t)")
+    if pts:
+        c = cut(pts[0].runs[0])
+        ax[0].set_title(f"Fig. chi4: χ4(t), sub-box N = {c['chi4_N'][proper_subbox(c, pts[0].N)]:.4g}")
+    ax[0].legend(fontsize=6, ncol=2)
+    t4 = lambda r: (cut(r)["tau4"][proper_subbox(cut(r), r["N"])], cut(r)["tau4_err"][proper_subbox(cut(r), r["N"])])
+    sub = [p for p in pts if p.phi <= 0.80 + 1e-9]
+    f4 = A.fit("tau4_tau_alpha", fit_series(sub, t4, sf.power, xrun=tau))
+    x, y, e = [], [], []
+    for p in pts:
+        x.append(p.mean(tau)[0])
+        m = p.mean(t4)
+        y.append(m[0])
+        e.append(m[1])
+    ax[1].errorbar(x, y, e, fmt="o", ms=4)
+    if f4.ok:
+        xx = np.geomspace(*f4.x_range, 20)
+        ax[1].plot(xx, f4.p["A"] * xx ** f4.p["s"], "k--", label=f"τ4 ∝ τ_α^{f4.p['s']:.3g}")
+    ax[1].set_xscale("log")
+    ax[1].set_yscale("log")
+    ax[1].set_xlabel("τ_α")
+    ax[1].set_ylabel("τ4")
+    ax[1].legend()
+    ax[1].set_title("inset of fig. chi4")
+    fc = A.fit("chi4_tau_phi", fit_series(pts, chi4_at_tau, sf.critical))
+    x, y, e = series_arrays(pts, chi4_at_tau)
+    ax[2].errorbar(x, y, e, fmt="o", ms=4)
+    if fc.ok:
+        xx = np.linspace(x.min(), x.max(), 100)
+        ax[2].plot(xx, fc.p["A"] * (fc.p["xc"] - xx) ** -fc.p["g"], "--", label=f"φc = {fc.p['xc']:.4f}, γχ = {fc.p['g']:.3g}")
+    ax[2].set_yscale("log")
+    ax[2].set_xlabel("φ")
+    ax[2].set_ylabel("χ4(τ_α)")
+    ax[2].legend(fontsize=8)
+    ax[2].set_title("χ4(τ_α) against φ")
+    f = A.save(fig, "chi4.png")
+    A.row("χ4(t) for all φ", "3.4, fig. chi4", "figure only", f"{len(pts)} densities", "figure", f, pts)
+    A.row("τ4 ∝ τ_α^z (φ ≤ 0.80)", "3.4, inset of fig. chi4", "1.19", fmt(f4.p["s"], f4.error("s")), verdict(f4.p["s"], f4.error("s"), 1.19), f, sub, f4.note)
+    A.row("χ4(τ_α) ∝ (φ_c - φ)^-γχ: γχ (own φ_c)", "3.4 (from ref. AvilaPRL2014)", "≈ 2.5", fmt(fc.p["g"], fc.error("g")),
+          verdict(fc.p["g"], fc.error("g"), 2.5), f, pts, fc.note)
+    A.row("χ4(τ_α) ∝ (φ_c - φ)^-γχ: φ_c", "3.4", "≈ 0.82", fmt(fc.p["xc"], fc.error("xc"), 4), verdict(fc.p["xc"], fc.error("xc"), 0.82), f, pts, fc.note)
+
+
+def s4_results(A, joint):
+    pts = A.series()
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
+    for p, col in zip(pts, colours(len(pts))):
+        qs = [s4_at_tau(r) for r in p.runs]
+        q = qs[0][0]
+        s = np.nanmean([x[1] for x in qs], axis=0)
+        ax[0].loglog(q, s, "-o", ms=2, color=col, label=f"{p.phi:g}")
+        xi = p.mean(xi_at_tau)[0]
+        ch = p.mean(lambda r: chi0_at_tau(r))[0]
+        if np.isfinite(xi) and np.isfinite(ch):
+            ax[1].loglog(q * xi, s / ch, "o", ms=3, color=col)
+    u = np.geomspace(0.05, 30, 100)
+    ax[1].loglog(u, 1 / (1 + u * u), "k-", lw=0.8, label="OZ 1/(1+(qξ)²)")
+    ax[0].set_xlabel("q")
+    ax[0].set_ylabel("S4(q, τ_α), whole box")
+    ax[0].legend(fontsize=6, ncol=2)
+    ax[0].set_title("Fig. S4")
+    ax[1].set_xlabel("q ξ")
+    ax[1].set_ylabel("S4 / χ0")
+    ax[1].legend()
+    ax[1].set_title("Fig. scalingS4 (χ0: the OZ fit's q → 0 value)")
+    f = A.save(fig, "s4.png")
+    fx = A.fit("xi_phi", fit_series(pts, xi_at_tau, sf.critical))
+    fz = A.fit("tau_xi", fit_series(pts, tau, sf.power, xrun=xi_at_tau))
+    fd = A.fit("chi4_xi", fit_series(pts, chi4_at_tau, sf.power, xrun=xi_at_tau))
+    fig, ax = plt.subplots(1, 3, figsize=(16, 4.5))
+    x, y, e = series_arrays(pts, xi_at_tau)
+    ax[0].errorbar(x, y, e, fmt="o")
+    if fx.ok:
+        xx = np.linspace(x.min(), x.max(), 100)
+        ax[0].plot(xx, fx.p["A"] * (fx.p["xc"] - xx) ** -fx.p["g"], "--", label=f"φc = {fx.p['xc']:.4f}, γξ = {fx.p['g']:.3g}")
+    ax[0].set_yscale("log")
+    ax[0].set_xlabel("φ")
+    ax[0].set_ylabel("ξ(τ_α)")
+    ax[0].legend(fontsize=8)
+    for k, (fn, f_, lab) in enumerate(((tau, fz, "τ_α"), (chi4_at_tau, fd, "χ4(τ_α)"))):
+        xs, ys, es = [], [], []
+        for p in pts:
+            xs.append(p.mean(xi_at_tau)[0])
+            m = p.mean(fn)
+            ys.append(m[0])
+            es.append(m[1])
+        ax[k + 1].errorbar(xs, ys, es, fmt="o")
+        if f_.ok:
+            xx = np.geomspace(*f_.x_range, 20)
+            ax[k + 1].plot(xx, f_.p["A"] * xx ** f_.p["s"], "k--", label=f"∝ ξ^{f_.p['s']:.3g}")
+        ax[k + 1].set_xscale("log")
+        ax[k + 1].set_yscale("log")
+        ax[k + 1].set_xlabel("ξ(τ_α)")
+        ax[k + 1].set_ylabel(lab)
+        ax[k + 1].legend()
+    ax[0].set_title("ξ(φ)")
+    ax[1].set_title("τ_α against ξ")
+    ax[2].set_title("Fig. xi-chi_4-2")
+    f2 = A.save(fig, "xi.png")
+    nx = sum(1 for p in pts if np.isfinite(p.mean(xi_at_tau)[0]))
+    A.row("S4(q, τ_α) for all φ; S4/χ4 against qξ collapse", "3.4, figs. S4, scalingS4", "figure only", f"{nx} of {len(pts)} densities with ξ", "figure", f, pts)
+    A.row("ξ(τ_α) ∝ (φ_c - φ)^-γξ: γξ (own φ_c)", "3.4", "1.6", fmt(fx.p["g"], fx.error("g")), verdict(fx.p["g"], fx.error("g"), 1.6), f2, pts, fx.note)
+    A.row("τ_α ∝ ξ^z: z", "3.4 (z = γ_τ/γ_ξ)", "not given", fmt(fz.p["s"], fz.error("s")), "—", f2, pts, fz.note)
+    A.row("χ4(τ_α) ∝ ξ^d_f': d_f'", "3.4, fig. xi-chi_4-2", "≈ 1.6", fmt(fd.p["s"], fd.error("s")), verdict(fd.p["s"], fd.error("s"), 1.6), f2, pts, fd.note)
+    if joint is not None and joint.ok:
+        for k, paper in (("tau", "not given"), ("chi4", "2.5"), ("xi", "1.6")):
+            g = joint.p[f"g_{k}"]
+            A.row(f"joint fit of τ_α, χ4(τ_α), ξ(τ_α) with one φ_c: γ_{k}", "3.3 (φ_c from the simultaneous fit)", paper,
+                  fmt(g, joint.error(f"g_{k}")), verdict(g, joint.error(f"g_{k}"), float(paper)) if paper[0].isdigit() else "—", f2, pts)
+        A.row("joint fit: φ_c", "3.3", "0.82", fmt(joint.p["xc"], joint.error("xc"), 4), verdict(joint.p["xc"], joint.error("xc"), 0.82), f2, pts, joint.note)
+    return fx
+
+
+def fss_results(A, joint):
+    pts = A.series()
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
+    gc = joint.p["g_chi4"] / joint.p["g_xi"] if joint is not None and joint.ok else math.nan
+    for p, col in zip(pts, colours(len(pts))):
+        c = cut(p.runs[0])
+        ns = np.asarray(c["chi4_N"], float)
+        pk = np.nanmean([cut(r)["chi4_peak"] for r in p.runs], axis=0)
+        ax[0].loglog(ns, pk, "-o", ms=3, color=col, label=f"{p.phi:g}")
+        xi = p.mean(xi_at_tau)[0]
+        if np.isfinite(xi) and np.isfinite(gc):
+            ax[1].loglog(np.sqrt(ns) / xi, pk * xi ** -gc, "-o", ms=3, color=col)
+    ax[0].set_xlabel("N (sub-box)")
+    ax[0].set_ylabel("χ4^P")
+    ax[0].legend(fontsize=6, ncol=2)
+    ax[0].set_title("Fig. chi4P(a)")
+    ax[1].set_xlabel("√N / ξ")
+    ax[1].set_ylabel(f"χ4^P ξ^-(γχ/γξ), γχ/γξ = {gc:.3g} (joint fit)")
+    ax[1].set_title("Fig. chi4P(b): finite-size collapse")
+    f = A.save(fig, "chi4_peak_fss.png")
+    A.row("finite-size scaling: χ4^P against sub-box N; collapse against √N/ξ", "3.4, fig. chi4P", "figure only",
+          f"exponent ratio γχ/γξ = {gc:.3g} from our joint fit", "figure", f, pts)
+
+
+def cutoff_results(A):
+    pts = [p for p in A.series() if len(p.runs[0]["cut"]) > 1]
+    if not pts:
+        A.row("cutoff a: ξ(τ_α) against a, χ4(t) for several a, ξ(φ) and χ4 against ξ at a = 0.6, 1.4, 3.0",
+              "3.4, figs. xi-vs-a, diff-a, chi4-diff-a", "figure only", "the study computes one cutoff", "not run", "", [])
+        return
+    cuts = sorted(pts[0].runs[0]["cut"])
+    fig, ax = plt.subplots(2, 2, figsize=(12, 9))
+    ax = ax.ravel()
+    for p, col in zip(pts, colours(len(pts))):
+        xs = [p.mean(lambda r, a=a: xi_at_tau(r, a))[0] for a in cuts]
+        ax[0].plot(cuts, xs, "-o", ms=3, color=col, label=f"{p.phi:g}")
+    ax[0].set_xlabel("a")
+    ax[0].set_ylabel("ξ at t = τ_α (a = 0.6)")
+    ax[0].set_yscale("log")
+    ax[0].legend(fontsize=6, ncol=2)
+    ax[0].set_title("Fig. xi-vs-a")
+    mid = A.nearest(pts, 0.78)
+    for a, col in zip(cuts, colours(len(cuts))):
+        c = cut(mid.runs[0], a)
+        g = proper_subbox(c, mid.N)
+        cm = np.nanmean([cut(r, a)["chi4"][g] for r in mid.runs], axis=0)
+        ax[1].semilogx(c["chi4_lag"], cm, "-", color=col, label=f"a = {a:g}")
+    ax[1].set_xlabel("t")
+    ax[1].set_ylabel("χ4(t)")
+    ax[1].legend(fontsize=7)
+    ax[1].set_title(f"Fig. chi4-diff-a (φ = {mid.phi:g})")
+    outs = []
+    for a, m in zip(A_THREE, ("o", "s", "^")):
+        if a not in cuts:
+            continue
+        xfn = lambda r, a=a: xi_at_tau(r, a)
+        x, y, e = series_arrays(pts, xfn)
+        ax[2].errorbar(x, y, e, fmt=m + "-", ms=4, label=f"a = {a:g}")
+        fd = A.fit(f"chi4_xi_a{a:g}", fit_series(pts, lambda r, a=a: chi4_at_tau(r, a), sf.power, xrun=xfn))
+        xs, ys = [p.mean(xfn)[0] for p in pts], [p.mean(lambda r, a=a: chi4_at_tau(r, a))[0] for p in pts]
+        ax[3].loglog(xs, ys, m, label=f"a = {a:g}: d_f' = {fd.p['s']:.3g}")
+        if fd.ok:
+            xx = np.geomspace(*fd.x_range, 10)
+            ax[3].plot(xx, fd.p["A"] * xx ** fd.p["s"], "k--", lw=0.6)
+        outs.append((a, fd))
+    ax[2].set_yscale("log")
+    ax[2].set_xlabel("φ")
+    ax[2].set_ylabel("ξ(τ_α)")
+    ax[2].legend()
+    ax[2].set_title("Fig. diff-a(a)")
+    ax[3].set_xlabel("ξ(τ_α)")
+    ax[3].set_ylabel("χ4(τ_α)")
+    ax[3].legend(fontsize=8)
+    ax[3].set_title("Fig. diff-a(b)")
+    f = A.save(fig, "cutoff.png")
+    A.row(f"ξ(τ_α) against a ({cuts[0]:g} to {cuts[-1]:g}) for all φ; χ4(t) for several a", "3.4, figs. xi-vs-a, chi4-diff-a",
+          "figure only", f"{len(cuts)} cutoffs, {len(pts)} densities", "figure", f, pts)
+    for a, fd in outs:
+        A.row(f"χ4 ∝ ξ^d_f' at a = {a:g}", "3.4, fig. diff-a(b)", "similar for all a (≈ 1.6)", fmt(fd.p["s"], fd.error("s")),
+              verdict(fd.p["s"], fd.error("s"), 1.6), f, pts, fd.note)
+
+
+def restitution_results(A):
+    fig, ax = plt.subplots(1, 3, figsize=(16, 4.5))
+    eps_list = A.restitutions()
+    pc = []
+    for eps, col in zip(eps_list, ("C0", "C1", "C2", "C3", "C4")):
+        pts = A.series(eps=eps)
+        fp, fv = tau_fits(A, pts, f"eps{eps:g}")
+        x, y, e = series_arrays(pts, tau)
+        ax[0].errorbar(x, y, e, fmt="o", ms=4, color=col, label=f"ε = {eps:g}")
+        if fv.ok:
+            xx = np.linspace(x.min(), x.max(), 50)
+            ax[0].plot(xx, fv.p["A"] * np.exp(fv.p["B"] / (fv.p["x0"] - xx)), "-", color=col, lw=0.7)
+        pc.append((eps, fp, fv, pts))
+        p78 = A.nearest(pts, 0.78)
+        if p78 is not None and abs(p78.phi - 0.78) < 1e-9:
+            c = cut(p78.runs[0])
+            pk = np.array([p78.mean(lambda r, g=g: (cut(r)["chi4_peak"][g], cut(r)["chi4_peak_err"][g])) for g in range(len(c["chi4_N"]))])
+            ax[2].errorbar(c["chi4_N"], pk[:, 0], pk[:, 1], fmt="o-", color=col, label=f"ε = {eps:g}")
+    ax[0].set_yscale("log")
+    ax[0].set_xlabel("φ")
+    ax[0].set_ylabel("τ_α")
+    ax[0].legend(fontsize=8)
+    ax[0].set_title("Fig. tau (VFT lines)")
+    for k, (nm, m) in enumerate((("xc", "o"), ("x0", "s"))):
+        xs = [e for e, fp, fv, _ in pc]
+        f_ = [fp if nm == "xc" else fv for _, fp, fv, _ in pc]
+        if not any(f.ok for f in f_):
+            continue
+        ax[1].errorbar(xs, [f.p[nm] for f in f_], [f.error(nm) for f in f_], fmt=m, label="φ_c (power law)" if nm == "xc" else "φ_0 (VFT)")
+    ax[1].set_xlabel("ε")
+    ax[1].set_ylabel("φ_c, φ_0")
+    ax[1].legend()
+    ax[1].set_title("inset of fig. tau")
+    ax[2].set_xscale("log")
+    ax[2].set_yscale("log")
+    ax[2].set_xlabel("N (sub-box)")
+    ax[2].set_ylabel("χ4^P at φ = 0.78")
+    ax[2].legend(fontsize=8)
+    ax[2].set_title("Fig. chi_4-peak")
+    f = A.save(fig, "restitution.png")
+    for eps, fp, fv, pts in pc:
+        A.row(f"ε = {eps:g}: φ_c (power law), φ_0 (VFT)", "3.4, fig. tau inset", "decreasing with ε (figure)",
+              f"φ_c {fmt(fp.p['xc'], fp.error('xc'), 4)}, φ_0 {fmt(fv.p['x0'], fv.error('x0'), 4)} ({len(pts)} densities)",
+              "figure", f, pts, "; ".join(n for n in (fp.note, fv.note) if n))
+    ok = [(e, fv.p["x0"]) for e, fp, fv, _ in pc if fv.ok]
+    mono = all(ok[i][1] <= ok[i + 1][1] for i in range(len(ok) - 1)) if len(ok) > 1 else None
+    A.row("φ_0(ε) decreases as ε grows", "3.4, fig. tau inset", "yes", "yes" if mono else ("no" if mono is False else "not determined"),
+          "agrees" if mono else ("differs" if mono is False else "not determined"), f, [p for *_, ps in pc for p in ps])
+    # d_f' over every eps: chi4(tau_alpha) against xi(tau_alpha), all points of the neighbour series
+    allp = [p for eps in eps_list for p in A.series(eps=eps)]
+    fd = A.fit("chi4_xi_all_eps", fit_series(allp, chi4_at_tau, sf.power, xrun=xi_at_tau))
+    A.row("χ4 ∝ ξ^d_f' over all ε (the paper: ε-independent)", "3.4, fig. chi_4-peak inset", "1.58", fmt(fd.p["s"], fd.error("s")),
+          verdict(fd.p["s"], fd.error("s"), 1.58), f, allp, fd.note)
+
+
+def appendix_results(A):
+    pts = A.series()
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
+    rat = []
+    qms = (0.15, 0.25, 0.4, 0.6, 1.0)
+    x, c4, oz, a2 = [], [], [], []
+    for p in pts:
+        c = cut(p.runs[0])
+        g = proper_subbox({"chi4_N": c["s4_N"]}, p.N)
+        x.append(p.phi)
+        c4.append(p.mean(lambda r: (cut(r)["s4_chi4"][g], cut(r)["s4_chi4_err"][g])))
+        oz.append(p.mean(lambda r: (cut(r)["s4_oz_chi0"][g], cut(r)["s4_oz_chi0_err"][g])))
+        a2.append(p.mean(lambda r: (cut(r)["s4_a2_chi0"][g], cut(r)["s4_a2_chi0_err"][g])))
+        row = []
+        for qm in qms:
+            vals = []
+            for r in p.runs:
+                q, s = s4_at_tau(r, A_MAIN, g)
+                ch0, _ = oz_fit(q, s, qm)
+                ref = chi4_at_tau(r, A_MAIN, proper_subbox(cut(r), r["N"]))[0]
+                vals.append(ch0 / ref if np.isfinite(ch0) and ref > 0 else math.nan)
+            row.append(np.nanmean(vals) if np.any(np.isfinite(vals)) else math.nan)
+        rat.append(row)
+    x = np.array(x)
+    for arr, m, lab in ((c4, "-", "χ4(t_s4), eq. 14"), (oz, "^", "χ0, fit 2 (OZ)"), (a2, "o", "χ0, fit 3 (with A²)")):
+        arr = np.array([v[:2] for v in arr])
+        ax[0].errorbar(x, arr[:, 0], arr[:, 1], fmt=m, label=lab, mfc="none")
+    ax[0].set_yscale("log")
+    ax[0].set_xlabel("φ")
+    ax[0].set_ylabel("χ")
+    ax[0].legend(fontsize=8)
+    gN = cut(pts[0].runs[0])["s4_N"][proper_subbox({"chi4_N": cut(pts[0].runs[0])["s4_N"]}, pts[0].N)] if pts else math.nan
+    ax[0].set_title(f"Fig. fitting: sub-box grid N = {gN:.4g}, at the node's t_s4")
+    rat = np.array(rat)
+    for k, qm in enumerate(qms):
+        ax[1].plot(x, rat[:, k], "o-", ms=3, label=f"q_m = {qm:g}")
+    ax[1].axhline(1, color="k", lw=0.6)
+    ax[1].set_xlabel("φ")
+    ax[1].set_ylabel("χ0 (OZ over 0 < q ≤ q_m) / χ4(τ_α)")
+    ax[1].legend(fontsize=8)
+    ax[1].set_title("robustness to the fit range [0, q_m]")
+    f = A.save(fig, "appendix_chi0.png")
+    oz_r = np.array([o[0] / c[0] for o, c in zip(oz, c4) if np.isfinite(o[0]) and c[0] > 0])
+    a2_r = np.array([o[0] / c[0] for o, c in zip(a2, c4) if np.isfinite(o[0]) and c[0] > 0])
+    med = lambda v: f"{np.median(v):.3g} (range {v.min():.3g}-{v.max():.3g}, {len(v)} φ)" if len(v) else "not determined"
+    A.row("appendix: χ0 (fit 2, OZ) / χ4(τ_α)", "appendix, fig. fitting", "≈ 1 for all φ", med(oz_r),
+          ("agrees" if len(oz_r) and abs(np.median(oz_r) - 1) < 0.15 else "differs") if len(oz_r) else "not determined", f, pts)
+    A.row("appendix: χ0 (fit 3, with A²) / χ4(τ_α)", "appendix, fig. fitting", "≈ 1 for all φ", med(a2_r),
+          ("agrees" if len(a2_r) and abs(np.median(a2_r) - 1) < 0.15 else "differs") if len(a2_r) else "not determined", f, pts)
+    spread = np.nanmax(rat, axis=1) - np.nanmin(rat, axis=1) if rat.size else np.array([])
+    spread = spread[np.isfinite(spread)]
+    A.row("appendix: χ0 robust to the fit range q_m", "appendix, fig. fitting", "robust",
+          f"max-min of χ0/χ4 over q_m = {', '.join(f'{q:g}' for q in qms)}: median {np.median(spread):.2g}" if len(spread) else "not determined",
+          "figure", f, pts)
+
+
+def driving_results(A):
+    """The eps = 0.9 series under both kick-pair rules, side by side."""
+    rules = [r for r in ("neighbours", "any") if A.series(pairs=r)]
+    out = {}
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for rule, col in zip(rules, ("C0", "C3")):
+        pts = A.series(pairs=rule)
+        fp, fv = tau_fits(A, pts, f"{rule}")
+        x, y, e = series_arrays(pts, tau)
+        ax.errorbar(x, y, e, fmt="o", color=col, label=f"pairs = {rule}")
+        res = {"fp": fp, "fv": fv, "pts": pts}
+        if all("s4_N" in cut(r) for p in pts for r in p.runs):
+            res["fc"] = A.fit(f"chi4_phi_{rule}", fit_series(pts, chi4_at_tau, sf.critical))
+            res["fx"] = A.fit(f"xi_phi_{rule}", fit_series(pts, xi_at_tau, sf.critical))
+            res["fd"] = A.fit(f"chi4_xi_{rule}", fit_series(pts, chi4_at_tau, sf.power, xrun=xi_at_tau))
+        dfs = lambda r: (cut(r)["cl_slow_d_f"], cut(r)["cl_slow_d_f_err"])
+        res["df_lo"], res["df_hi"] = (pts[0].mean(dfs), pts[-1].mean(dfs)) if pts else (None, None)
+        out[rule] = res
+    ax.set_yscale("log")
+    ax.set_xlabel("φ")
+    ax.set_ylabel("τ_α (ε = 0.9)")
+    ax.legend()
+    ax.set_title("the driving rule: which kick pairs")
+    f = A.save(fig, "driving_rules.png")
+    A.driving = (out, f)
+
+
+def joint_fit(A):
+    pts = A.series()
+    seeds = seeds_of(pts)
+
+    def one(drop):
+        ser = {}
+        for k, fn in (("tau", tau), ("chi4", chi4_at_tau), ("xi", xi_at_tau)):
+            ser[k] = series_arrays(pts, fn, drop)
+        return sf.critical_joint(ser)
+    return A.fit("joint_tau_chi4_xi", sf.jackknife_over_seeds(one, seeds))
+
+
+def driving_rows(A):
+    out, f = A.driving
+    if len(out) < 2:
+        A.row("both kick-pair rules side by side (ε = 0.9)", "2 (driving)", "—",
+              f"only pairs = {', '.join(out) or 'none'} in this study", "not run", f, [])
+        return
+    def cell(res, what):
+        if what == "phi_c":
+            return fmt(res["fp"].p["xc"], res["fp"].error("xc"), 4)
+        if what == "gamma":
+            return fmt(res["fp"].p["g"], res["fp"].error("g"))
+        if what == "phi_0":
+            return fmt(res["fv"].p["x0"], res["fv"].error("x0"), 4)
+        if what == "B":
+            return fmt(res["fv"].p["B"], res["fv"].error("B"))
+        if what == "better":
+            return better(res["fp"], res["fv"]).split(" (")[0]
+        if what in ("fc", "fx", "fd"):
+            f_ = res.get(what)
+            k = "s" if what == "fd" else "g"
+            return fmt(f_.p[k], f_.error(k)) if f_ is not None else "not determined"
+        if what == "tau_range":
+            t = [p.mean(tau)[0] for p in res["pts"]]
+            return f"{min(t):.3g} to {max(t):.3g} (φ {res['pts'][0].phi:g}-{res['pts'][-1].phi:g})" if t else "—"
+        if what in ("df_lo", "df_hi"):
+            m = res[what]
+            return fmt(m[0], m[1]) if m else "—"
+    A.driving_table = []
+    for what, lab, paper in (("tau_range", "τ_α range", "grows ~100-fold to φ = 0.805 (fig. Q-t)"),
+                             ("phi_c", "τ_α power law φ_c", "0.82"), ("gamma", "τ_α power law γ", "—"),
+                             ("phi_0", "τ_α VFT φ_0", "0.83"), ("B", "τ_α VFT B", "—"), ("better", "better form", "VFT"),
+                             ("fc", "γχ (χ4(τ_α), own φ_c)", "2.5"), ("fx", "γξ (ξ(τ_α), own φ_c)", "1.6"),
+                             ("fd", "d_f' (χ4 ∝ ξ^d_f')", "1.6"), ("df_lo", "d_f slow, lowest φ", "1.65 (0.60)"),
+                             ("df_hi", "d_f slow, highest φ", "1.91 (0.805)")):
+        A.driving_table.append((lab, paper, cell(out["neighbours"], what), cell(out["any"], what)))
+
+
+def write_h5(A, path):
+    tmp = path + ".tmp"
+    with h5py.File(tmp, "w") as f:
+        f.attrs["study_dir"] = A.dir
+        f.attrs["created"] = time.strftime("%Y-%m-%dT%H:%M:%S")
+        f.attrs["conventions"] = __doc__.split("Conventions")[1].strip()
+        pg = f.create_group("points")
+        per_run = {"tau_alpha": tau, "beta": lambda r: (cut(r)["beta"], cut(r)["beta_err"]),
+                   "tau0": lambda r: (cut(r)["tau0"], cut(r)["tau0_err"]), "D": lambda r: (r["D"], r["D_err"]),
+                   "Z": lambda r: (r["Z"], r["Z_err"]), "chi4_tau_alpha": chi4_at_tau, "xi_tau_alpha": xi_at_tau,
+                   "chi0_tau_alpha": chi0_at_tau,
+                   "d_f_slow": lambda r: (cut(r)["cl_slow_d_f"], cut(r)["cl_slow_d_f_err"]),
+                   "d_f_fast": lambda r: (cut(r)["cl_fast_d_f"], cut(r)["cl_fast_d_f_err"]),
+                   "kappa_slow": lambda r: (cut(r)["cl_slow_kappa"], cut(r)["cl_slow_kappa_err"]),
+                   "n_star_slow": n_star,
+                   "cluster_lag_over_tau_alpha": lambda r: (cut(r)["cl_lag"] / cut(r)["tau_alpha"], math.nan),
+                   "s4_lag_over_tau_alpha": lambda r: (cut(r)["s4_t_s4"] / cut(r)["tau_alpha"], math.nan)}
+        for key, p in sorted(A.points.items()):
+            g = pg.create_group(f"{p.pairs}_eps{p.eps:g}_phi{p.phi:g}_n{p.N}")
+            g.attrs.update(pairs=p.pairs, restitution=p.eps, packing_fraction=p.phi, n_particles=p.N,
+                           seeds=np.array([r["seed"] for r in p.runs]), runs=",".join(r["name"] for r in p.runs),
+                           cpu_s=A.cpu.get(key, 0.0))
+            for name, fn in per_run.items():
+                vals = p.values(fn)
+                m, e, sem, n = p.mean(fn)
+                d = g.create_dataset(name, data=np.array([[v, q] for _, v, q in vals], float))
+                d.attrs.update(columns="value, quoted error (one row per seed, in attribute seeds' order)",
+                               mean=m, error=e, seed_spread_error=sem, n=n)
+            c = cut(p.runs[0])
+            g.create_dataset("q_lag", data=c["lag"])
+            g.create_dataset("q_mean", data=np.nanmean([cut(r)["q"] for r in p.runs], axis=0))
+            if "chi4" in c:
+                g.create_dataset("chi4_subbox_particles", data=c["chi4_N"])
+                g.create_dataset("chi4_peak_mean", data=np.nanmean([cut(r)["chi4_peak"] for r in p.runs], axis=0))
+        fg = f.create_group("fits")
+        for name, fit in sorted(A.fits.items()):
+            h = fg.create_group(name)
+            h.attrs.update(form=fit.form, chi2=fit.chi2, dof=fit.dof, n_points=fit.n, x_min=fit.x_range[0],
+                           x_max=fit.x_range[1], note=fit.note or "",
+                           error_from="jackknife over seeds (err_fit: the fit's own covariance)")
+            for n_ in fit.names:
+                h.attrs[n_] = fit.p[n_]
+                h.attrs[n_ + "_err"] = fit.error(n_)
+                h.attrs[n_ + "_err_fit"] = fit.err[n_]
+        rg = f.create_group("reproduction")
+        dt = h5py.string_dtype()
+        for col in ("item", "section", "paper", "ours", "verdict", "figure", "note"):
+            rg.create_dataset(col, data=np.array([r[col] for r in A.rows], dtype=object), dtype=dt)
+        rg.create_dataset("cpu_s", data=np.array([r["cpu"] for r in A.rows], float))
+        if A.skipped:
+            f.attrs["skipped_runs"] = "; ".join(f"{n}: {s}" for n, s in A.skipped)
+    os.replace(tmp, path)
+
+
+def hms(s):
+    s = int(round(s))
+    return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
+
+
+def write_table(A, path, command, discussion=None):
+    n_runs = sum(len(p.runs) for p in A.points.values())
+    total = sum(A.cpu.values())
+    L = ["# The paper from our own runs", "",
+         "Generated by `launch_scripts/analyse_study.py` (do not edit by hand): every row below comes from the "
+         f"study in `{os.path.relpath(A.dir, os.path.dirname(os.path.abspath(path)))}`, "
+         f"{n_runs} complete runs, {hms(total)} of CPU in the runs and {hms(A.pilot_cpu)} in the pilots.",
+         "", f"Command: `{command}`", "",
+         "The paper: Avila, Castillo, Vollmayr-Lee, Zippelius, *Dynamical heterogeneities in a driven granular "
+         "fluid* (`../shared/paper/`), section 3. Errors: jackknife over seeds for every cross-run fit, the standard "
+         "error of the seed mean for per-point values. \"agrees\" means within 2 of our standard errors; a row "
+         "marked \"differs\" is discussed below the table. CPU is that of the runs behind the row.", ""]
+    if A.skipped:
+        L += [f"Left out: {len(A.skipped)} runs not complete ({', '.join(sorted({s for _, s in A.skipped}))}).", ""]
+    L += ["| result | paper (section, figure) | paper | ours | verdict | figure | CPU |", "|---|---|---|---|---|---|---|"]
+    for r in A.rows:
+        note = f" ({r['note']})" if r["note"] else ""
+        L.append(f"| {r['item']} | {r['section']} | {r['paper']} | {r['ours']}{note} | {r['verdict']} | "
+                 f"{'`' + r['figure'] + '`' if r['figure'] else '—'} | {hms(r['cpu'])} |")
+    if getattr(A, "driving_table", None):
+        L += ["", "## The two driving rules side by side (ε = 0.9)", "",
+              "`driving.pairs = \"neighbours\"` (a kick's partner within reach of the first particle) against `\"any\"` "
+              "(two particles from the whole system); the paper does not say which it used (docs/engine.md, \"The "
+              "driving model\").", "",
+              "| quantity | paper | neighbours | any |", "|---|---|---|---|"]
+        for lab, paper, a, b in A.driving_table:
+            L.append(f"| {lab} | {paper} | {a} | {b} |")
+    L += ["", "## Per point (ε, φ): the means over seeds", "",
+          "| pairs | ε | φ | N | seeds | τ_α | β | τ0 | D | χ4(τ_α) | ξ(τ_α) | d_f slow |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    for key, p in sorted(A.points.items()):
+        cells = []
+        for fn in (tau, lambda r: (cut(r)["beta"], cut(r)["beta_err"]), lambda r: (cut(r)["tau0"], cut(r)["tau0_err"]),
+                   lambda r: (r["D"], r["D_err"]), chi4_at_tau, xi_at_tau, lambda r: (cut(r)["cl_slow_d_f"], cut(r)["cl_slow_d_f_err"])):
+            m, e, _, _ = p.mean(fn)
+            cells.append(fmt(m, e))
+        L.append(f"| {p.pairs} | {p.eps:g} | {p.phi:g} | {p.N} | {len(p.runs)} | " + " | ".join(cells) + " |")
+    L.append("")
+    with open(path + ".tmp", "w") as fh:
+        fh.write("\n".join(L))
+        if discussion:
+            with open(discussion) as d:
+                fh.write("\n" + d.read())
+    os.replace(path + ".tmp", path)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog=__doc__.split("\n\n", 1)[1])
+    ap.add_argument("study_dir")
+    ap.add_argument("--table", help="also write the reproduction table here (e.g. docs/reproduction.md)")
+    ap.add_argument("--discussion", help="a Markdown file appended to the table (what we found about each disagreement)")
+    a = ap.parse_args(argv)
+    t0 = time.time()
+    A = Analysis(a.study_dir)
+    if not A.points:
+        raise SystemExit(f"analyse_study: no complete run with a = {A_MAIN} in {a.study_dir}"
+                         + (f" ({len(A.skipped)} left out: {A.skipped[0][0]}: {A.skipped[0][1]}, ...)" if A.skipped else ""))
+    say(f"analyse_study: {sum(len(p.runs) for p in A.points.values())} runs at {len(A.points)} points"
+        + (f"; {len(A.skipped)} runs left out (not complete)" if A.skipped else ""))
+    failed = []
+
+    def step(name, fn, *args):
+        say(f"  {name}")
+        if not A.series():
+            A.row(name, "—", "—", f"no run of the main series (pairs = neighbours, ε = {EPS_MAIN:g})", "not determined", "", [])
+            return None
+        try:
+            return fn(A, *args)
+        except Exception as e:  # one result that cannot be made must not cost the others
+            import traceback
+            traceback.print_exc()
+            failed.append(name)
+            A.row(name, "—", "—", f"analysis failed: {type(e).__name__}: {e}", "failed", "", [])
+            return None
+
+    for name, fn in (("overlap", overlap_results), ("ageing", ageing_results), ("D", d_results), ("P(dx)", pdx_results)):
+        step(name, fn)
+    res = step("tau_alpha(phi)", tau_results)
+    phi_c = res[0].p["xc"] if res and res[0].ok else math.nan
+    step("clusters", cluster_results, phi_c)
+    step("chi4", chi4_results, phi_c)
+    joint = step("joint fit of tau_alpha, chi4, xi", joint_fit)
+    step("S4 and xi", s4_results, joint)
+    step("finite size", fss_results, joint)
+    step("cutoff a", cutoff_results)
+    step("restitution", restitution_results)
+    step("appendix", appendix_results)
+    A.driving = ({}, "")
+    step("driving rules", driving_results)
+    driving_rows(A)
+    write_h5(A, os.path.join(A.dir, "study.h5"))
+    cmd = "launch_scripts/analyse_study.sh " + os.path.relpath(A.dir, os.getcwd())
+    write_table(A, os.path.join(A.dir, "reproduction.md"), cmd, a.discussion)
+    if a.table:
+        write_table(A, a.table, cmd, a.discussion)
+    differ = [r["item"] for r in A.rows if r["verdict"].startswith("differs")]
+    say(f"analyse_study: {len(A.rows)} rows, {len(differ)} differ from the paper; {len(A.fits)} fits; "
+        f"study.h5, reproduction.md and {len(os.listdir(A.figdir))} figures in {A.dir} ({time.time() - t0:.1f} s)")
+    if failed:
+        say(f"analyse_study: FAILED: {', '.join(failed)} (the rest is written)")
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    import warnings
+    warnings.simplefilter("ignore", RuntimeWarning)
+    sys.exit(main())

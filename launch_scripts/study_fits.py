@@ -1,0 +1,294 @@
+"""The fits a study analysis makes across runs (analyse_study.py), each with
+its range, its quality and an error from independent runs.
+
+Every fit takes points x with values y and standard errors sy (the error of
+each point's mean over seeds) and returns a Fit: parameters, their errors
+from the fit's covariance (scaled by nothing: the points' errors are taken
+as they are), chi2 and degrees of freedom, the range of x it used, and a
+note where it could not be made. `jackknife_over_seeds` repeats any fit
+with one seed left out of every point at a time and gives the jackknife
+error over seeds, the error a cross-run fit is quoted with.
+
+Forms (the paper's eqs. and section 3):
+  critical   y = A (xc - x)^-g            (tau_alpha, chi4, xi against phi)
+  vft        y = A exp(B / (x0 - x))      (tau_alpha against phi)
+  power      y = A x^s                    (D against tau_alpha, tau4 against tau_alpha, ...)
+  critical_joint: one xc shared by several critical series
+"""
+import math
+
+import numpy as np
+from scipy.optimize import least_squares
+
+
+class Fit:
+    def __init__(self, form, names, x_range=(math.nan, math.nan), note=""):
+        self.form = form
+        self.names = list(names)
+        self.p = {n: math.nan for n in names}
+        self.err = {n: math.nan for n in names}     # from the covariance of the fit
+        self.jk = {n: math.nan for n in names}      # jackknife over seeds (set by jackknife_over_seeds)
+        self.chi2 = math.nan
+        self.dof = 0
+        self.n = 0
+        self.x_range = x_range
+        self.note = note
+
+    @property
+    def ok(self):
+        return all(np.isfinite(self.p[n]) for n in self.names)
+
+    def error(self, name):
+        """The quoted error: the jackknife over seeds where it exists, else the fit's own."""
+        e = self.jk.get(name, math.nan)
+        return e if np.isfinite(e) else self.err[name]
+
+    def chi2_dof(self):
+        return self.chi2 / self.dof if self.dof > 0 else math.nan
+
+    def __repr__(self):
+        ps = ", ".join(f"{n}={self.p[n]:.4g}+-{self.error(n):.2g}" for n in self.names)
+        return f"Fit({self.form}: {ps}; chi2/dof={self.chi2_dof():.3g}; x in {self.x_range}; {self.note})"
+
+
+def _clean(x, y, sy):
+    x, y, sy = (np.asarray(v, float) for v in (x, y, sy))
+    m = np.isfinite(x) & np.isfinite(y) & (y > 0) & np.isfinite(sy) & (sy > 0)
+    return x[m], y[m], sy[m]
+
+
+def _wlin(u, v, w):
+    """Weighted straight line v = c0 + c1 u (weights w = 1/sigma^2): (c, cov, chi2)."""
+    A = np.vstack([np.ones_like(u), u]).T * np.sqrt(w)[:, None]
+    b = v * np.sqrt(w)
+    c, *_ = np.linalg.lstsq(A, b, rcond=None)
+    cov = np.linalg.inv(A.T @ A)
+    r = A @ c - b
+    return c, cov, float(r @ r)
+
+
+def _finish(fit, res, names, n):
+    J = res.jac
+    try:
+        cov = np.linalg.inv(J.T @ J)
+    except np.linalg.LinAlgError:
+        cov = np.full((len(names), len(names)), math.nan)
+    for i, nme in enumerate(names):
+        fit.p[nme] = float(res.x[i])
+        fit.err[nme] = float(math.sqrt(cov[i, i])) if cov[i, i] >= 0 else math.nan
+    fit.chi2 = float(2 * res.cost)
+    fit.n = n
+    fit.dof = n - len(names)
+    return fit
+
+
+def power(x, y, sy, x_range=None):
+    """y = A x^s: a straight line in ln-ln, weighted by sy/y. Parameters A, s."""
+    fit = Fit("power", ["A", "s"])
+    x, y, sy = _clean(x, y, sy)
+    if x_range is not None:
+        m = (x >= x_range[0]) & (x <= x_range[1])
+        x, y, sy = x[m], y[m], sy[m]
+    m = x > 0
+    x, y, sy = x[m], y[m], sy[m]
+    if len(x) < 3:
+        fit.note = f"{len(x)} points with data in the range: a power law needs 3"
+        return fit
+    fit.x_range = (float(x.min()), float(x.max()))
+    c, cov, chi2 = _wlin(np.log(x), np.log(y), (y / sy) ** 2)
+    fit.p.update(A=float(math.exp(c[0])), s=float(c[1]))
+    fit.err.update(A=float(math.exp(c[0]) * math.sqrt(cov[0, 0])), s=float(math.sqrt(cov[1, 1])))
+    fit.chi2, fit.n, fit.dof = chi2, len(x), len(x) - 2
+    return fit
+
+
+def _scan_then_refine(x, y, sy, xs_from_scan, model_lin, names):
+    """For forms that are a straight line in ln y once the singular point is
+    fixed: scan the singular point, take the best straight line, then
+    refine all three parameters together (least squares on ln y)."""
+    v, w = np.log(y), (y / sy) ** 2
+    best = None
+    for xc in xs_from_scan:
+        c, _, chi2 = _wlin(model_lin(xc, x), v, w)
+        if best is None or chi2 < best[0]:
+            best = (chi2, xc, c)
+    return best
+
+
+def critical(x, y, sy, x_range=None, xc_max=1.0):
+    """y = A (xc - x)^-g, xc above every x. Parameters xc, g, A."""
+    fit = Fit("critical", ["xc", "g", "A"])
+    x, y, sy = _clean(x, y, sy)
+    if x_range is not None:
+        m = (x >= x_range[0]) & (x <= x_range[1])
+        x, y, sy = x[m], y[m], sy[m]
+    if len(x) < 4:
+        fit.note = f"{len(x)} points with data in the range: three parameters need 4"
+        return fit
+    fit.x_range = (float(x.min()), float(x.max()))
+    top = x.max()
+    scan = top + np.geomspace(1e-4, xc_max - top, 400)
+    best = _scan_then_refine(x, y, sy, scan, lambda xc, x: np.log(xc - x), None)
+    _, xc0, c = best
+    sl = sy / y
+
+    def res(p):
+        xc, g, lnA = p
+        d = np.maximum(xc - x, 1e-12)
+        return (lnA - g * np.log(d) - np.log(y)) / sl
+
+    r = least_squares(res, [xc0, -c[1], c[0]], bounds=([top + 1e-6, -50, -200], [xc_max + 1.0, 50, 200]))
+    _finish(fit, r, ["xc", "g", "lnA"], len(x))
+    fit.p["A"], fit.err["A"] = math.exp(fit.p.pop("lnA")), math.exp(r.x[2]) * fit.err.pop("lnA")
+    if xc0 >= scan[-1] - 1e-12 or fit.p["xc"] > xc_max:
+        fit.note = f"xc runs to the scan's end ({xc_max}): no divergence is resolved"
+    return fit
+
+
+def vft(x, y, sy, x_range=None, x0_max=1.0):
+    """y = A exp(B/(x0 - x)), x0 above every x. Parameters x0, B, A."""
+    fit = Fit("vft", ["x0", "B", "A"])
+    x, y, sy = _clean(x, y, sy)
+    if x_range is not None:
+        m = (x >= x_range[0]) & (x <= x_range[1])
+        x, y, sy = x[m], y[m], sy[m]
+    if len(x) < 4:
+        fit.note = f"{len(x)} points with data in the range: three parameters need 4"
+        return fit
+    fit.x_range = (float(x.min()), float(x.max()))
+    top = x.max()
+    scan = top + np.geomspace(1e-4, x0_max - top, 400)
+    _, x00, c = _scan_then_refine(x, y, sy, scan, lambda x0, x: 1.0 / (x0 - x), None)
+    sl = sy / y
+
+    def res(p):
+        x0, B, lnA = p
+        d = np.maximum(x0 - x, 1e-12)
+        return (lnA + B / d - np.log(y)) / sl
+
+    r = least_squares(res, [x00, c[1], c[0]], bounds=([top + 1e-6, -50, -200], [x0_max + 1.0, 50, 200]))
+    _finish(fit, r, ["x0", "B", "lnA"], len(x))
+    fit.p["A"], fit.err["A"] = math.exp(fit.p.pop("lnA")), math.exp(r.x[2]) * fit.err.pop("lnA")
+    if x00 >= scan[-1] - 1e-12:
+        fit.note = f"x0 runs to the scan's end ({x0_max}): no divergence is resolved"
+    return fit
+
+
+def critical_joint(series, x_range=None, xc_max=1.0):
+    """Several quantities y_k = A_k (xc - x)^-g_k with one xc (the paper's
+    "simultaneous fit of tau_alpha, chi4 and xi"). series: {name: (x, y, sy)}.
+    Parameters xc, g_<name>, A_<name>."""
+    keys = list(series)
+    names = ["xc"] + [f"g_{k}" for k in keys] + [f"A_{k}" for k in keys]
+    fit = Fit("critical_joint", names)
+    data = {}
+    for k in keys:
+        x, y, sy = _clean(*series[k])
+        if x_range is not None:
+            m = (x >= x_range[0]) & (x <= x_range[1])
+            x, y, sy = x[m], y[m], sy[m]
+        if len(x) < 3:
+            fit.note = f"{k}: {len(x)} points with data in the range; each series needs 3"
+            return fit
+        data[k] = (x, y, sy)
+    allx = np.concatenate([d[0] for d in data.values()])
+    fit.x_range = (float(allx.min()), float(allx.max()))
+    top = allx.max()
+    best = None
+    for xc in top + np.geomspace(1e-4, xc_max - top, 300):
+        tot, cs = 0.0, []
+        for k in keys:
+            x, y, sy = data[k]
+            c, _, chi2 = _wlin(np.log(xc - x), np.log(y), (y / sy) ** 2)
+            tot += chi2
+            cs.append(c)
+        if best is None or tot < best[0]:
+            best = (tot, xc, cs)
+    _, xc0, cs = best
+    p0 = [xc0] + [-c[1] for c in cs] + [c[0] for c in cs]
+    K = len(keys)
+
+    def res(p):
+        out = []
+        for i, k in enumerate(keys):
+            x, y, sy = data[k]
+            d = np.maximum(p[0] - x, 1e-12)
+            out.append((p[1 + K + i] - p[1 + i] * np.log(d) - np.log(y)) / (sy / y))
+        return np.concatenate(out)
+
+    lo = [top + 1e-6] + [-50] * K + [-200] * K
+    hi = [xc_max + 1.0] + [50] * K + [200] * K
+    r = least_squares(res, p0, bounds=(lo, hi))
+    lnames = ["xc"] + [f"g_{k}" for k in keys] + [f"lnA_{k}" for k in keys]
+    tmp = Fit("tmp", lnames)
+    _finish(tmp, r, lnames, len(allx))
+    fit.p["xc"], fit.err["xc"] = tmp.p["xc"], tmp.err["xc"]
+    for i, k in enumerate(keys):
+        fit.p[f"g_{k}"], fit.err[f"g_{k}"] = tmp.p[f"g_{k}"], tmp.err[f"g_{k}"]
+        fit.p[f"A_{k}"] = math.exp(tmp.p[f"lnA_{k}"])
+        fit.err[f"A_{k}"] = fit.p[f"A_{k}"] * tmp.err[f"lnA_{k}"]
+    fit.chi2, fit.n, fit.dof = tmp.chi2, tmp.n, tmp.dof
+    if xc0 >= top + (xc_max - top) * 0.999:
+        fit.note = f"xc runs to the scan's end ({xc_max}): no divergence is resolved"
+    return fit
+
+
+def seed_mean(values):
+    """Mean over seeds and its standard error from their spread (NaN for one seed)."""
+    v = np.asarray([a for a in values if np.isfinite(a)], float)
+    if len(v) == 0:
+        return math.nan, math.nan, 0
+    if len(v) == 1:
+        return float(v[0]), math.nan, 1
+    return float(v.mean()), float(v.std(ddof=1) / math.sqrt(len(v))), len(v)
+
+
+def quoted_mean_error(errs):
+    """The error of a mean over seeds from each run's own quoted error."""
+    e = np.asarray([a for a in errs if np.isfinite(a)], float)
+    return float(math.sqrt((e ** 2).sum()) / len(e)) if len(e) else math.nan
+
+
+def jackknife_over_seeds(fit_fn, seeds, fit=None):
+    """Jackknife over independent runs. fit_fn(drop) makes the fit with
+    seed `drop` left out of every point (drop=None: all seeds) and returns
+    a Fit. Sets fit.jk (sqrt((n-1)/n sum (theta_s - theta_bar)^2) over the
+    n seeds) and returns the fit."""
+    if fit is None:
+        fit = fit_fn(None)
+    seeds = sorted(set(seeds))
+    if not fit.ok or len(seeds) < 2:
+        if len(seeds) < 2:
+            fit.note = (fit.note + "; " if fit.note else "") + "one seed: no error over runs"
+        return fit
+    reps = [fit_fn(s) for s in seeds]
+    n = len(reps)
+    for name in fit.names:
+        th = np.array([r.p.get(name, math.nan) for r in reps], float)
+        if np.all(np.isfinite(th)):
+            fit.jk[name] = float(math.sqrt((n - 1) / n * ((th - th.mean()) ** 2).sum()))
+    return fit
+
+
+def interp_ln_t(t, y, at):
+    """y(t) at t = at, linear in ln t between the two lags around it. Returns
+    (value, interpolation error): the error is the difference from the
+    parabola in ln t through the three lags nearest `at` (NaN outside the
+    lags or where y is not finite there)."""
+    t, y = np.asarray(t, float), np.asarray(y, float)
+    if not np.isfinite(at) or at <= 0 or len(t) < 2 or at < t[0] or at > t[-1]:
+        return math.nan, math.nan
+    lt, la = np.log(t), math.log(at)
+    j = int(np.searchsorted(lt, la))
+    j = min(max(j, 1), len(t) - 1)
+    a, b = j - 1, j
+    if not (np.isfinite(y[a]) and np.isfinite(y[b])):
+        return math.nan, math.nan
+    f = (la - lt[a]) / (lt[b] - lt[a]) if lt[b] > lt[a] else 0.0
+    lin = float(y[a] + f * (y[b] - y[a]))
+    idx = np.argsort(np.abs(lt - la))[:3]
+    idx = np.sort(idx)
+    if len(idx) < 3 or not np.all(np.isfinite(y[idx])):
+        return lin, math.nan
+    c = np.polyfit(lt[idx], y[idx], 2)
+    return lin, float(abs(np.polyval(c, la) - lin))

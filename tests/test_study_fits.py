@@ -1,0 +1,111 @@
+#!/usr/bin/env python3
+"""Each cross-run fit of the study analysis (launch_scripts/study_fits.py)
+against synthetic studies with known parameters: K seeds per point, each
+seed's value the true one times (1 + s * gaussian noise), its quoted error
+s * true value, as a run reports it. The fit with its jackknife error over
+seeds must recover every parameter within 3 errors in every one of R
+synthetic studies, and the errors must be honest: the fraction of studies
+whose parameter lies within one jackknife error of the truth must be that
+of a t distribution with K-1 degrees of freedom (0.64 for K = 6) within
+its binomial spread. Also: the ln t interpolation is exact for a line in
+ln t and its error estimate is zero there; fits with too few points say so.
+Usage: test_study_fits.py LAUNCH_SCRIPTS_DIR"""
+import math
+import sys
+
+import numpy as np
+
+sys.path.insert(0, sys.argv[1] if len(sys.argv) > 1 else "launch_scripts")
+import study_fits as sf  # noqa: E402
+
+K, R, S = 6, 60, 0.03
+fails = []
+
+
+def check(cond, what):
+    print(("ok   " if cond else "FAIL ") + what)
+    if not cond:
+        fails.append(what)
+
+
+def synthetic(fit_fn, x, truth_fn, params, rng):
+    """R synthetic studies; returns per parameter the normalised deviations (est - true)/jk_err."""
+    y_true = truth_fn(x)
+    devs = {p: [] for p in params}
+    for _ in range(R):
+        runs = y_true[None, :] * (1 + S * rng.standard_normal((K, len(x))))
+
+        def one(drop):
+            keep = [k for k in range(K) if k != drop]
+            y = runs[keep].mean(axis=0)
+            sy = S * y_true / math.sqrt(len(keep))
+            return fit_fn(x, y, sy)
+        f = sf.jackknife_over_seeds(one, list(range(K)))
+        for p, true in params.items():
+            devs[p].append((f.p[p] - true) / f.error(p) if f.ok else math.inf)
+    return {p: np.array(v) for p, v in devs.items()}
+
+
+def judge(name, devs):
+    # P(|t_5| < 1) = 0.637; binomial sd over R = 60 studies is 0.062: accept 0.45 .. 0.85
+    for p, d in devs.items():
+        inside = float(np.mean(np.abs(d) < 1))
+        check(np.all(np.abs(d) < 3 * 2.0) and np.mean(np.abs(d) < 3) > 0.9,
+              f"{name}: {p} recovered within 3 jackknife errors in {np.mean(np.abs(d) < 3):.0%} of {R} studies (worst {np.max(np.abs(d)):.2f})")
+        check(0.45 <= inside <= 0.85, f"{name}: {p} within one error in {inside:.0%} of studies (t with {K - 1} dof: 64%)")
+
+
+rng = np.random.default_rng(20261123)
+phi = np.array([0.60, 0.65, 0.70, 0.72, 0.74, 0.76, 0.77, 0.78, 0.785, 0.79, 0.795, 0.80])
+
+# tau_alpha = 0.05 (0.82 - phi)^-2.4
+judge("critical (power law in phi_c - phi)",
+      synthetic(sf.critical, phi, lambda x: 0.05 * (0.82 - x) ** -2.4, {"xc": 0.82, "g": 2.4}, rng))
+# tau_alpha = 0.2 exp(0.5/(0.83 - phi))
+judge("vft", synthetic(sf.vft, phi, lambda x: 0.2 * np.exp(0.5 / (0.83 - x)), {"x0": 0.83, "B": 0.5}, rng))
+# D = 0.3 tau^-1.47 over tau from 1.5 to 50
+tau = np.geomspace(1.5, 50, 9)
+judge("power", synthetic(sf.power, tau, lambda x: 0.3 * x ** -1.47, {"s": -1.47}, rng))
+
+
+# joint: tau, chi4, xi with one phi_c
+def joint_truth():
+    return {"tau": lambda x: 0.05 * (0.82 - x) ** -2.4, "chi4": lambda x: 0.02 * (0.82 - x) ** -2.5,
+            "xi": lambda x: 0.1 * (0.82 - x) ** -1.6}
+
+
+devs = {"xc": [], "g_chi4": [], "g_xi": []}
+for _ in range(R // 2):
+    data = {k: f(phi)[None, :] * (1 + S * rng.standard_normal((K, len(phi)))) for k, f in joint_truth().items()}
+
+    def one(drop):
+        keep = [k for k in range(K) if k != drop]
+        return sf.critical_joint({k: (phi, v[keep].mean(axis=0), S * joint_truth()[k](phi) / math.sqrt(len(keep)))
+                                  for k, v in data.items()})
+    f = sf.jackknife_over_seeds(one, list(range(K)))
+    for p, true in (("xc", 0.82), ("g_chi4", 2.5), ("g_xi", 1.6)):
+        devs[p].append((f.p[p] - true) / f.error(p))
+for p, d in devs.items():
+    d = np.array(d)
+    check(np.mean(np.abs(d) < 3) > 0.9, f"critical_joint: {p} recovered within 3 jackknife errors in {np.mean(np.abs(d) < 3):.0%} of {R // 2} studies")
+    check(0.40 <= np.mean(np.abs(d) < 1) <= 0.90, f"critical_joint: {p} within one error in {np.mean(np.abs(d) < 1):.0%} of studies")
+
+# too few points: a note, no numbers
+f = sf.critical(phi[:3], phi[:3] * 0 + 1, phi[:3] * 0 + 0.1)
+check(not f.ok and "need 4" in f.note, f"critical with 3 points says why it is not made: {f.note!r}")
+f = sf.power([1, 2], [1, 2], [0.1, 0.1])
+check(not f.ok and "needs 3" in f.note, f"power with 2 points says why it is not made: {f.note!r}")
+f = sf.jackknife_over_seeds(lambda d: sf.power(tau, tau, tau * 0.1), [1])
+check("one seed" in f.note and not np.isfinite(f.jk["s"]), "one seed: no jackknife error, and the note says so")
+
+# interpolation in ln t
+t = np.geomspace(0.1, 100, 13)
+v, e = sf.interp_ln_t(t, 2 + 3 * np.log(t), 7.3)
+check(abs(v - (2 + 3 * math.log(7.3))) < 1e-12 and e < 1e-12, f"interp_ln_t exact on a line in ln t ({v:.15g}, error {e:.2g})")
+v, e = sf.interp_ln_t(t, np.log(t) ** 2, 7.3)
+true = math.log(7.3) ** 2
+check(abs(v - true) <= 1.5 * e + 1e-12 and e > 0, f"interp_ln_t on a parabola: error estimate {e:.3g} covers the miss {abs(v - true):.3g}")
+check(all(math.isnan(x) for x in sf.interp_ln_t(t, t, 1000.0)), "interp_ln_t outside the lags: NaN")
+
+print(f"{len(fails)} failed" if fails else "all passed")
+sys.exit(1 if fails else 0)
