@@ -96,3 +96,9 @@ set_tests_properties(replay_runs_from_one_log PROPERTIES LABELS process TIMEOUT 
 add_test(NAME study_fits_synthetic
   COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/test_study_fits.py ${PROJECT_SOURCE_DIR}/launch_scripts)
 set_tests_properties(study_fits_synthetic PROPERTIES LABELS unit TIMEOUT 120)
+
+# LCM's GUI log player through logplayer.sh on Xvfb: --inputs plays exactly
+# the log's inputs (tests/logplayer_gui.sh).
+add_test(NAME logplayer_gui
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/logplayer_gui.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(logplayer_gui PROPERTIES LABELS process TIMEOUT 180)
