@@ -6,11 +6,18 @@
 #   --out DIR       where run.h5, plots and logs go (default runs/<scene>-<time>)
 #   --bus private   (default) a private network namespace: no packet leaves
 #                   the machine, nothing else on the host sees the run
-#   --bus host      the host's LCM bus ($LCM_DEFAULT_URL, else
-#                   udpm://239.255.76.67:7667?ttl=1: lcm-spy (spy.sh) on this
-#                   host and other hosts on the LAN can watch)
+#   --bus host      this host's LCM bus ($LCM_DEFAULT_URL, else
+#                   udpm://239.255.76.67:7667?ttl=0): lcm-spy (spy.sh) on this
+#                   host can watch; no packet leaves the host
+#   --bus lan       the LAN's bus (ttl=1): other hosts can watch, or run the
+#                   analysis (--role); receive buffers of 4 MiB
+#   --role R        all (default): sim, nodes and recorder here; analysis:
+#                   the nodes and the recorder only (results and plots here);
+#                   sim: the sim only. Start the analysis on one host and the
+#                   sim on another, both with --bus lan, the same scene and
+#                   the same --run-id (README, "Several hosts")
 #   --url URL       LCM URL (default udpm://239.255.76.67:7667?ttl=0, and
-#                   ttl=1 with --bus host)
+#                   ttl=1 with --bus lan)
 #   --record LOG    also record everything with lcm-logger into LOG
 #   --no-build      skip setup.sh (packages and build)
 #   --resume CKPT   continue the run saved in checkpoint CKPT (instead of a
@@ -27,7 +34,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
-scene="" out="" bus=private url="" record="" build_first=1 resume="" run_id=""
+scene="" out="" bus=private url="" record="" build_first=1 resume="" run_id="" role=all
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
@@ -37,7 +44,8 @@ while (($#)); do
   --no-build) build_first=0; shift ;;
   --resume) resume=$2; shift 2 ;;
   --run-id) run_id=$2; shift 2 ;;
-  -h | --help) sed -n '2,24p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  --role) role=$2; shift 2 ;;
+  -h | --help) sed -n '2,32p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   -*) echo "run_scene: unknown option $1" >&2; exit 2 ;;
   *) [[ -z $scene ]] || { echo "run_scene: one scene only" >&2; exit 2; }; scene=$1; shift ;;
   esac
@@ -52,7 +60,12 @@ else
   [[ -f $scene ]] || { echo "run_scene: no scene file $scene" >&2; exit 2; }
   sim_input=("$scene")
 fi
-[[ $bus == private || $bus == host ]] || { echo "run_scene: --bus is private or host, not $bus" >&2; exit 2; }
+[[ $bus == private || $bus == host || $bus == lan ]] || { echo "run_scene: --bus is private, host or lan, not $bus" >&2; exit 2; }
+[[ $role == all || $role == sim || $role == analysis ]] || { echo "run_scene: --role is all, sim or analysis, not $role" >&2; exit 2; }
+if [[ $role != all ]]; then
+  [[ $bus == lan || -n $url ]] || { echo "run_scene: --role $role splits a run over hosts: use --bus lan (or --url)" >&2; exit 2; }
+  [[ -n $run_id || -n $resume ]] || { echo "run_scene: --role $role needs --run-id ID, the same on both hosts" >&2; exit 2; }
+fi
 
 if ((build_first)) && [[ -z ${DYNHET_IN_NETNS:-} ]]; then BUILD_DIR=$build "$root/launch_scripts/setup.sh"; fi
 
@@ -76,9 +89,9 @@ if [[ $bus == private && -z ${DYNHET_IN_NETNS:-} ]]; then
   exec "$root/launch_scripts/netns.sh" "$0" ${scene:+"$scene"} "${args[@]}"
 fi
 if [[ -n $url ]]; then export LCM_DEFAULT_URL=$url; fi
-# On the host's bus other hosts should see the run (ttl=1, the LAN); a
-# private bus never leaves the namespace anyway.
-if [[ $bus == host ]]; then default_ttl=1; else default_ttl=0; fi
+# Only the LAN bus leaves the host (ttl=1); a private bus never leaves its
+# namespace anyway.
+if [[ $bus == lan ]]; then default_ttl=1; else default_ttl=0; fi
 url=${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=$default_ttl}
 # Frames come in bursts of chunks: ask for a big socket receive buffer.
 [[ $url == udpm://* && $url != *recv_buf_size* ]] && url="$url&recv_buf_size=4194304"
@@ -109,7 +122,12 @@ start() { # name, then the command; waits for its "ready" line
   echo "run_scene: $n did not get ready in 10 s" >&2; exit 1
 }
 
-echo "run_scene: ${scene:-resuming $resume} -> $out (bus $bus, $url, run $run_id)" >&2
+echo "run_scene: ${scene:-resuming $resume} -> $out (bus $bus, $url, run $run_id, role $role)" >&2
+if [[ $role == sim ]]; then # the sim alone; the analysis host records and plots
+  "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" --pace-nodes --checkpoint "$out/checkpoint.h5" \
+    --checkpoint-before-frames "$out/checkpoint_before_frames.h5" 2> >(tee ${resume:+-a} "$out/sim_node.log" >&2)
+  exit $?
+fi
 if [[ -n $record ]]; then
   rm -f "$record"
   # Ahead of the other processes where allowed (root): a starved lcm-logger
@@ -117,8 +135,10 @@ if [[ -n $record ]]; then
   nice -n -5 lcm-logger --lcm-url="$url" --force "$record" >"$out/lcm-logger.log" 2>&1 &
   logger_pid=$!
 fi
-start recorder "$bin/recorder" --out "$out/run.h5" --run-id "$run_id"
-for n in $nodes; do start "$n" "$bin/$n" --run-id "$run_id"; done
+# On the analysis host the sim may be started minutes later, by hand.
+wait_run=(); [[ $role == analysis ]] && wait_run=(--wait-run 900)
+start recorder "$bin/recorder" --out "$out/run.h5" --run-id "$run_id" "${wait_run[@]}"
+for n in $nodes; do start "$n" "$bin/$n" --run-id "$run_id" "${wait_run[@]}"; done
 if [[ -n $record ]]; then
   # lcm-logger says nothing when it is ready. The nodes publish their status
   # every second from the start: once the log holds anything (it is flushed
@@ -130,11 +150,16 @@ if [[ -n $record ]]; then
 fi
 
 # The sim in the foreground (its progress line goes to the terminal and
-# sim_node.log).
+# sim_node.log); with --role analysis it runs on another host.
 set +e
-"$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" --pace-nodes --checkpoint "$out/checkpoint.h5" \
-  --checkpoint-before-frames "$out/checkpoint_before_frames.h5" 2> >(tee ${resume:+-a} "$out/sim_node.log" >&2)
-sim_rc=$?
+if [[ $role == analysis ]]; then
+  echo "run_scene: waiting for run $run_id's sim on the bus (start it with --role sim --run-id $run_id)" >&2
+  sim_rc=0
+else
+  "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" --pace-nodes --checkpoint "$out/checkpoint.h5" \
+    --checkpoint-before-frames "$out/checkpoint_before_frames.h5" 2> >(tee ${resume:+-a} "$out/sim_node.log" >&2)
+  sim_rc=$?
+fi
 set -e
 if [[ $sim_rc -ne 0 ]]; then
   echo "run_scene: sim_node failed (exit $sim_rc); giving the others 15 s to finish" >&2

@@ -102,3 +102,10 @@ set_tests_properties(study_fits_synthetic PROPERTIES LABELS unit TIMEOUT 120)
 add_test(NAME logplayer_gui
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/logplayer_gui.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(logplayer_gui PROPERTIES LABELS process TIMEOUT 180)
+
+# Two hosts as two network namespaces joined by a veth pair: the sim in one
+# (--bus lan --role sim), nodes and recorder in the other; complete, no
+# frame lost, equal to the one-host run bit for bit (tests/two_hosts.sh).
+add_test(NAME two_hosts_veth
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/two_hosts.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(two_hosts_veth PROPERTIES LABELS process TIMEOUT 180)
