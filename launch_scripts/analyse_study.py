@@ -127,8 +127,9 @@ def read_run(path, meta):
                     c["s4_" + k] = fnum(last(s, k))
             if a in cl:
                 g2 = cl[a]
-                c["cl_size"] = g2["size_centre"][:]
-                c["cl_width"] = (g2["size_hi"][:] - g2["size_lo"][:] + 1).astype(float)
+                if "size_centre" in g2:  # absent where this cutoff's tau_alpha was never reached
+                    c["cl_size"] = g2["size_centre"][:]
+                    c["cl_width"] = (g2["size_hi"][:] - g2["size_lo"][:] + 1).astype(float)
                 for k in ("p_slow", "p_fast", "rg_slow", "rg_fast", "rg_size_slow", "rg_size_fast"):
                     c["cl_" + k] = last(g2, k)
                 for k in ("slow_d_f", "slow_d_f_err", "fast_d_f", "fast_d_f_err", "slow_kappa", "slow_kappa_err",
@@ -867,6 +868,9 @@ def s4_results(A, joint):
     A.row("ξ(τ_α) ∝ (φ_c - φ)^-γξ: γξ (own φ_c)", "3.4", "1.6", fmt(fx.p["g"], fx.error("g")), verdict(fx.p["g"], fx.error("g"), 1.6), f2, pts, fx.note)
     A.row("τ_α ∝ ξ^z: z", "3.4 (z = γ_τ/γ_ξ)", "not given", fmt(fz.p["s"], fz.error("s")), "—", f2, pts, fz.note)
     A.row("χ4(τ_α) ∝ ξ^d_f': d_f'", "3.4, fig. xi-chi_4-2", "≈ 1.6", fmt(fd.p["s"], fd.error("s")), verdict(fd.p["s"], fd.error("s"), 1.6), f2, pts, fd.note)
+    fd0 = A.fit("chi0_xi", fit_series(pts, chi0_at_tau, sf.power, xrun=xi_at_tau))
+    A.row("the same with the whole box's OZ χ0 in place of the sub-box χ4: d_f'", "3.4 (eq. 18)", "≈ 1.6",
+          fmt(fd0.p["s"], fd0.error("s")), verdict(fd0.p["s"], fd0.error("s"), 1.6), f2, pts, fd0.note)
     if joint is not None and joint.ok:
         for k, paper in (("tau", "not given"), ("chi4", "2.5"), ("xi", "1.6")):
             g = joint.p[f"g_{k}"]
@@ -961,14 +965,18 @@ def cutoff_results(A):
 def restitution_results(A):
     fig, ax = plt.subplots(1, 3, figsize=(16, 4.5))
     eps_list = A.restitutions()
+    # phi_c(eps) and phi_0(eps) are compared over the densities every eps has
+    ranges = [(min(p.phi for p in A.series(eps=e)), max(p.phi for p in A.series(eps=e))) for e in eps_list if A.series(eps=e)]
+    common = (max(r[0] for r in ranges), min(r[1] for r in ranges)) if ranges else None
     pc = []
     for eps, col in zip(eps_list, ("C0", "C1", "C2", "C3", "C4")):
         pts = A.series(eps=eps)
-        fp, fv = tau_fits(A, pts, f"eps{eps:g}")
+        fp = A.fit(f"tau_power_eps{eps:g}_common", fit_series(pts, tau, sf.critical, x_range=common))
+        fv = A.fit(f"tau_vft_eps{eps:g}_common", fit_series(pts, tau, sf.vft, x_range=common))
         x, y, e = series_arrays(pts, tau)
         ax[0].errorbar(x, y, e, fmt="o", ms=4, color=col, label=f"ε = {eps:g}")
         if fv.ok:
-            xx = np.linspace(x.min(), x.max(), 50)
+            xx = np.linspace(*fv.x_range, 50)
             ax[0].plot(xx, fv.p["A"] * np.exp(fv.p["B"] / (fv.p["x0"] - xx)), "-", color=col, lw=0.7)
         pc.append((eps, fp, fv, pts))
         p78 = A.nearest(pts, 0.78)
@@ -980,7 +988,7 @@ def restitution_results(A):
     ax[0].set_xlabel("φ")
     ax[0].set_ylabel("τ_α")
     ax[0].legend(fontsize=8)
-    ax[0].set_title("Fig. tau (VFT lines)")
+    ax[0].set_title(f"Fig. tau (VFT over φ {common[0]:g}-{common[1]:g})" if common else "Fig. tau")
     for k, (nm, m) in enumerate((("xc", "o"), ("x0", "s"))):
         xs = [e for e, fp, fv, _ in pc]
         f_ = [fp if nm == "xc" else fv for _, fp, fv, _ in pc]
@@ -998,14 +1006,23 @@ def restitution_results(A):
     ax[2].legend(fontsize=8)
     ax[2].set_title("Fig. chi_4-peak")
     f = A.save(fig, "restitution.png")
+    rng = f"φ {common[0]:g}-{common[1]:g}, the densities every ε has" if common else ""
     for eps, fp, fv, pts in pc:
-        A.row(f"ε = {eps:g}: φ_c (power law), φ_0 (VFT)", "3.4, fig. tau inset", "decreasing with ε (figure)",
-              f"φ_c {fmt(fp.p['xc'], fp.error('xc'), 4)}, φ_0 {fmt(fv.p['x0'], fv.error('x0'), 4)} ({len(pts)} densities)",
+        A.row(f"ε = {eps:g}: φ_c (power law), φ_0 (VFT), over {rng}", "3.4, fig. tau inset", "decreasing with ε (figure)",
+              f"φ_c {fmt(fp.p['xc'], fp.error('xc'), 4)}, φ_0 {fmt(fv.p['x0'], fv.error('x0'), 4)}",
               "figure", f, pts, "; ".join(n for n in (fp.note, fv.note) if n))
-    ok = [(e, fv.p["x0"]) for e, fp, fv, _ in pc if fv.ok]
-    mono = all(ok[i][1] <= ok[i + 1][1] for i in range(len(ok) - 1)) if len(ok) > 1 else None
-    A.row("φ_0(ε) decreases as ε grows", "3.4, fig. tau inset", "yes", "yes" if mono else ("no" if mono is False else "not determined"),
-          "agrees" if mono else ("differs" if mono is False else "not determined"), f, [p for *_, ps in pc for p in ps])
+    for nm, key, which in (("φ_c", "xc", 1), ("φ_0", "x0", 2)):
+        vals = [(e, f[which].p[key], f[which].error(key)) for e, *f in [(e, None, fp, fv) for e, fp, fv, _ in pc] if f[which].ok]
+        vals.sort()
+        if len(vals) < 2:
+            A.row(f"{nm}(ε) decreases as ε grows", "3.4, fig. tau inset", "yes", "not determined", "not determined", f, [])
+            continue
+        # ordered by eps: each step up in eps must not raise phi by more than 2 combined errors
+        wrong = [(a, b) for a, b in zip(vals, vals[1:]) if b[1] - a[1] > 2 * math.hypot(a[2], b[2])]
+        order = ", ".join(f"{e:g}: {v:.4f}" for e, v, _ in vals)
+        A.row(f"{nm}(ε) decreases as ε grows ({rng})", "3.4, fig. tau inset", "yes", order,
+              "agrees" if not wrong else "differs (" + "; ".join(f"ε {a[0]:g} → {b[0]:g} rises" for a, b in wrong) + ")",
+              f, [p for *_, ps in pc for p in ps])
     # d_f' over every eps: chi4(tau_alpha) against xi(tau_alpha), all points of the neighbour series
     allp = [p for eps in eps_list for p in A.series(eps=eps)]
     fd = A.fit("chi4_xi_all_eps", fit_series(allp, chi4_at_tau, sf.power, xrun=xi_at_tau))
