@@ -255,9 +255,13 @@ def whole_box_s4(c):
     return int(np.argmax(np.asarray(c["s4_N"], float)))
 
 
-def chi4_at_tau(r, a=A_MAIN, g=None):
+XI_MIN = 0.3   # below this OZ xi, S4 varies by less than 10% over q <= 1: not determined
+
+
+def chi4_at_tau(r, a=A_MAIN, g=None, own=False):
+    """chi4 of cutoff a at tau_alpha of a = 0.6 (own: at cutoff a's own tau_alpha)."""
     c = cut(r, a)
-    t = tau(r)[0]
+    t = tau(r, a if own else A_MAIN)[0]
     if g is None:
         g = proper_subbox(c, r["N"])
     v, ie = sf.interp_ln_t(c["chi4_lag"], c["chi4"][g], t)
@@ -265,11 +269,14 @@ def chi4_at_tau(r, a=A_MAIN, g=None):
     return v, math.hypot(e, ie if np.isfinite(ie) else 0.0)
 
 
-def xi_at_tau(r, a=A_MAIN):
+def xi_at_tau(r, a=A_MAIN, own=False):
+    """The whole box's OZ xi of cutoff a at tau_alpha (of a = 0.6, or own);
+    NaN where it is below XI_MIN (S4 flat over the q range)."""
     c = cut(r, a)
-    t = tau(r)[0]
+    t = tau(r, a if own else A_MAIN)[0]
     g = whole_box_s4(c)
-    v, ie = sf.interp_ln_t(c["s4_lag"], c["xi_t"][:, g], t)
+    xs = np.where(c["xi_t"][:, g] >= XI_MIN, c["xi_t"][:, g], np.nan)
+    v, ie = sf.interp_ln_t(c["s4_lag"], xs, t)
     rel = c["s4_oz_xi_err"][g] / c["s4_oz_xi"][g] if np.isfinite(c["s4_oz_xi"][g]) and c["s4_oz_xi"][g] > 0 else math.nan
     return v, math.hypot(abs(v) * rel if np.isfinite(rel) else math.nan, ie if np.isfinite(ie) else 0.0)
 
@@ -322,18 +329,33 @@ def oz_fit(q, s, q_max):
 # ---------------------------------------------------------------- the study
 
 class Analysis:
-    def __init__(self, d):
+    def __init__(self, d, also=()):
+        """d: the study; also: other study directories whose runs add points
+        (finite size, longer lags) without entering the study's own series."""
         self.dir = os.path.abspath(d)
-        idx = os.path.join(self.dir, "index.toml")
+        self.points = {}      # the study's own points: (pairs, eps, phi, N) -> Point
+        self.extra = {}       # the other studies' points: (study, pairs, eps, phi, N) -> Point
+        self.skipped = []
+        self.cpu = {}
+        self.pilot_cpu = 0.0
+        self.also = [os.path.abspath(x) for x in also]
+        for k, sd in enumerate([d] + list(also)):
+            self.read_study(sd, primary=(k == 0))
+        self.fits = {}
+        self.rows = []
+        self.figdir = os.path.join(self.dir, "figures")
+        os.makedirs(self.figdir, exist_ok=True)
+
+    def read_study(self, d, primary):
+        sdir = os.path.abspath(d)
+        idx = os.path.join(sdir, "index.toml")
         if not os.path.exists(idx):
             raise SystemExit(f"analyse_study: {idx} does not exist: is {d} a study directory (run_study.sh --out)?")
         with open(idx, "rb") as fh:
             runs = tomllib.load(fh).get("runs", {})
-        self.points = {}
-        self.skipped = []
-        self.cpu = {}
+        study = os.path.basename(sdir.rstrip("/"))
         for name, m in sorted(runs.items()):
-            path = os.path.join(self.dir, m["path"], "run.h5")
+            path = os.path.join(sdir, m["path"], "run.h5")
             if m.get("state") != "complete" or not os.path.exists(path):
                 self.skipped.append((name, m.get("state", "?")))
                 continue
@@ -345,20 +367,22 @@ class Analysis:
             if r["complete"] != 1 or A_MAIN not in r["cut"]:
                 self.skipped.append((name, "run.h5 not complete" if r["complete"] != 1 else f"no cutoff a = {A_MAIN}"))
                 continue
-            r["name"], r["path"] = name, path
+            r["name"], r["path"], r["study"] = name, path, study
             key = (m.get("pairs", "neighbours"), float(m["restitution"]), float(m["packing_fraction"]), int(m["n_particles"]))
-            self.points.setdefault(key, Point(key)).runs.append(r)
-            self.cpu[key] = self.cpu.get(key, 0.0) + float(m.get("cpu_s", 0.0))
-        self.pilot_cpu = 0.0
-        for sub in ("pilots",):
-            for root, _, files in os.walk(os.path.join(self.dir, sub)):
+            if primary:
+                self.points.setdefault(key, Point(key)).runs.append(r)
+                self.cpu[key] = self.cpu.get(key, 0.0) + float(m.get("cpu_s", 0.0))
+            else:
+                pt = self.extra.setdefault((study,) + key, Point(key))
+                pt.study = study
+                pt.runs.append(r)
+                self.cpu[(study,) + key] = self.cpu.get((study,) + key, 0.0) + float(m.get("cpu_s", 0.0))
+        if primary:
+            for root, _, files in os.walk(os.path.join(sdir, "pilots")):
                 if "status.toml" in files:
                     with open(os.path.join(root, "status.toml"), "rb") as fh:
                         self.pilot_cpu += float(tomllib.load(fh).get("cpu_s", 0.0))
-        self.fits = {}
-        self.rows = []
-        self.figdir = os.path.join(self.dir, "figures")
-        os.makedirs(self.figdir, exist_ok=True)
+        self.study_name = getattr(self, "study_name", study)
 
     # -- selections
     def series(self, pairs="neighbours", eps=EPS_MAIN, N=None):
@@ -375,7 +399,8 @@ class Analysis:
         return sorted({k[1] for k in self.points if k[0] == pairs}, reverse=True)
 
     def cpu_of(self, pts):
-        return sum(self.cpu.get((p.pairs, p.eps, p.phi, p.N), 0.0) for p in pts)
+        return sum(self.cpu.get(((p.study,) if getattr(p, "study", None) else ()) + (p.pairs, p.eps, p.phi, p.N), 0.0)
+                   for p in pts)
 
     def nearest(self, pts, phi):
         return min(pts, key=lambda p: abs(p.phi - phi)) if pts else None
@@ -904,8 +929,55 @@ def fss_results(A, joint):
           f"exponent ratio γχ/γξ = {gc:.3g} from our joint fit", "figure", f, pts)
 
 
+def tau_n_results(A):
+    """tau_alpha against N at each density run at several N (this study's
+    points and those of --also studies with the same dynamics)."""
+    allp = [p for p in list(A.points.values()) + list(A.extra.values())
+            if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9]
+    by_phi = {}
+    for p in allp:
+        by_phi.setdefault(p.phi, {})
+        q = by_phi[p.phi].get(p.N)
+        if q is None or len(p.runs) > len(q.runs):
+            by_phi[p.phi][p.N] = p
+    multi = {phi: d for phi, d in sorted(by_phi.items()) if len(d) > 1}
+    if not multi:
+        A.row("τ_α against N (finite size)", "2 (N = 3.6 x 10^5 to 4 x 10^6)", "not studied",
+              "one N per density in this study (add one with --also, e.g. studies/finite_size.toml)", "not run", "", [])
+        return
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    cells, used = [], []
+    for (phi, d), col in zip(multi.items(), colours(len(multi))):
+        ns = sorted(d)
+        vals = [d[n].mean(tau) for n in ns]
+        ax.errorbar(ns, [v[0] for v in vals], [v[1] for v in vals], fmt="o-", color=col, label=f"φ = {phi:g}")
+        cells.append(f"φ {phi:g}: " + ", ".join(f"{fmt(v[0], v[1])} (N {n}, {d[n].mean(tau)[3]} seed{'s' if d[n].mean(tau)[3] > 1 else ''})"
+                                                 for n, v in zip(ns, vals)))
+        used += list(d.values())
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("N")
+    ax.set_ylabel("τ_α (ε = 0.9, a = 0.6)")
+    ax.legend(fontsize=8)
+    ax.set_title("τ_α against the number of particles")
+    f = A.save(fig, "tau_alpha_N.png")
+    A.row("τ_α against N (finite size)", "2 (N = 3.6 x 10^5 to 4 x 10^6)", "not studied", "; ".join(cells), "figure", f, used)
+
+
 def cutoff_results(A):
-    pts = [p for p in A.series() if len(p.runs[0]["cut"]) > 1]
+    """The cutoff a. Each a is taken at its own tau_alpha(a) where the run's
+    lags reach it (solid), and all at tau_alpha of a = 0.6 (dashed); the
+    d_f' rows use each a's own tau_alpha."""
+    # per density, the point (this study's or an --also study's) whose lags reach furthest in tau_alpha
+    cands = [p for p in A.series() + [q for q in A.extra.values() if q.pairs == "neighbours" and abs(q.eps - EPS_MAIN) < 1e-9]
+             if len(p.runs[0]["cut"]) > 1]
+    reach = lambda p: cut(p.runs[0])["lag"][-1] / max(cut(p.runs[0])["tau_alpha"], 1e-300)
+    best = {}
+    for p in cands:
+        if p.phi not in best or reach(p) > reach(best[p.phi]):
+            best[p.phi] = p
+    pts = [best[k] for k in sorted(best)]
+    src = sorted({getattr(p, "study", None) or A.study_name for p in pts})
     if not pts:
         A.row("cutoff a: ξ(τ_α) against a, χ4(t) for several a, ξ(φ) and χ4 against ξ at a = 0.6, 1.4, 3.0",
               "3.4, figs. xi-vs-a, diff-a, chi4-diff-a", "figure only", "the study computes one cutoff", "not run", "", [])
@@ -913,13 +985,18 @@ def cutoff_results(A):
     cuts = sorted(pts[0].runs[0]["cut"])
     fig, ax = plt.subplots(2, 2, figsize=(12, 9))
     ax = ax.ravel()
+    reached = {}
     for p, col in zip(pts, colours(len(pts))):
-        xs = [p.mean(lambda r, a=a: xi_at_tau(r, a))[0] for a in cuts]
-        ax[0].plot(cuts, xs, "-o", ms=3, color=col, label=f"{p.phi:g}")
+        own = [p.mean(lambda r, a=a: xi_at_tau(r, a, own=True))[0] for a in cuts]
+        fixed = [p.mean(lambda r, a=a: xi_at_tau(r, a))[0] for a in cuts]
+        ax[0].plot(cuts, own, "-o", ms=3, color=col, label=f"{p.phi:g}")
+        ax[0].plot(cuts, fixed, "--", lw=0.8, color=col)
+        for a, v in zip(cuts, own):
+            reached[a] = reached.get(a, 0) + int(np.isfinite(v))
     ax[0].set_xlabel("a")
-    ax[0].set_ylabel("ξ at t = τ_α (a = 0.6)")
+    ax[0].set_ylabel("ξ: at τ_α(a) (solid), at τ_α(0.6) (dashed)")
     ax[0].set_yscale("log")
-    ax[0].legend(fontsize=6, ncol=2)
+    ax[0].legend(fontsize=6, ncol=2, title="φ", title_fontsize=7)
     ax[0].set_title("Fig. xi-vs-a")
     mid = A.nearest(pts, 0.78)
     for a, col in zip(cuts, colours(len(cuts))):
@@ -930,16 +1007,17 @@ def cutoff_results(A):
     ax[1].set_xlabel("t")
     ax[1].set_ylabel("χ4(t)")
     ax[1].legend(fontsize=7)
-    ax[1].set_title(f"Fig. chi4-diff-a (φ = {mid.phi:g})")
+    ax[1].set_title(f"Fig. chi4-diff-a (φ = {mid.phi:g}; lags to 4 τ_α(0.6))")
     outs = []
     for a, m in zip(A_THREE, ("o", "s", "^")):
         if a not in cuts:
             continue
-        xfn = lambda r, a=a: xi_at_tau(r, a)
+        xfn = lambda r, a=a: xi_at_tau(r, a, own=True)
+        cfn = lambda r, a=a: chi4_at_tau(r, a, own=True)
         x, y, e = series_arrays(pts, xfn)
         ax[2].errorbar(x, y, e, fmt=m + "-", ms=4, label=f"a = {a:g}")
-        fd = A.fit(f"chi4_xi_a{a:g}", fit_series(pts, lambda r, a=a: chi4_at_tau(r, a), sf.power, xrun=xfn))
-        xs, ys = [p.mean(xfn)[0] for p in pts], [p.mean(lambda r, a=a: chi4_at_tau(r, a))[0] for p in pts]
+        fd = A.fit(f"chi4_xi_a{a:g}", fit_series(pts, cfn, sf.power, xrun=xfn))
+        xs, ys = [p.mean(xfn)[0] for p in pts], [p.mean(cfn)[0] for p in pts]
         ax[3].loglog(xs, ys, m, label=f"a = {a:g}: d_f' = {fd.p['s']:.3g}")
         if fd.ok:
             xx = np.geomspace(*fd.x_range, 10)
@@ -947,18 +1025,20 @@ def cutoff_results(A):
         outs.append((a, fd))
     ax[2].set_yscale("log")
     ax[2].set_xlabel("φ")
-    ax[2].set_ylabel("ξ(τ_α)")
+    ax[2].set_ylabel("ξ(τ_α(a))")
     ax[2].legend()
     ax[2].set_title("Fig. diff-a(a)")
-    ax[3].set_xlabel("ξ(τ_α)")
-    ax[3].set_ylabel("χ4(τ_α)")
+    ax[3].set_xlabel("ξ(τ_α(a))")
+    ax[3].set_ylabel("χ4(τ_α(a))")
     ax[3].legend(fontsize=8)
     ax[3].set_title("Fig. diff-a(b)")
     f = A.save(fig, "cutoff.png")
+    short = [f"{a:g}" for a in cuts if reached.get(a, 0) < len(pts)]
     A.row(f"ξ(τ_α) against a ({cuts[0]:g} to {cuts[-1]:g}) for all φ; χ4(t) for several a", "3.4, figs. xi-vs-a, chi4-diff-a",
-          "figure only", f"{len(cuts)} cutoffs, {len(pts)} densities", "figure", f, pts)
+          "figure only", f"{len(cuts)} cutoffs, {len(pts)} densities, from {', '.join(src)} (lags to {min(reach(p) for p in pts):.3g} τ_α)" +
+          (f"; τ_α(a) beyond the lags (4 τ_α(0.6)) at some φ for a = {', '.join(short)}" if short else ""), "figure", f, pts)
     for a, fd in outs:
-        A.row(f"χ4 ∝ ξ^d_f' at a = {a:g}", "3.4, fig. diff-a(b)", "similar for all a (≈ 1.6)", fmt(fd.p["s"], fd.error("s")),
+        A.row(f"χ4 ∝ ξ^d_f' at a = {a:g} (at τ_α(a))", "3.4, fig. diff-a(b)", "similar for all a (≈ 1.6)", fmt(fd.p["s"], fd.error("s")),
               verdict(fd.p["s"], fd.error("s"), 1.6), f, pts, fd.note)
 
 
@@ -1279,9 +1359,12 @@ def main(argv=None):
     ap.add_argument("study_dir")
     ap.add_argument("--table", help="also write the reproduction table here (e.g. docs/reproduction.md)")
     ap.add_argument("--discussion", help="a Markdown file appended to the table (what we found about each disagreement)")
+    ap.add_argument("--also", action="append", default=[], metavar="STUDY_DIR",
+                    help="another study whose runs add points: tau_alpha against N where it ran other N, and the "
+                         "cutoff figure from whichever study's lags reach furthest")
     a = ap.parse_args(argv)
     t0 = time.time()
-    A = Analysis(a.study_dir)
+    A = Analysis(a.study_dir, a.also)
     if not A.points:
         raise SystemExit(f"analyse_study: no complete run with a = {A_MAIN} in {a.study_dir}"
                          + (f" ({len(A.skipped)} left out: {A.skipped[0][0]}: {A.skipped[0][1]}, ...)" if A.skipped else ""))
@@ -1312,6 +1395,7 @@ def main(argv=None):
     joint = step("joint fit of tau_alpha, chi4, xi", joint_fit)
     step("S4 and xi", s4_results, joint)
     step("finite size", fss_results, joint)
+    step("tau_alpha against N", tau_n_results)
     step("cutoff a", cutoff_results)
     step("restitution", restitution_results)
     step("appendix", appendix_results)
