@@ -85,10 +85,7 @@ def _finish(fit, res, names, n):
 def power(x, y, sy, x_range=None):
     """y = A x^s: a straight line in ln-ln, weighted by sy/y. Parameters A, s."""
     fit = Fit("power", ["A", "s"])
-    x, y, sy = _clean(x, y, sy)
-    if x_range is not None:
-        m = (x >= x_range[0]) & (x <= x_range[1])
-        x, y, sy = x[m], y[m], sy[m]
+    x, y, sy = _in_range(x, y, sy, x_range)
     m = x > 0
     x, y, sy = x[m], y[m], sy[m]
     if len(x) < 3:
@@ -102,76 +99,55 @@ def power(x, y, sy, x_range=None):
     return fit
 
 
-def _scan_then_refine(x, y, sy, xs_from_scan, model_lin, names):
-    """For forms that are a straight line in ln y once the singular point is
-    fixed: scan the singular point, take the best straight line, then
-    refine all three parameters together (least squares on ln y)."""
+def _in_range(x, y, sy, x_range):
+    x, y, sy = _clean(x, y, sy)
+    if x_range is not None:
+        m = (x >= x_range[0]) & (x <= x_range[1])
+        x, y, sy = x[m], y[m], sy[m]
+    return x, y, sy
+
+
+def _singular(form, names, x, y, sy, x_range, s_max, u, sign):
+    """y = A exp(sign k u(s - x)) with a singular point s above every x:
+    ln y is a straight line in u once s is fixed. Scans s for the best line,
+    then refines s, k and ln A together (least squares on ln y, weighted by
+    sy/y). names: (singular point, k, amplitude)."""
+    fit = Fit(form, names)
+    x, y, sy = _in_range(x, y, sy, x_range)
+    if len(x) < 4:
+        fit.note = f"{len(x)} points with data in the range: three parameters need 4"
+        return fit
+    fit.x_range = (float(x.min()), float(x.max()))
+    top = x.max()
+    scan = top + np.geomspace(1e-4, s_max - top, 400)
     v, w = np.log(y), (y / sy) ** 2
     best = None
-    for xc in xs_from_scan:
-        c, _, chi2 = _wlin(model_lin(xc, x), v, w)
+    for s in scan:
+        c, _, chi2 = _wlin(u(s - x), v, w)
         if best is None or chi2 < best[0]:
-            best = (chi2, xc, c)
-    return best
+            best = (chi2, s, c)
+    _, s0, c = best
+    sl = sy / y
+
+    def res(p):
+        return (p[2] + sign * p[1] * u(np.maximum(p[0] - x, 1e-12)) - v) / sl
+
+    r = least_squares(res, [s0, sign * c[1], c[0]], bounds=([top + 1e-6, -50, -200], [s_max + 1.0, 50, 200]))
+    _finish(fit, r, [names[0], names[1], "lnA"], len(x))
+    fit.p[names[2]], fit.err[names[2]] = math.exp(fit.p.pop("lnA")), math.exp(r.x[2]) * fit.err.pop("lnA")
+    if s0 >= scan[-1] - 1e-12 or fit.p[names[0]] > s_max:
+        fit.note = f"{names[0]} runs to the scan's end ({s_max}): no divergence is resolved"
+    return fit
 
 
 def critical(x, y, sy, x_range=None, xc_max=1.0):
     """y = A (xc - x)^-g, xc above every x. Parameters xc, g, A."""
-    fit = Fit("critical", ["xc", "g", "A"])
-    x, y, sy = _clean(x, y, sy)
-    if x_range is not None:
-        m = (x >= x_range[0]) & (x <= x_range[1])
-        x, y, sy = x[m], y[m], sy[m]
-    if len(x) < 4:
-        fit.note = f"{len(x)} points with data in the range: three parameters need 4"
-        return fit
-    fit.x_range = (float(x.min()), float(x.max()))
-    top = x.max()
-    scan = top + np.geomspace(1e-4, xc_max - top, 400)
-    best = _scan_then_refine(x, y, sy, scan, lambda xc, x: np.log(xc - x), None)
-    _, xc0, c = best
-    sl = sy / y
-
-    def res(p):
-        xc, g, lnA = p
-        d = np.maximum(xc - x, 1e-12)
-        return (lnA - g * np.log(d) - np.log(y)) / sl
-
-    r = least_squares(res, [xc0, -c[1], c[0]], bounds=([top + 1e-6, -50, -200], [xc_max + 1.0, 50, 200]))
-    _finish(fit, r, ["xc", "g", "lnA"], len(x))
-    fit.p["A"], fit.err["A"] = math.exp(fit.p.pop("lnA")), math.exp(r.x[2]) * fit.err.pop("lnA")
-    if xc0 >= scan[-1] - 1e-12 or fit.p["xc"] > xc_max:
-        fit.note = f"xc runs to the scan's end ({xc_max}): no divergence is resolved"
-    return fit
+    return _singular("critical", ["xc", "g", "A"], x, y, sy, x_range, xc_max, np.log, -1.0)
 
 
 def vft(x, y, sy, x_range=None, x0_max=1.0):
     """y = A exp(B/(x0 - x)), x0 above every x. Parameters x0, B, A."""
-    fit = Fit("vft", ["x0", "B", "A"])
-    x, y, sy = _clean(x, y, sy)
-    if x_range is not None:
-        m = (x >= x_range[0]) & (x <= x_range[1])
-        x, y, sy = x[m], y[m], sy[m]
-    if len(x) < 4:
-        fit.note = f"{len(x)} points with data in the range: three parameters need 4"
-        return fit
-    fit.x_range = (float(x.min()), float(x.max()))
-    top = x.max()
-    scan = top + np.geomspace(1e-4, x0_max - top, 400)
-    _, x00, c = _scan_then_refine(x, y, sy, scan, lambda x0, x: 1.0 / (x0 - x), None)
-    sl = sy / y
-
-    def res(p):
-        x0, B, lnA = p
-        d = np.maximum(x0 - x, 1e-12)
-        return (lnA + B / d - np.log(y)) / sl
-
-    r = least_squares(res, [x00, c[1], c[0]], bounds=([top + 1e-6, -50, -200], [x0_max + 1.0, 50, 200]))
-    _finish(fit, r, ["x0", "B", "lnA"], len(x))
-    fit.p["A"], fit.err["A"] = math.exp(fit.p.pop("lnA")), math.exp(r.x[2]) * fit.err.pop("lnA")
-    if x00 >= scan[-1] - 1e-12:
-        fit.note = f"x0 runs to the scan's end ({x0_max}): no divergence is resolved"
-    return fit
+    return _singular("vft", ["x0", "B", "A"], x, y, sy, x_range, x0_max, lambda d: 1.0 / d, 1.0)
 
 
 def critical_joint(series, x_range=None, xc_max=1.0):
@@ -183,10 +159,7 @@ def critical_joint(series, x_range=None, xc_max=1.0):
     fit = Fit("critical_joint", names)
     data = {}
     for k in keys:
-        x, y, sy = _clean(*series[k])
-        if x_range is not None:
-            m = (x >= x_range[0]) & (x <= x_range[1])
-            x, y, sy = x[m], y[m], sy[m]
+        x, y, sy = _in_range(*series[k], x_range)
         if len(x) < 3:
             fit.note = f"{k}: {len(x)} points with data in the range; each series needs 3"
             return fit
