@@ -441,6 +441,18 @@ def verdict(v, e, paper):
     return f"{'agrees' if z <= 2 else 'differs'} ({z:.1f} σ)"
 
 
+def fit_verdict(f, name, paper, transform=lambda v: v):
+    """verdict() for a fit's parameter; a fit that did not resolve its singular
+    point, or whose form misses the points badly, says so instead."""
+    if not f.ok:
+        return "not determined"
+    if not f.determined:
+        return "not determined (no divergence resolved)"
+    v = verdict(transform(f.p[name]), f.error(name), paper)
+    r = f.chi2_dof()
+    return v + (f"; χ²/dof {r:.2g}: the form misses the points" if np.isfinite(r) and r > 4 else "")
+
+
 def colours(n):
     return plt.cm.viridis(np.linspace(0, 0.95, max(n, 1)))
 
@@ -553,10 +565,15 @@ def tau_results(A):
     ax.legend(fontsize=8)
     ax.set_title("Fig. taueps09")
     f = A.save(fig, "tau_alpha_phi.png")
-    A.row("τ_α(φ) power law: φ_c", "3.1, fig. taueps09", "0.82", fmt(fp.p["xc"], fp.error("xc"), 4), verdict(fp.p["xc"], fp.error("xc"), 0.82), f, pts, fp.note)
+    A.row("τ_α(φ) power law: φ_c", "3.1, fig. taueps09", "0.82", fmt(fp.p["xc"], fp.error("xc"), 4), fit_verdict(fp, "xc", 0.82), f, pts, fp.note)
     A.row("τ_α(φ) power law: γ", "3.1, fig. taueps09", "not given", fmt(fp.p["g"], fp.error("g")), "—", f, pts, fp.note)
-    A.row("τ_α(φ) VFT: φ_0", "3.1, fig. taueps09", "0.83", fmt(fv.p["x0"], fv.error("x0"), 4), verdict(fv.p["x0"], fv.error("x0"), 0.83), f, pts, fv.note)
+    A.row("τ_α(φ) VFT: φ_0", "3.1, fig. taueps09", "0.83", fmt(fv.p["x0"], fv.error("x0"), 4), fit_verdict(fv, "x0", 0.83), f, pts, fv.note)
     A.row("τ_α(φ) VFT: B", "3.1, fig. taueps09", "not given", fmt(fv.p["B"], fv.error("B")), "—", f, pts, fv.note)
+    # "the inverse power law ... only works for a narrower range of values of phi": the densities from 0.74 up
+    fn = A.fit("tau_power_eps0.9_narrow", fit_series(pts, tau, sf.critical, x_range=(0.74, 1.0)))
+    A.row("τ_α(φ) power law over the narrower range φ ≥ 0.74: φ_c", "3.1, fig. taueps09", "0.82",
+          fmt(fn.p["xc"], fn.error("xc"), 4) + f", γ {fmt(fn.p['g'], fn.error('g'))}, χ²/dof {fn.chi2_dof():.2g}",
+          fit_verdict(fn, "xc", 0.82), f, [p for p in pts if p.phi >= 0.74], fn.note)
     A.row("τ_α(φ): which form fits better (smaller χ² over the same points)", "3.1", "VFT", better(fp, fv),
           ("agrees" if "VFT (" in better(fp, fv) else "differs") if fp.ok and fv.ok else "not determined", f, pts)
     return fp, fv
@@ -623,9 +640,9 @@ def d_results(A):
     sub_i = [p for p in pts if PHI_INTERMEDIATE[0] <= p.phi <= PHI_INTERMEDIATE[1]]
     sub_h = [p for p in pts if PHI_HIGH[0] <= p.phi <= PHI_HIGH[1]]
     A.row(f"D ∝ τ_α^-θ at intermediate densities (φ ≤ {PHI_INTERMEDIATE[1]})", "3.2, fig. D-vs-tau", "θ ≈ 1.47",
-          fmt(-fi.p["s"], fi.error("s")), verdict(-fi.p["s"], fi.error("s"), 1.47), f, sub_i, fi.note)
+          fmt(-fi.p["s"], fi.error("s")), fit_verdict(fi, "s", 1.47, lambda v: -v), f, sub_i, fi.note)
     A.row(f"D ∝ τ_α^-θ' at the highest densities (φ ≥ {PHI_HIGH[0]})", "3.2, fig. D-vs-tau", "θ' ≈ 0.91",
-          fmt(-fh.p["s"], fh.error("s")), verdict(-fh.p["s"], fh.error("s"), 0.91), f, sub_h, fh.note)
+          fmt(-fh.p["s"], fh.error("s")), fit_verdict(fh, "s", 0.91, lambda v: -v), f, sub_h, fh.note)
 
 
 def pdx_results(A):
@@ -821,15 +838,19 @@ def chi4_results(A, phi_c_tau):
     ax[2].set_title("χ4(τ_α) against φ")
     f = A.save(fig, "chi4.png")
     A.row("χ4(t) for all φ", "3.4, fig. chi4", "figure only", f"{len(pts)} densities", "figure", f, pts)
-    A.row("τ4 ∝ τ_α^z (φ ≤ 0.80)", "3.4, inset of fig. chi4", "1.19", fmt(f4.p["s"], f4.error("s")), verdict(f4.p["s"], f4.error("s"), 1.19), f, sub, f4.note)
+    A.row("τ4 ∝ τ_α^z (φ ≤ 0.80)", "3.4, inset of fig. chi4", "1.19", fmt(f4.p["s"], f4.error("s")), fit_verdict(f4, "s", 1.19), f, sub, f4.note)
+    t4w = lambda r: (cut(r)["tau4"][int(np.argmax(cut(r)["chi4_N"]))], cut(r)["tau4_err"][int(np.argmax(cut(r)["chi4_N"]))])
+    f4w = A.fit("tau4_box_tau_alpha", fit_series(sub, t4w, sf.power, xrun=tau))
+    A.row("the same with τ4 of the whole box (no sub-box)", "3.4, inset of fig. chi4", "1.19", fmt(f4w.p["s"], f4w.error("s")),
+          fit_verdict(f4w, "s", 1.19), f, sub, f4w.note)
     A.row("χ4(τ_α) ∝ (φ_c - φ)^-γχ: γχ (own φ_c)", "3.4 (from ref. AvilaPRL2014)", "≈ 2.5", fmt(fc.p["g"], fc.error("g")),
-          verdict(fc.p["g"], fc.error("g"), 2.5), f, pts, fc.note)
-    A.row("χ4(τ_α) ∝ (φ_c - φ)^-γχ: φ_c", "3.4", "≈ 0.82", fmt(fc.p["xc"], fc.error("xc"), 4), verdict(fc.p["xc"], fc.error("xc"), 0.82), f, pts, fc.note)
+          fit_verdict(fc, "g", 2.5), f, pts, fc.note)
+    A.row("χ4(τ_α) ∝ (φ_c - φ)^-γχ: φ_c", "3.4", "≈ 0.82", fmt(fc.p["xc"], fc.error("xc"), 4), fit_verdict(fc, "xc", 0.82), f, pts, fc.note)
     # The sub-box chi4 saturates once xi^2 approaches the sub-box; the whole
     # box's OZ chi0 (S4 extrapolated to q -> 0) has no sub-box: the same fit on it.
     f0 = A.fit("chi0_tau_phi", fit_series(pts, chi0_at_tau, sf.critical))
     A.row("the same with χ0 of the whole box's OZ fit in place of χ4: γχ", "3.4 (eq. 18: χ0 = lim S4(q→0))", "≈ 2.5",
-          fmt(f0.p["g"], f0.error("g")), verdict(f0.p["g"], f0.error("g"), 2.5), f, pts, f0.note)
+          fmt(f0.p["g"], f0.error("g")), fit_verdict(f0, "g", 2.5), f, pts, f0.note)
 
 
 def s4_results(A, joint):
@@ -890,18 +911,18 @@ def s4_results(A, joint):
     f2 = A.save(fig, "xi.png")
     nx = sum(1 for p in pts if np.isfinite(p.mean(xi_at_tau)[0]))
     A.row("S4(q, τ_α) for all φ; S4/χ4 against qξ collapse", "3.4, figs. S4, scalingS4", "figure only", f"{nx} of {len(pts)} densities with ξ", "figure", f, pts)
-    A.row("ξ(τ_α) ∝ (φ_c - φ)^-γξ: γξ (own φ_c)", "3.4", "1.6", fmt(fx.p["g"], fx.error("g")), verdict(fx.p["g"], fx.error("g"), 1.6), f2, pts, fx.note)
+    A.row("ξ(τ_α) ∝ (φ_c - φ)^-γξ: γξ (own φ_c)", "3.4", "1.6", fmt(fx.p["g"], fx.error("g")), fit_verdict(fx, "g", 1.6), f2, pts, fx.note)
     A.row("τ_α ∝ ξ^z: z", "3.4 (z = γ_τ/γ_ξ)", "not given", fmt(fz.p["s"], fz.error("s")), "—", f2, pts, fz.note)
-    A.row("χ4(τ_α) ∝ ξ^d_f': d_f'", "3.4, fig. xi-chi_4-2", "≈ 1.6", fmt(fd.p["s"], fd.error("s")), verdict(fd.p["s"], fd.error("s"), 1.6), f2, pts, fd.note)
+    A.row("χ4(τ_α) ∝ ξ^d_f': d_f'", "3.4, fig. xi-chi_4-2", "≈ 1.6", fmt(fd.p["s"], fd.error("s")), fit_verdict(fd, "s", 1.6), f2, pts, fd.note)
     fd0 = A.fit("chi0_xi", fit_series(pts, chi0_at_tau, sf.power, xrun=xi_at_tau))
     A.row("the same with the whole box's OZ χ0 in place of the sub-box χ4: d_f'", "3.4 (eq. 18)", "≈ 1.6",
-          fmt(fd0.p["s"], fd0.error("s")), verdict(fd0.p["s"], fd0.error("s"), 1.6), f2, pts, fd0.note)
+          fmt(fd0.p["s"], fd0.error("s")), fit_verdict(fd0, "s", 1.6), f2, pts, fd0.note)
     if joint is not None and joint.ok:
         for k, paper in (("tau", "not given"), ("chi4", "2.5"), ("xi", "1.6")):
             g = joint.p[f"g_{k}"]
             A.row(f"joint fit of τ_α, χ4(τ_α), ξ(τ_α) with one φ_c: γ_{k}", "3.3 (φ_c from the simultaneous fit)", paper,
-                  fmt(g, joint.error(f"g_{k}")), verdict(g, joint.error(f"g_{k}"), float(paper)) if paper[0].isdigit() else "—", f2, pts)
-        A.row("joint fit: φ_c", "3.3", "0.82", fmt(joint.p["xc"], joint.error("xc"), 4), verdict(joint.p["xc"], joint.error("xc"), 0.82), f2, pts, joint.note)
+                  fmt(g, joint.error(f"g_{k}")), fit_verdict(joint, f"g_{k}", float(paper)) if paper[0].isdigit() else "—", f2, pts)
+        A.row("joint fit: φ_c", "3.3", "0.82", fmt(joint.p["xc"], joint.error("xc"), 4), fit_verdict(joint, "xc", 0.82), f2, pts, joint.note)
     return fx
 
 
@@ -1039,7 +1060,7 @@ def cutoff_results(A):
           (f"; τ_α(a) beyond the lags (4 τ_α(0.6)) at some φ for a = {', '.join(short)}" if short else ""), "figure", f, pts)
     for a, fd in outs:
         A.row(f"χ4 ∝ ξ^d_f' at a = {a:g} (at τ_α(a))", "3.4, fig. diff-a(b)", "similar for all a (≈ 1.6)", fmt(fd.p["s"], fd.error("s")),
-              verdict(fd.p["s"], fd.error("s"), 1.6), f, pts, fd.note)
+              fit_verdict(fd, "s", 1.6), f, pts, fd.note)
 
 
 def restitution_results(A):
@@ -1107,7 +1128,7 @@ def restitution_results(A):
     allp = [p for eps in eps_list for p in A.series(eps=eps)]
     fd = A.fit("chi4_xi_all_eps", fit_series(allp, chi4_at_tau, sf.power, xrun=xi_at_tau))
     A.row("χ4 ∝ ξ^d_f' over all ε (the paper: ε-independent)", "3.4, fig. chi_4-peak inset", "1.58", fmt(fd.p["s"], fd.error("s")),
-          verdict(fd.p["s"], fd.error("s"), 1.58), f, allp, fd.note)
+          fit_verdict(fd, "s", 1.58), f, allp, fd.note)
 
 
 def appendix_results(A):
@@ -1162,10 +1183,10 @@ def appendix_results(A):
     med = lambda v: f"median {np.median(v):.3g} (range {v.min():.3g}-{v.max():.3g}, {len(v)} φ)" if len(v) else "not determined"
     A.row("appendix: χ0 (fit 2, OZ) / χ4", "appendix, fig. fitting", "≈ 1 for all φ", med(oz_r),
           ("agrees" if abs(np.median(oz_r) - 1) < 0.15 else "differs") if len(oz_r) else "not determined", f, pts,
-          "agrees: median within 15% of 1")
+          "criterion: the median within 15% of 1")
     A.row("appendix: χ0 (fit 3, with A²) / χ4", "appendix, fig. fitting", "≈ 1 for all φ", med(a2_r),
           ("agrees" if abs(np.median(a2_r) - 1) < 0.15 else "differs") if len(a2_r) else "not determined", f, pts,
-          "agrees: median within 15% of 1")
+          "criterion: the median within 15% of 1")
     spread = np.nanmax(rat, axis=1) - np.nanmin(rat, axis=1) if rat.size else np.array([])
     spread = spread[np.isfinite(spread)]
     A.row("appendix: χ0 robust to the fit range q_m", "appendix, fig. fitting", "robust",
@@ -1403,7 +1424,7 @@ def main(argv=None):
     step("driving rules", driving_results)
     driving_rows(A)
     write_h5(A, os.path.join(A.dir, "study.h5"))
-    cmd = "launch_scripts/analyse_study.sh " + os.path.relpath(A.dir, os.getcwd())
+    cmd = "launch_scripts/analyse_study.sh " + " ".join(argv if argv is not None else sys.argv[1:])
     write_table(A, os.path.join(A.dir, "reproduction.md"), cmd, a.discussion)
     if a.table:
         write_table(A, a.table, cmd, a.discussion)

@@ -39,9 +39,21 @@ class Fit:
         return all(np.isfinite(self.p[n]) for n in self.names)
 
     def error(self, name):
-        """The quoted error: the jackknife over seeds where it exists, else the fit's own."""
+        """The quoted error: the jackknife over seeds where it exists, else the
+        fit's own; where the form misses the points (chi2/dof > 1) at least
+        the fit's own error times sqrt(chi2/dof) (the Birge ratio), since
+        seeds that all share the misfit agree with each other."""
         e = self.jk.get(name, math.nan)
-        return e if np.isfinite(e) else self.err[name]
+        e = e if np.isfinite(e) else self.err[name]
+        r = self.chi2_dof()
+        if np.isfinite(r) and r > 1 and np.isfinite(self.err[name]):
+            e = max(e, self.err[name] * math.sqrt(r)) if np.isfinite(e) else self.err[name] * math.sqrt(r)
+        return e
+
+    @property
+    def determined(self):
+        """False where the fit ran to the end of its range (no divergence resolved)."""
+        return self.ok and "scan's end" not in self.note
 
     def chi2_dof(self):
         return self.chi2 / self.dof if self.dof > 0 else math.nan
