@@ -224,4 +224,20 @@ void append_row(hid_t dset, hid_t mem_type, const void *data, const std::string 
   check_status(H5Dwrite(dset, mem_type, mem_space, file_space, H5P_DEFAULT, data), "cannot append to", path);
 }
 
+void write_row(hid_t dset, hsize_t index, hid_t mem_type, const void *data, const std::string &path) {
+  Id file_space(check(H5Dget_space(dset), "cannot get the shape of", path));
+  const int rank = H5Sget_simple_extent_ndims(file_space);
+  std::vector<hsize_t> dims(rank);
+  H5Sget_simple_extent_dims(file_space, dims.data(), nullptr);
+  if (index >= dims[0]) fail("no record " + std::to_string(index) + " to overwrite in", path);
+  std::vector<hsize_t> start(rank, 0), count = dims;
+  start[0] = index;
+  count[0] = 1;
+  check_status(H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
+               "cannot select a record of", path);
+  Id mem_space(check(H5Screate_simple(rank, count.data(), nullptr), "cannot shape", path));
+  check_status(H5Dwrite(dset, mem_type, mem_space, file_space, H5P_DEFAULT, data),
+               "cannot overwrite a record of", path);
+}
+
 } // namespace dynhet::h5

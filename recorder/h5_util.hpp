@@ -98,5 +98,7 @@ Id create_growing(hid_t loc, const std::string &name, hid_t type, const std::vec
                   const std::vector<hsize_t> &chunk);
 // Appends one record (a full row of row_shape) read from `data` of `mem_type`.
 void append_row(hid_t dset, hid_t mem_type, const void *data, const std::string &path);
+// Overwrites record `index` (along the first axis) with `data`.
+void write_row(hid_t dset, hsize_t index, hid_t mem_type, const void *data, const std::string &path);
 
 } // namespace dynhet::h5

@@ -117,6 +117,43 @@ inline std::string read_string(hid_t file, const std::string &path) {
   return v.at(0);
 }
 
+// Are the two paths links to one HDF5 object (hard links to the same
+// dataset or group)? And how many hard links an object has.
+struct ObjectInfo {
+  bool valid;
+  unsigned links;
+#if H5_VERSION_GE(1, 12, 0)
+  H5O_token_t token;
+#else
+  haddr_t addr;
+#endif
+};
+inline ObjectInfo object_info(hid_t file, const std::string &path) {
+  ObjectInfo o{};
+#if H5_VERSION_GE(1, 12, 0)
+  H5O_info2_t info;
+  o.valid = H5Oget_info_by_name3(file, path.c_str(), &info, H5O_INFO_BASIC, H5P_DEFAULT) >= 0;
+  o.token = info.token;
+#else
+  H5O_info_t info;
+  o.valid = H5Oget_info_by_name2(file, path.c_str(), &info, H5O_INFO_BASIC, H5P_DEFAULT) >= 0;
+  o.addr = info.addr;
+#endif
+  o.links = info.rc;
+  if (!o.valid) throw std::runtime_error("HDF5 read failed: object info of " + path);
+  return o;
+}
+inline bool same_object(hid_t file, const std::string &a, const std::string &b) {
+  const ObjectInfo x = object_info(file, a), y = object_info(file, b);
+#if H5_VERSION_GE(1, 12, 0)
+  int cmp = 1;
+  H5Otoken_cmp(file, &x.token, &y.token, &cmp);
+  return cmp == 0;
+#else
+  return x.addr == y.addr;
+#endif
+}
+
 // An attribute of the object at `obj_path` ("/" for the root).
 class Attr {
 public:
