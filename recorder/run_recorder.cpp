@@ -49,10 +49,12 @@ std::optional<RunRecorder::Stamp> RunRecorder::at_frame(int64_t frame, bool last
   return Stamp{frame, info_->frame_time[frame], last_word};
 }
 
+// -1 is a node's "no frame yet" (e.g. its final result when the sim failed
+// before the first frame): taken, with no record.
 std::string RunRecorder::frame_problem(int32_t frame_index) const {
-  if (frame_index >= 0 && frame_index < info_->n_frames) return "";
+  if (frame_index >= -1 && frame_index < info_->n_frames) return "";
   return "frame_index " + std::to_string(frame_index) + " is not one of the run's " +
-         std::to_string(info_->n_frames) + " frames";
+         std::to_string(info_->n_frames) + " frames (nor -1, none yet)";
 }
 
 bool RunRecorder::rejected(const char *channel, const std::string &why) {
@@ -245,6 +247,7 @@ void RunRecorder::write_msd(const msd_t &m) {
     msd_started_ = true;
   }
   if (m.n_lags <= 0) return;
+  if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
   const Stamp at = *at_frame(m.frame_index, m.is_final);
   const std::pair<const char *, const std::vector<double> *> per_lag[] = {
       {"msd_all", &m.msd_all},
@@ -301,6 +304,7 @@ void RunRecorder::write_displacement(const displacement_t &m) {
     displacement_started_ = true;
   }
   if (m.n_values <= 0) return;
+  if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
   const Stamp at = *at_frame(m.frame_index, m.is_final);
   const Shape series{dim(m.n_sets), dim(m.n_targets)}, bins{dim(m.n_sets), dim(m.n_targets), dim(m.n_bins)};
   auto scalar = [&](const char *name, const auto &v) { writer_->append_scalar(base + name, at, v); };
@@ -365,6 +369,7 @@ void RunRecorder::write_s4(const s4_t &m) {
     s4_started_[label] = true;
   }
   if (m.n_values <= 0) return;
+  if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
   const Stamp at = *at_frame(m.frame_index, m.is_final);
   const std::pair<const char *, const std::vector<double> *> arrays[] = {{"s4", &m.s4},
                                                                          {"s4_err", &m.s4_err},
@@ -419,6 +424,7 @@ void RunRecorder::write_clusters(const clusters_t &m) {
     writer_->set_attribute("observables/" + base, "kappa_n_max", m.kappa_n_max);
     clusters_started_[label] = true;
   }
+  if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
   const Stamp at = *at_frame(m.frame_index, m.is_final);
   auto scalar = [&](const char *name, const auto &v) { writer_->append_scalar(base + name, at, v); };
   auto array = [&](const char *name, const auto &v) { writer_->append_observable(base + name, at, v); };
@@ -486,6 +492,7 @@ void RunRecorder::write_chi4(const chi4_t &m) {
     chi4_started_[label] = true;
   }
   if (m.n_values <= 0) return;
+  if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
   const Stamp at = *at_frame(m.frame_index, m.is_final);
   const Shape grid_lag{dim(m.n_grids), dim(m.n_lags)};
   writer_->append_observable(base + "chi4", at, m.chi4.data(), grid_lag);
@@ -507,6 +514,7 @@ void RunRecorder::write_overlap(const overlap_t &m) {
     overlap_started_[label] = true;
   }
   if (m.n_lags <= 0) return;
+  if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
   const Stamp at = *at_frame(m.frame_index, m.is_final);
   writer_->append_observable(base + "q", at, m.q);
   writer_->append_observable(base + "q_err", at, m.q_err);

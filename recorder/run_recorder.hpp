@@ -63,9 +63,10 @@ public:
   // Each returns true when the message belongs to the run and was taken;
   // a node status only when the node made progress, so that the caller
   // can tell a working pipeline from a stalled one. A result whose frame
-  // index is not one of the run's, or whose array sizes do not fit its
-  // dimensions, is rejected (message_rejected). on_run creates the file on
-  // the first run info and throws if it cannot.
+  // index is neither one of the run's nor -1 (no frame yet: taken, not
+  // written), or whose array sizes do not fit its dimensions, is rejected
+  // (message_rejected). on_run creates the file on the first run info and
+  // throws if it cannot.
   bool on_run(const run_info_t &m);
   bool on_sim_status(const sim_status_t &m);
   bool on_node_status(const node_status_t &m);
@@ -128,7 +129,7 @@ private:
   // The record of frame `frame` (replacing one of the same step if `last_word`);
   // none if the run has no such frame.
   std::optional<Stamp> at_frame(int64_t frame, bool last_word) const;
-  // "" if the result's frame index is one of the run's, else why not.
+  // "" if the result's frame index is one of the run's or -1 (none yet), else why not.
   std::string frame_problem(int32_t frame_index) const;
   bool rejected(const char *channel, const std::string &why);
   void write_run_info(const run_info_t &m);

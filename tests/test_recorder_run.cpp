@@ -378,20 +378,28 @@ TEST(RunRecorder, MultiDimensionalResultsKeepTheirShape) {
   std::remove(path.c_str());
 }
 
+// The sim fails before its first frame: the nodes' final results carry
+// frame_index -1 (no frame yet); they count as final, make no record, and
+// are not rejected.
 TEST(RunRecorder, FailedSimSettlesButIsIncomplete) {
   const std::string path = temp_file("failed");
   dynhet::RunRecorder rec(path, "test");
   ASSERT_TRUE(rec.on_run(run_info()));
-  auto s = sim(1.0, "failed", 100);
+  auto s = sim(1.0, "failed", 100, 0);
   s.message = "boom";
   rec.on_sim_status(s);
-  for (double a : {0.6, 1.8}) rec.on_overlap(overlap(a, true, 0));
+  for (double a : {0.6, 1.8}) EXPECT_TRUE(rec.on_overlap(overlap(a, true, -1)));
   rec.on_node_status(node(1.5, "failed", 0));
   EXPECT_TRUE(rec.completion().settled());
+  EXPECT_EQ(rec.messages_rejected(), 0);
   const auto missing = rec.finish();
   ASSERT_FALSE(missing.empty());
   EXPECT_EQ(missing[0], "sim: failed (boom)");
   EXPECT_EQ(missing[1], "overlap node: failed");
+  h5read::File f(path);
+  EXPECT_FALSE(h5read::exists(f, "/observables/overlap/a0.6/q"));
+  EXPECT_FALSE(h5read::exists(f, "/observables/sim"));
+  EXPECT_TRUE(h5read::exists(f, "/observables/overlap/a0.6/lag_time"));
   std::remove(path.c_str());
 }
 
