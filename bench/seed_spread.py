@@ -63,12 +63,12 @@ def quantities(path, a):
         pair("Z", f"{o}/sim/reduced_pressure", f"{o}/sim/reduced_pressure_err")
         pair("collision frequency", f"{o}/sim/collision_frequency", f"{o}/sim/collision_frequency_err")
         # chi4(t) of every sub-box size at the lag of its largest value
-        # (the lag fixed per point below), value [lag * sizes + size].
+        # (the lag fixed per point below); records are [grid][lag], kept
+        # here as [lag][size].
         c, ce = last(f, f"{o}/chi4/a{a}/chi4"), last(f, f"{o}/chi4/a{a}/chi4_err")
         sizes = f.get(f"{o}/chi4/a{a}/subbox_particles")
         if c is not None and sizes is not None:
-            ns = sizes.shape[0]
-            out["_chi4"] = (c.reshape(-1, ns), ce.reshape(-1, ns), np.asarray(sizes[()]))
+            out["_chi4"] = (c.T, ce.T, np.asarray(sizes[()]))
         for k in ("chi4_peak", "tau4"):
             pair(k, f"{o}/chi4/a{a}/{k}", f"{o}/chi4/a{a}/{k}_err")
         pair("xi", f"{o}/s4/a{a}/xi", f"{o}/s4/a{a}/xi_err")

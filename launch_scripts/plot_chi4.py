@@ -23,8 +23,7 @@ def main(path, png):
         for ax, (name, g) in zip(axes[0], groups):
             t = g["lag_time"][()]
             sizes = g["subbox_particles"][()]
-            chi = g["chi4"]["value"][-1].reshape(len(sizes), len(t))
-            err = g["chi4_err"]["value"][-1].reshape(len(sizes), len(t))
+            chi, err = g["chi4"]["value"][-1], g["chi4_err"]["value"][-1]  # [grid][lag]
             peak, tau4 = g["chi4_peak"]["value"][-1], g["tau4"]["value"][-1]
             for i, n in enumerate(sizes):
                 line = ax.errorbar(t, chi[i], yerr=np.nan_to_num(err[i]), marker="o", ms=2.5, capsize=2,

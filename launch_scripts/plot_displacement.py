@@ -30,22 +30,20 @@ def main(path, png):
             return 1
         g = f["observables/displacement"]
         x = g["x"][()]
-        nb = len(x)
         lag, mult = last(g, "lag_time"), last(g, "target_tau_alpha")
         nt = len(lag)
-        p, p_err = last(g, "p"), last(g, "p_err")
+        p, p_err = last(g, "p"), last(g, "p_err")  # [set][target][bin]
         tau = float(last(g, "tau_alpha"))
         fig, axes = plt.subplots(1, 2, figsize=(11, 4.4), sharey=True)
         for s, (ax, name) in enumerate(zip(axes, ("all", "small"))):
             for l_ in range(nt):
-                i = s * nt + l_
+                i = (s, l_)  # per-series values are [set][target]
                 if not math.isfinite(lag[l_]):
                     continue
-                sl = slice(i * nb, (i + 1) * nb)
-                ok = p[sl] > 0
+                ok = p[i] > 0
                 what = f"{mult[l_]:g} $\\tau_\\alpha$" if math.isfinite(mult[l_]) else "fixed"
-                err = np.nan_to_num(p_err[sl][ok])
-                line = ax.errorbar(x[ok], p[sl][ok], yerr=[np.minimum(err, 0.9 * p[sl][ok]), err], fmt="o", ms=2, capsize=1.5, lw=0.8,
+                err = np.nan_to_num(p_err[i][ok])
+                line = ax.errorbar(x[ok], p[i][ok], yerr=[np.minimum(err, 0.9 * p[i][ok]), err], fmt="o", ms=2, capsize=1.5, lw=0.8,
                                    label=f"t = {lag[l_]:.3g} ({what})")
                 colour = line[0].get_color()
                 d, x0, amp = (float(last(g, k)[i]) for k in ("gauss_d", "tail_x0", "tail_amplitude"))

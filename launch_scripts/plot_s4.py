@@ -57,7 +57,7 @@ def plot_xi(ax, g):
     """OZ xi(t) of every grid at every computed lag, t_s4 marked."""
     sizes, lags = g["subbox_particles"][()], g["lag_time"][()]
     t_s4, tau_alpha = float(last(g, "t_s4")), float(last(g, "tau_alpha"))
-    xi_lag = last(g, "xi_lag").reshape(len(lags), len(sizes))
+    xi_lag = last(g, "xi_lag")  # [lag][grid]
     for gi in range(len(sizes)):
         ax.plot(lags, xi_lag[:, gi], "o-", ms=2.5, label=f"N = {sizes[gi]:.0f}")
     ax.axvline(t_s4, color="k", lw=0.6, ls=":")

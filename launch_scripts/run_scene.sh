@@ -29,12 +29,15 @@
 #                   checkpoint's). Sim, nodes and recorder all get it, so
 #                   they take only this run's messages: two runs on one bus
 #                   never cross
+#   --author NAME   run.h5's h5md/author name (default: $DYNHET_AUTHOR,
+#                   else $USER, else "unknown")
+#   --author-email ADDRESS  run.h5's h5md/author email (default: none)
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
-scene="" out="" bus=private url="" record="" build_first=1 resume="" run_id="" role=all
+scene="" out="" bus=private url="" record="" build_first=1 resume="" run_id="" role=all author="" author_email=""
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
@@ -45,7 +48,9 @@ while (($#)); do
   --resume) resume=$2; shift 2 ;;
   --run-id) run_id=$2; shift 2 ;;
   --role) role=$2; shift 2 ;;
-  -h | --help) sed -n '2,32p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  --author) author=$2; shift 2 ;;
+  --author-email) author_email=$2; shift 2 ;;
+  -h | --help) sed -n '2,34p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
   -*) echo "run_scene: unknown option $1" >&2; exit 2 ;;
   *) [[ -z $scene ]] || { echo "run_scene: one scene only" >&2; exit 2; }; scene=$1; shift ;;
   esac
@@ -86,6 +91,8 @@ if [[ $bus == private && -z ${DYNHET_IN_NETNS:-} ]]; then
   [[ -z $url ]] || args+=(--url "$url")
   [[ -z $record ]] || args+=(--record "$record")
   [[ -z $run_id ]] || args+=(--run-id "$run_id")
+  [[ -z $author ]] || args+=(--author "$author")
+  [[ -z $author_email ]] || args+=(--author-email "$author_email")
   exec "$root/launch_scripts/netns.sh" "$0" ${scene:+"$scene"} "${args[@]}"
 fi
 if [[ -n $url ]]; then export LCM_DEFAULT_URL=$url; fi
@@ -137,7 +144,9 @@ if [[ -n $record ]]; then
 fi
 # On the analysis host the sim may be started minutes later, by hand.
 wait_run=(); [[ $role == analysis ]] && wait_run=(--wait-run 900)
-start recorder "$bin/recorder" --out "$out/run.h5" --run-id "$run_id" "${wait_run[@]}"
+authorship=(); [[ -z $author ]] || authorship+=(--author "$author")
+[[ -z $author_email ]] || authorship+=(--author-email "$author_email")
+start recorder "$bin/recorder" --out "$out/run.h5" --run-id "$run_id" "${wait_run[@]}" "${authorship[@]}"
 for n in $nodes; do start "$n" "$bin/$n" --run-id "$run_id" "${wait_run[@]}"; done
 if [[ -n $record ]]; then
   # lcm-logger says nothing when it is ready. The nodes publish their status

@@ -1,5 +1,6 @@
 #include "h5_util.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace dynhet::h5 {
@@ -110,10 +111,13 @@ void Id::reset() {
   id_ = H5I_INVALID_HID;
 }
 
-Id string_type() {
+Id string_type(size_t size, const std::string &text) {
   Id t(check(H5Tcopy(H5T_C_S1), "cannot copy", "string type"));
-  check_status(H5Tset_size(t, H5T_VARIABLE), "cannot size", "string type");
-  check_status(H5Tset_cset(t, H5T_CSET_UTF8), "cannot set UTF-8 on", "string type");
+  check_status(H5Tset_size(t, std::max<size_t>(size, 1)), "cannot size", "string type");
+  check_status(H5Tset_strpad(t, H5T_STR_NULLPAD), "cannot set NULLPAD on", "string type");
+  const bool ascii = std::all_of(text.begin(), text.end(), [](char c) { return (c & 0x80) == 0; });
+  check_status(H5Tset_cset(t, ascii ? H5T_CSET_ASCII : H5T_CSET_UTF8), "cannot set the character set of",
+               "string type");
   return t;
 }
 
@@ -148,14 +152,18 @@ void write_attr(hid_t obj, const std::string &name, hid_t type, const std::vecto
 }
 
 void write_attr(hid_t obj, const std::string &name, const std::string &value) {
-  const char *p = value.c_str();
-  write_attr(obj, name, string_type(), {}, &p);
+  // c_str(): an empty string is one NUL byte, the smallest fixed-length string.
+  write_attr(obj, name, string_type(value.size(), value), {}, value.c_str());
 }
 
 void write_attr(hid_t obj, const std::string &name, const std::vector<std::string> &values) {
-  std::vector<const char *> p;
-  for (const std::string &v : values) p.push_back(v.c_str());
-  write_attr(obj, name, string_type(), {p.size()}, p.data());
+  size_t width = 1;
+  std::string all;
+  for (const std::string &v : values) width = std::max(width, v.size()), all += v;
+  std::vector<char> padded(values.size() * width, '\0');
+  for (size_t i = 0; i < values.size(); ++i)
+    std::copy(values[i].begin(), values[i].end(), &padded[i * width]);
+  write_attr(obj, name, string_type(width, all), {values.size()}, padded.data());
 }
 
 void write_bool_attr(hid_t obj, const std::string &name, const std::vector<bool> &values, bool scalar) {
@@ -180,8 +188,7 @@ void write_dataset(hid_t loc, const std::string &name, hid_t type, const std::ve
 }
 
 void write_string_dataset(hid_t loc, const std::string &name, const std::string &text) {
-  const char *p = text.c_str();
-  write_dataset(loc, name, string_type(), {}, &p);
+  write_dataset(loc, name, string_type(text.size(), text), {}, text.c_str());
 }
 
 Id create_growing(hid_t loc, const std::string &name, hid_t type, const std::vector<hsize_t> &row_shape,
@@ -215,6 +222,22 @@ void append_row(hid_t dset, hid_t mem_type, const void *data, const std::string 
                "cannot select the new record of", path);
   Id mem_space(check(H5Screate_simple(rank, count.data(), nullptr), "cannot shape", path));
   check_status(H5Dwrite(dset, mem_type, mem_space, file_space, H5P_DEFAULT, data), "cannot append to", path);
+}
+
+void write_row(hid_t dset, hsize_t index, hid_t mem_type, const void *data, const std::string &path) {
+  Id file_space(check(H5Dget_space(dset), "cannot get the shape of", path));
+  const int rank = H5Sget_simple_extent_ndims(file_space);
+  std::vector<hsize_t> dims(rank);
+  H5Sget_simple_extent_dims(file_space, dims.data(), nullptr);
+  if (index >= dims[0]) fail("no record " + std::to_string(index) + " to overwrite in", path);
+  std::vector<hsize_t> start(rank, 0), count = dims;
+  start[0] = index;
+  count[0] = 1;
+  check_status(H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start.data(), nullptr, count.data(), nullptr),
+               "cannot select a record of", path);
+  Id mem_space(check(H5Screate_simple(rank, count.data(), nullptr), "cannot shape", path));
+  check_status(H5Dwrite(dset, mem_type, mem_space, file_space, H5P_DEFAULT, data),
+               "cannot overwrite a record of", path);
 }
 
 } // namespace dynhet::h5

@@ -56,8 +56,10 @@ template <> inline hid_t native_type<int32_t>() { return H5T_NATIVE_INT32; }
 template <> inline hid_t native_type<int64_t>() { return H5T_NATIVE_INT64; }
 template <> inline hid_t native_type<double>() { return H5T_NATIVE_DOUBLE; }
 
-// Variable-length UTF-8 string type (h5py reads it as str).
-Id string_type();
+// Fixed-length string type of `size` bytes (at least 1), NULLPAD: what
+// H5MD asks for (h5py reads it as bytes). ASCII, or UTF-8 when `text`
+// holds a byte above 127.
+Id string_type(size_t size, const std::string &text);
 // h5py's boolean: an int8 enum {FALSE = 0, TRUE = 1}.
 Id bool_type();
 
@@ -75,6 +77,7 @@ template <class T> void write_attr(hid_t obj, const std::string &name, T value) 
 template <class T> void write_attr(hid_t obj, const std::string &name, const std::vector<T> &values) {
   write_attr(obj, name, native_type<T>(), {values.size()}, values.data());
 }
+// Strings are fixed-length (string_type): one, or an array padded to the longest.
 void write_attr(hid_t obj, const std::string &name, const std::string &value);
 inline void write_attr(hid_t obj, const std::string &name, const char *value) {
   write_attr(obj, name, std::string(value));
@@ -95,5 +98,7 @@ Id create_growing(hid_t loc, const std::string &name, hid_t type, const std::vec
                   const std::vector<hsize_t> &chunk);
 // Appends one record (a full row of row_shape) read from `data` of `mem_type`.
 void append_row(hid_t dset, hid_t mem_type, const void *data, const std::string &path);
+// Overwrites record `index` (along the first axis) with `data`.
+void write_row(hid_t dset, hsize_t index, hid_t mem_type, const void *data, const std::string &path);
 
 } // namespace dynhet::h5

@@ -14,11 +14,28 @@ namespace dynhet {
 namespace {
 
 // One H5MD time series: a group with step, time and value datasets that
-// grow together; n values per record.
+// grow together, records of `shape`. A series that shares another's clock
+// (image shares position's) holds hard links to its step and time and
+// writes only its values.
 struct Series {
   h5::Id step, time, value;
-  size_t n = 0;
+  H5mdWriter::Shape shape;
+  bool owns_clock = true;
+  hsize_t records = 0;
+  int64_t last_step = 0; // valid when records > 0
 };
+
+size_t count_of(const H5mdWriter::Shape &shape) {
+  size_t n = 1;
+  for (size_t d : shape) n *= d;
+  return n;
+}
+
+std::string shape_text(const H5mdWriter::Shape &shape) {
+  std::string out = "(";
+  for (size_t d : shape) out += (out.size() > 1 ? ", " : "") + std::to_string(d);
+  return out + ")";
+}
 
 struct ParticleGroup {
   double box_length = 0;
@@ -48,11 +65,6 @@ h5::Id create_file(const std::string &path) {
   keep_metadata_until_flush(fapl, path);
   return h5::Id(
       h5::check(H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl), "cannot create file", path));
-}
-
-std::string default_author() {
-  const char *user = std::getenv("USER");
-  return user && *user ? user : "dynhet user";
 }
 
 // x = p + k L with p in [0, L).
@@ -107,50 +119,82 @@ struct H5mdWriter::Impl {
   }
 
   // The series at `group_path`, created on first use with records of
-  // `row_shape` (empty: one number per record).
-  Series &series_at(const std::string &group_path, hid_t type, std::vector<hsize_t> row_shape,
-                    std::vector<hsize_t> chunk) {
+  // `shape` in chunks of `chunk` (same rank plus one). With `clock_path`,
+  // step and time are hard links to that series' (which must exist).
+  Series &series_at(const std::string &group_path, hid_t type, const H5mdWriter::Shape &shape,
+                    const std::vector<hsize_t> &chunk, const std::string &clock_path = "") {
     auto it = series.find(group_path);
-    if (it != series.end()) return it->second;
+    if (it != series.end()) {
+      if (it->second.shape != shape)
+        throw std::runtime_error("HDF5: '" + group_path + "' records have shape " +
+                                 shape_text(it->second.shape) + ", not " + shape_text(shape));
+      return it->second;
+    }
     h5::Id group = h5::require_group(open_file(), group_path);
     Series s;
-    s.step = h5::create_growing(group, "step", H5T_NATIVE_INT64, {}, {1024});
-    s.time = h5::create_growing(group, "time", H5T_NATIVE_DOUBLE, {}, {1024});
-    s.value = h5::create_growing(group, "value", type, row_shape, chunk);
-    s.n = 1;
-    for (hsize_t d : row_shape) s.n *= d;
+    s.shape = shape;
+    if (clock_path.empty()) {
+      s.step = h5::create_growing(group, "step", H5T_NATIVE_INT64, {}, {1024});
+      s.time = h5::create_growing(group, "time", H5T_NATIVE_DOUBLE, {}, {1024});
+    } else {
+      for (const char *d : {"step", "time"})
+        h5::check_status(
+            H5Lcreate_hard(file, (clock_path + "/" + d).c_str(), group, d, H5P_DEFAULT, H5P_DEFAULT),
+            "cannot link the clock of", group_path + "/" + d);
+      s.owns_clock = false;
+    }
+    const std::vector<hsize_t> row(shape.begin(), shape.end());
+    s.value = h5::create_growing(group, "value", type, row, chunk);
     return series.emplace(group_path, std::move(s)).first->second;
   }
 
-  void append(Series &s, const std::string &group_path, int64_t step, double time, hid_t mem_type,
-              const void *values, size_t n) {
-    if (n != s.n)
-      throw std::runtime_error("HDF5: '" + group_path + "' records hold " + std::to_string(s.n) +
-                               " values, not " + std::to_string(n));
-    h5::append_row(s.step, H5T_NATIVE_INT64, &step, group_path + "/step");
-    h5::append_row(s.time, H5T_NATIVE_DOUBLE, &time, group_path + "/time");
+  // Appends, replaces or drops one record (see H5mdWriter::Stamp).
+  H5mdWriter::Recorded append(Series &s, const std::string &group_path, const H5mdWriter::Stamp &at,
+                              hid_t mem_type, const void *values) {
+    using R = H5mdWriter::Recorded;
+    if (s.records > 0 && at.step <= s.last_step) {
+      if (at.step < s.last_step || !at.replace) return R::dropped;
+      const hsize_t last = s.records - 1;
+      if (s.owns_clock) h5::write_row(s.time, last, H5T_NATIVE_DOUBLE, &at.time, group_path + "/time");
+      h5::write_row(s.value, last, mem_type, values, group_path + "/value");
+      return R::replaced;
+    }
+    if (s.owns_clock) {
+      h5::append_row(s.step, H5T_NATIVE_INT64, &at.step, group_path + "/step");
+      h5::append_row(s.time, H5T_NATIVE_DOUBLE, &at.time, group_path + "/time");
+    }
     h5::append_row(s.value, mem_type, values, group_path + "/value");
+    ++s.records;
+    s.last_step = at.step;
+    return R::appended;
   }
 
   template <class T>
-  void append_observable(const std::string &name, int64_t step, double time, const T *v, size_t n) {
+  H5mdWriter::Recorded append_observable(const std::string &name, const H5mdWriter::Stamp &at, const T *v,
+                                         const H5mdWriter::Shape &shape) {
     const std::string group_path = "observables/" + name;
+    const size_t n = count_of(shape);
     if (n == 0) throw std::runtime_error("HDF5: empty record for '" + group_path + "'");
-    std::vector<hsize_t> row, chunk{rows_per_chunk(n * sizeof(T))};
-    if (n > 1) {
-      row.push_back(n);
-      chunk.push_back(n);
-    }
-    Series &s = series_at(group_path, h5::native_type<T>(), row, chunk);
-    append(s, group_path, step, time, h5::native_type<T>(), v, n);
-    changed();
+    std::vector<hsize_t> chunk{rows_per_chunk(n * sizeof(T))};
+    chunk.insert(chunk.end(), shape.begin(), shape.end());
+    Series &s = series_at(group_path, h5::native_type<T>(), shape, chunk);
+    const H5mdWriter::Recorded r = append(s, group_path, at, h5::native_type<T>(), v);
+    if (r != H5mdWriter::Recorded::dropped) changed();
+    return r;
   }
 
-  template <class T> void write_fixed(const std::string &name, const std::vector<T> &values) {
-    const auto [parent, leaf] = split_leaf("observables/" + name);
+  template <class T>
+  void write_fixed(const std::string &name, const std::vector<T> &values, const H5mdWriter::Shape &shape) {
+    const std::string path = "observables/" + name;
+    std::vector<hsize_t> dims(shape.begin(), shape.end());
+    if (dims.empty()) dims.push_back(values.size());
+    if (count_of(shape.empty() ? H5mdWriter::Shape{values.size()} : shape) != values.size())
+      throw std::runtime_error("HDF5: '" + path + "': " + std::to_string(values.size()) +
+                               " values for shape " + shape_text(shape));
+    const auto [parent, leaf] = split_leaf(path);
     h5::Id group = h5::require_group(open_file(), parent);
     if (H5Lexists(group, leaf.c_str(), H5P_DEFAULT) > 0) H5Ldelete(group, leaf.c_str(), H5P_DEFAULT);
-    h5::write_dataset(group, leaf, h5::native_type<T>(), {values.size()}, values.data());
+    h5::write_dataset(group, leaf, h5::native_type<T>(), dims, values.data());
     changed();
   }
 
@@ -168,8 +212,15 @@ struct H5mdWriter::Impl {
   }
 };
 
+std::string default_author() {
+  for (const char *var : {"DYNHET_AUTHOR", "USER"})
+    if (const char *v = std::getenv(var); v && *v) return v;
+  return "unknown";
+}
+
 H5mdWriter::H5mdWriter(const std::string &path, const std::string &creator_name,
-                       const std::string &creator_version, const std::string &author)
+                       const std::string &creator_version, const std::string &author,
+                       const std::string &author_email)
     : impl_(std::make_unique<Impl>()) {
   h5::silence_errors();
   impl_->path = path;
@@ -181,6 +232,7 @@ H5mdWriter::H5mdWriter(const std::string &path, const std::string &creator_name,
   h5::write_attr(creator, "version", creator_version);
   h5::Id who = h5::require_group(h5md, "author");
   h5::write_attr(who, "name", author.empty() ? default_author() : author);
+  if (!author_email.empty()) h5::write_attr(who, "email", author_email);
   impl_->flush();
 }
 
@@ -225,8 +277,8 @@ void H5mdWriter::set_particles(const std::string &group, double box_length,
   set_particles(group, box_length, std::vector<int32_t>(species.begin(), species.end()));
 }
 
-void H5mdWriter::append_frame(int64_t step, double time, const std::vector<double> &unwrapped_xy,
-                              const std::string &group) {
+H5mdWriter::Recorded H5mdWriter::append_frame(const Stamp &at, const std::vector<double> &unwrapped_xy,
+                                              const std::string &group) {
   auto it = impl_->particles.find(group);
   if (it == impl_->particles.end())
     throw std::logic_error("append_frame: call set_particles(\"" + group + "\", ...) first");
@@ -239,34 +291,39 @@ void H5mdWriter::append_frame(int64_t step, double time, const std::vector<doubl
   std::vector<int32_t> image(2 * n);
   for (size_t i = 0; i < 2 * n; ++i) fold(unwrapped_xy[i], box, position[i], image[i]);
 
-  // One frame per chunk, split along particles beyond 64Ki of them.
-  const std::vector<hsize_t> row{n, 2}, chunk{1, std::min<hsize_t>(n, 65536), 2};
+  // One frame per chunk, split along particles beyond 64Ki of them. Image
+  // shares position's step and time (hard links, as H5MD allows), so both
+  // take or drop the record alike.
+  const Shape row{n, 2};
+  const std::vector<hsize_t> chunk{1, std::min<hsize_t>(n, 65536), 2};
   const std::string base = "particles/" + group;
   Series &pos = impl_->series_at(base + "/position", H5T_NATIVE_DOUBLE, row, chunk);
-  Series &img = impl_->series_at(base + "/image", H5T_NATIVE_INT32, row, chunk);
-  impl_->append(pos, base + "/position", step, time, H5T_NATIVE_DOUBLE, position.data(), 2 * n);
-  impl_->append(img, base + "/image", step, time, H5T_NATIVE_INT32, image.data(), 2 * n);
-  impl_->changed();
+  Series &img = impl_->series_at(base + "/image", H5T_NATIVE_INT32, row, chunk, base + "/position");
+  const Recorded r = impl_->append(pos, base + "/position", at, H5T_NATIVE_DOUBLE, position.data());
+  impl_->append(img, base + "/image", at, H5T_NATIVE_INT32, image.data());
+  if (r != Recorded::dropped) impl_->changed();
+  return r;
 }
 
-void H5mdWriter::append_observable(const std::string &path, int64_t step, double time, const double *v,
-                                   size_t n) {
-  impl_->append_observable(path, step, time, v, n);
+H5mdWriter::Recorded H5mdWriter::append_observable(const std::string &path, const Stamp &at, const double *v,
+                                                   const Shape &shape) {
+  return impl_->append_observable(path, at, v, shape);
 }
-void H5mdWriter::append_observable(const std::string &path, int64_t step, double time, const int32_t *v,
-                                   size_t n) {
-  impl_->append_observable(path, step, time, v, n);
+H5mdWriter::Recorded H5mdWriter::append_observable(const std::string &path, const Stamp &at, const int32_t *v,
+                                                   const Shape &shape) {
+  return impl_->append_observable(path, at, v, shape);
 }
-void H5mdWriter::append_observable(const std::string &path, int64_t step, double time, const int64_t *v,
-                                   size_t n) {
-  impl_->append_observable(path, step, time, v, n);
+H5mdWriter::Recorded H5mdWriter::append_observable(const std::string &path, const Stamp &at, const int64_t *v,
+                                                   const Shape &shape) {
+  return impl_->append_observable(path, at, v, shape);
 }
 
-void H5mdWriter::write_fixed(const std::string &path, const std::vector<double> &values) {
-  impl_->write_fixed(path, values);
+void H5mdWriter::write_fixed(const std::string &path, const std::vector<double> &values, const Shape &shape) {
+  impl_->write_fixed(path, values, shape);
 }
-void H5mdWriter::write_fixed(const std::string &path, const std::vector<int32_t> &values) {
-  impl_->write_fixed(path, values);
+void H5mdWriter::write_fixed(const std::string &path, const std::vector<int32_t> &values,
+                             const Shape &shape) {
+  impl_->write_fixed(path, values, shape);
 }
 
 void H5mdWriter::set_attribute(const std::string &object, const std::string &name, int32_t v) {

@@ -36,7 +36,7 @@ using Clock = std::chrono::steady_clock;
 double since(Clock::time_point t) { return std::chrono::duration<double>(Clock::now() - t).count(); }
 
 struct Options {
-  std::string url, out, from_log;
+  std::string url, out, from_log, author, author_email;
   double timeout = 60, wait_run = 120;
   int64_t run_id = 0; // 0: the first run seen
 };
@@ -46,7 +46,7 @@ struct Options {
 class Session {
 public:
   Session(lcm::LCM &lcm, const Options &o)
-      : lcm_(lcm), opt_(o), rec_(o.out, DYNHET_VERSION), start_(Clock::now()) {}
+      : lcm_(lcm), opt_(o), rec_(o.out, DYNHET_VERSION, o.author, o.author_email), start_(Clock::now()) {}
 
   int run();
 
@@ -284,6 +284,9 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   app.add_option("--wait-run", o.wait_run, "seconds to wait for the run info")->capture_default_str();
   app.add_option("--run-id", o.run_id, "record only this run (default: the first one seen)");
+  app.add_option("--author", o.author,
+                 "the file's h5md/author name (default: $DYNHET_AUTHOR, else $USER, else \"unknown\")");
+  app.add_option("--author-email", o.author_email, "the file's h5md/author email (default: none)");
   app.add_option("--list-nodes", list_log,
                  "print the analysis nodes the run in this lcm-logger log needs, and exit");
   CLI11_PARSE(app, argc, argv);

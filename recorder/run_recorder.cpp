@@ -4,6 +4,7 @@
 
 #include <cstdio>
 
+#include "dynhet/lcm_url.hpp"
 #include "dynhet/model.hpp"
 
 namespace dynhet {
@@ -26,11 +27,40 @@ std::string join(const std::vector<std::string> &lines, const char *sep) {
 
 bool ended(const std::string &phase) { return phase == "done" || phase == "failed"; }
 
+// "" if `n` values are the product of the dimensions, else why not.
+std::string size_problem(const char *what, int64_t n, int64_t a, int64_t b, int64_t c = 1) {
+  if (n == a * b * c) return "";
+  return std::string(what) + ": " + std::to_string(n) + " values for dimensions " + std::to_string(a) +
+         " x " + std::to_string(b) + (c == 1 ? "" : " x " + std::to_string(c));
+}
+
+using Shape = H5mdWriter::Shape;
+size_t dim(int32_t n) { return static_cast<size_t>(n); }
 
 } // namespace
 
-RunRecorder::RunRecorder(std::string out_path, std::string creator_version)
-    : out_path_(std::move(out_path)), creator_version_(std::move(creator_version)) {}
+RunRecorder::RunRecorder(std::string out_path, std::string creator_version, std::string author,
+                         std::string author_email)
+    : out_path_(std::move(out_path)), creator_version_(std::move(creator_version)),
+      author_(std::move(author)), author_email_(std::move(author_email)) {}
+
+std::optional<RunRecorder::Stamp> RunRecorder::at_frame(int64_t frame, bool last_word) const {
+  if (frame < 0 || frame >= info_->n_frames) return std::nullopt;
+  return Stamp{frame, info_->frame_time[frame], last_word};
+}
+
+// -1 is a node's "no frame yet" (e.g. its final result when the sim failed
+// before the first frame): taken, with no record.
+std::string RunRecorder::frame_problem(int32_t frame_index) const {
+  if (frame_index >= -1 && frame_index < info_->n_frames) return "";
+  return "frame_index " + std::to_string(frame_index) + " is not one of the run's " +
+         std::to_string(info_->n_frames) + " frames (nor -1, none yet)";
+}
+
+bool RunRecorder::rejected(const char *channel, const std::string &why) {
+  message_rejected(channel, why);
+  return false;
+}
 
 // A failed write costs that record, not the run: it is reported on
 // stderr (the first few times) and counted against completeness.
@@ -74,7 +104,8 @@ void RunRecorder::stop_writing(const std::string &why) {
 
 bool RunRecorder::on_run(const run_info_t &m) {
   if (info_) return false;
-  writer_ = std::make_unique<H5mdWriter>(out_path_, "dynhet recorder", creator_version_);
+  writer_ =
+      std::make_unique<H5mdWriter>(out_path_, "dynhet recorder", creator_version_, author_, author_email_);
   info_ = std::make_unique<run_info_t>(m);
   assembler_.expect(m.n_particles, m.n_frames, m.chunk_particles);
   writer_->set_auto_flush(false); // one flush per message, in guarded()
@@ -113,7 +144,7 @@ void RunRecorder::write_run_info(const run_info_t &m) {
     writer_->write_fixed("schedule/frame_time", m.frame_time);
     writer_->write_fixed("schedule/origin_frame", m.origin_frame);
     writer_->write_fixed("schedule/lag_time", m.lag_time);
-    writer_->write_fixed("schedule/pair_frame", m.pair_frame);
+    writer_->write_fixed("schedule/pair_frame", m.pair_frame, {dim(m.n_origins), dim(m.n_lags)});
     writer_->write_fixed("schedule/cutoff_a", m.cutoff_a);
     writer_->set_attribute("observables/schedule", "n_origins", m.n_origins);
     writer_->set_attribute("observables/schedule", "n_lags", m.n_lags);
@@ -122,7 +153,7 @@ void RunRecorder::write_run_info(const run_info_t &m) {
 
 bool RunRecorder::on_sim_status(const sim_status_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
-  if (sim_.take(m, m.phase)) guarded("sim status", [&] { write_sim(m); });
+  guarded("sim status", [&] { write_sim(m); });
   // The frames kept are counted at the end (finish), not at a "done": a
   // forged one must not close the recorder's frames while the sim goes on.
   if (ended(m.phase) && m.frames_published > 0) frames_published_ = m.frames_published;
@@ -130,21 +161,25 @@ bool RunRecorder::on_sim_status(const sim_status_t &m) {
   return true;
 }
 
-// EDMD has no time step; its events (collisions and kicks) stand in.
+// Step f: the sim had published frames 0 .. f. The first status after a
+// frame makes the record, the sim's last word (done, failed, interrupted)
+// replaces it; sim_time is the status's own simulation time (>= time).
 void RunRecorder::write_sim(const sim_status_t &m) {
-  const int64_t step = m.n_collisions + m.n_kicks;
-  const double t = m.sim_time;
-  writer_->append_observable("sim/kinetic_energy", step, t, &m.kinetic_energy, 1);
-  writer_->append_observable("sim/n_collisions", step, t, &m.n_collisions, 1);
-  writer_->append_observable("sim/n_kicks", step, t, &m.n_kicks, 1);
-  writer_->append_observable("sim/packing_fraction", step, t, &m.packing_fraction, 1);
-  writer_->append_observable("sim/collisions_per_second", step, t, &m.collisions_per_second, 1);
-  writer_->append_observable("sim/frames_published", step, t, &m.frames_published, 1);
-  writer_->append_observable("sim/reduced_pressure", step, t, &m.reduced_pressure, 1);
-  writer_->append_observable("sim/reduced_pressure_err", step, t, &m.reduced_pressure_err, 1);
-  writer_->append_observable("sim/collision_frequency", step, t, &m.collision_frequency, 1);
-  writer_->append_observable("sim/collision_frequency_err", step, t, &m.collision_frequency_err, 1);
-  writer_->append_observable("sim/n_tc", step, t, &m.n_tc, 1);
+  const auto at = at_frame(int64_t{m.frames_published} - 1, ended(m.phase) || m.phase == "interrupted");
+  if (!at) return;
+  const std::pair<const char *, double> doubles[] = {{"sim_time", m.sim_time},
+                                                     {"kinetic_energy", m.kinetic_energy},
+                                                     {"packing_fraction", m.packing_fraction},
+                                                     {"collisions_per_second", m.collisions_per_second},
+                                                     {"reduced_pressure", m.reduced_pressure},
+                                                     {"reduced_pressure_err", m.reduced_pressure_err},
+                                                     {"collision_frequency", m.collision_frequency},
+                                                     {"collision_frequency_err", m.collision_frequency_err}};
+  for (const auto &[name, v] : doubles) writer_->append_scalar("sim/" + std::string(name), *at, v);
+  writer_->append_scalar("sim/n_collisions", *at, m.n_collisions);
+  writer_->append_scalar("sim/n_kicks", *at, m.n_kicks);
+  writer_->append_scalar("sim/n_tc", *at, m.n_tc);
+  writer_->append_scalar("sim/frames_published", *at, m.frames_published);
 }
 
 // All chunks the sim sent before saying it ended have been handled by
@@ -164,27 +199,30 @@ bool RunRecorder::on_node_status(const node_status_t &m) {
   n.latest = m;
   completion_.node_state(m.node, m.state);
   completion_.node_frames(m.node, m.frames_whole, m.frames_lost, m.frames_expected);
-  if (n.thin.take(m, m.state)) guarded("node status", [&] { write_node(m); });
+  guarded("node status", [&] { write_node(m); });
   return progress;
 }
 
-// Node status has no simulation time of its own: time is wall-clock
-// seconds since the first node status of the run (node clocks are the
-// host's; the run info's own stamp is old in a replay), step the frames
-// the node has handled.
+// Step f: the node had handled f + 1 frames (whole or lost), time the
+// simulation time of frame f; its done or failed replaces the record of
+// that step. wall_time: seconds since the first node status the recorder
+// heard (node clocks are the host's; the run info's own stamp is old in a
+// replay).
 void RunRecorder::write_node(const node_status_t &m) {
-  const std::string base = "nodes/" + node_key(m.node) + "/";
-  const int64_t step = int64_t{m.frames_whole} + m.frames_lost;
   if (!node_clock_zero_) node_clock_zero_ = m.utime;
-  const double t = 1e-6 * static_cast<double>(m.utime - *node_clock_zero_);
-  writer_->append_observable(base + "frames_whole", step, t, &m.frames_whole, 1);
-  writer_->append_observable(base + "frames_lost", step, t, &m.frames_lost, 1);
-  writer_->append_observable(base + "chunks_received", step, t, &m.chunks_received, 1);
-  writer_->append_observable(base + "pairs_done", step, t, &m.pairs_done, 1);
+  const auto at = at_frame(int64_t{m.frames_whole} + m.frames_lost - 1, ended(m.state));
+  if (!at) return;
+  const std::string base = "nodes/" + node_key(m.node) + "/";
+  writer_->append_scalar(base + "frames_whole", *at, m.frames_whole);
+  writer_->append_scalar(base + "frames_lost", *at, m.frames_lost);
+  writer_->append_scalar(base + "chunks_received", *at, m.chunks_received);
+  writer_->append_scalar(base + "pairs_done", *at, m.pairs_done);
+  writer_->append_scalar(base + "wall_time", *at, 1e-6 * static_cast<double>(m.utime - *node_clock_zero_));
 }
 
 bool RunRecorder::on_overlap(const overlap_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
+  if (const std::string bad = frame_problem(m.frame_index); !bad.empty()) return rejected(kChanOverlap, bad);
   guarded("overlap", [&] { write_overlap(m); });
   if (m.is_final) completion_.final_result("overlap", m.cutoff_a);
   return true;
@@ -192,13 +230,15 @@ bool RunRecorder::on_overlap(const overlap_t &m) {
 
 bool RunRecorder::on_msd(const msd_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
+  if (const std::string bad = frame_problem(m.frame_index); !bad.empty()) return rejected(kChanMsd, bad);
   guarded("msd", [&] { write_msd(m); });
   if (m.is_final) completion_.final_result("msd", 0.0);
   return true;
 }
 
 // msd/{msd_all, msd_small, msd_{fast,slow}_{all,small}} and their _err:
-// (records, lags), the subsets' fractions as attributes; diffusion, diffusion_err, fit_t_min, fit_t_max: one number per record.
+// (records, lags), the subsets' fractions as attributes; diffusion,
+// diffusion_err, fit_t_min, fit_t_max: one number per record.
 void RunRecorder::write_msd(const msd_t &m) {
   if (!msd_started_) {
     writer_->write_fixed("msd/lag_time", m.lag_time);
@@ -207,37 +247,45 @@ void RunRecorder::write_msd(const msd_t &m) {
     msd_started_ = true;
   }
   if (m.n_lags <= 0) return;
-  const int64_t step = m.frame_index;
-  const double t = m.sim_time;
-  writer_->append_observable("msd/msd_all", step, t, m.msd_all);
-  writer_->append_observable("msd/msd_all_err", step, t, m.msd_all_err);
-  writer_->append_observable("msd/msd_small", step, t, m.msd_small);
-  writer_->append_observable("msd/msd_small_err", step, t, m.msd_small_err);
-  writer_->append_observable("msd/diffusion", step, t, &m.diffusion, 1);
-  writer_->append_observable("msd/diffusion_err", step, t, &m.diffusion_err, 1);
-  writer_->append_observable("msd/fit_t_min", step, t, &m.fit_t_min, 1);
-  writer_->append_observable("msd/fit_t_max", step, t, &m.fit_t_max, 1);
-  writer_->append_observable("msd/msd_fast_all", step, t, m.msd_fast_all);
-  writer_->append_observable("msd/msd_fast_all_err", step, t, m.msd_fast_all_err);
-  writer_->append_observable("msd/msd_slow_all", step, t, m.msd_slow_all);
-  writer_->append_observable("msd/msd_slow_all_err", step, t, m.msd_slow_all_err);
-  writer_->append_observable("msd/msd_fast_small", step, t, m.msd_fast_small);
-  writer_->append_observable("msd/msd_fast_small_err", step, t, m.msd_fast_small_err);
-  writer_->append_observable("msd/msd_slow_small", step, t, m.msd_slow_small);
-  writer_->append_observable("msd/msd_slow_small_err", step, t, m.msd_slow_small_err);
+  if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
+  const Stamp at = *at_frame(m.frame_index, m.is_final);
+  const std::pair<const char *, const std::vector<double> *> per_lag[] = {
+      {"msd_all", &m.msd_all},
+      {"msd_all_err", &m.msd_all_err},
+      {"msd_small", &m.msd_small},
+      {"msd_small_err", &m.msd_small_err},
+      {"msd_fast_all", &m.msd_fast_all},
+      {"msd_fast_all_err", &m.msd_fast_all_err},
+      {"msd_slow_all", &m.msd_slow_all},
+      {"msd_slow_all_err", &m.msd_slow_all_err},
+      {"msd_fast_small", &m.msd_fast_small},
+      {"msd_fast_small_err", &m.msd_fast_small_err},
+      {"msd_slow_small", &m.msd_slow_small},
+      {"msd_slow_small_err", &m.msd_slow_small_err}};
+  for (const auto &[name, v] : per_lag) writer_->append_observable("msd/" + std::string(name), at, *v);
+  writer_->append_scalar("msd/diffusion", at, m.diffusion);
+  writer_->append_scalar("msd/diffusion_err", at, m.diffusion_err);
+  writer_->append_scalar("msd/fit_t_min", at, m.fit_t_min);
+  writer_->append_scalar("msd/fit_t_max", at, m.fit_t_max);
 }
 
 bool RunRecorder::on_displacement(const displacement_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
+  std::string bad = frame_problem(m.frame_index);
+  if (bad.empty() && m.n_values > 0)
+    bad = size_problem("displacement series", m.n_series, m.n_sets, m.n_targets);
+  if (bad.empty() && m.n_values > 0)
+    bad = size_problem("displacement bins", m.n_values, m.n_sets, m.n_targets, m.n_bins);
+  if (!bad.empty()) return rejected(kChanDisplacement, bad);
   guarded("displacement", [&] { write_displacement(m); });
   if (m.is_final) completion_.final_result("displacement", 0.0);
   return true;
 }
 
 // displacement/: x (bin centres) once, with the settings as attributes; per
-// record the targets and their lags (records, targets), per series (set s,
-// target l) at [s * n_targets + l] the fits (records, series), and per bin
-// p, p_err, count (records, series * bins).
+// record the targets and their lags (records, targets), per series the fits
+// (records, sets, targets), and per bin p, p_err, count (records, sets,
+// targets, bins); set 0 is all particles, set 1 the small ones.
 void RunRecorder::write_displacement(const displacement_t &m) {
   const std::string base = "displacement/";
   if (!displacement_started_) {
@@ -250,28 +298,43 @@ void RunRecorder::write_displacement(const displacement_t &m) {
     writer_->set_attribute(g, "tail_sigmas", m.tail_sigmas);
     writer_->set_attribute(g, "min_bin_count", m.min_bin_count);
     writer_->set_attribute(g, "cutoff_a", m.cutoff_a);
-    writer_->set_attribute(g, "layout", "series s * n_targets + l; bins (s * n_targets + l) * n_bins + b");
+    writer_->set_attribute(g, "layout",
+                           "per target [record][target]; per series [record][set][target]; "
+                           "per bin [record][set][target][bin]");
     displacement_started_ = true;
   }
   if (m.n_values <= 0) return;
-  const int64_t step = m.frame_index;
-  const double t = m.sim_time;
-  auto scalar = [&](const char *name, const auto &v) { writer_->append_observable(base + name, step, t, &v, 1); };
-  auto array = [&](const char *name, const auto &v) { writer_->append_observable(base + name, step, t, v); };
+  if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
+  const Stamp at = *at_frame(m.frame_index, m.is_final);
+  const Shape series{dim(m.n_sets), dim(m.n_targets)}, bins{dim(m.n_sets), dim(m.n_targets), dim(m.n_bins)};
+  auto scalar = [&](const char *name, const auto &v) { writer_->append_scalar(base + name, at, v); };
+  auto per_target = [&](const char *name, const auto &v) { writer_->append_observable(base + name, at, v); };
+  auto shaped = [&](const char *name, const auto &v, const Shape &shape) {
+    writer_->append_observable(base + name, at, v.data(), shape);
+  };
   scalar("tau_alpha", m.tau_alpha);
-  array("target_time", m.target_time), array("target_tau_alpha", m.target_tau_alpha);
-  array("lag_index", m.lag_index), array("lag_time", m.lag_time);
-  array("n_pairs", m.n_pairs), array("samples", m.samples), array("fraction_outside", m.fraction_outside);
-  array("p", m.p), array("p_err", m.p_err), array("count", m.count);
-  array("gauss_d", m.gauss_d), array("gauss_d_err", m.gauss_d_err), array("gauss_bins", m.gauss_bins);
-  array("tail_x0", m.tail_x0), array("tail_x0_err", m.tail_x0_err), array("tail_amplitude", m.tail_amplitude);
-  array("tail_x_min", m.tail_x_min), array("tail_x_max", m.tail_x_max), array("tail_bins", m.tail_bins);
+  per_target("target_time", m.target_time), per_target("target_tau_alpha", m.target_tau_alpha);
+  per_target("lag_index", m.lag_index), per_target("lag_time", m.lag_time);
+  shaped("n_pairs", m.n_pairs, series), shaped("samples", m.samples, series);
+  shaped("fraction_outside", m.fraction_outside, series);
+  shaped("p", m.p, bins), shaped("p_err", m.p_err, bins), shaped("count", m.count, bins);
+  shaped("gauss_d", m.gauss_d, series), shaped("gauss_d_err", m.gauss_d_err, series);
+  shaped("gauss_bins", m.gauss_bins, series);
+  shaped("tail_x0", m.tail_x0, series), shaped("tail_x0_err", m.tail_x0_err, series);
+  shaped("tail_amplitude", m.tail_amplitude, series);
+  shaped("tail_x_min", m.tail_x_min, series), shaped("tail_x_max", m.tail_x_max, series);
+  shaped("tail_bins", m.tail_bins, series);
   scalar("gauss_d_small_tau_alpha", m.gauss_d_small_tau_alpha);
   scalar("tail_x0_small_tau_alpha", m.tail_x0_small_tau_alpha);
 }
 
 bool RunRecorder::on_s4(const s4_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
+  std::string bad = frame_problem(m.frame_index);
+  if (bad.empty() && m.n_values > 0) bad = size_problem("s4_lag", m.n_lag_values, m.n_lags, m.n_values);
+  if (bad.empty() && m.n_values > 0)
+    bad = size_problem("xi_lag, chi0_lag", m.n_lag_fits, m.n_lags, m.n_grids);
+  if (!bad.empty()) return rejected(kChanS4, bad);
   guarded("s4", [&] { write_s4(m); });
   if (m.is_final) completion_.final_result("s4", m.cutoff_a);
   return true;
@@ -280,8 +343,8 @@ bool RunRecorder::on_s4(const s4_t &m) {
 // s4/a<cutoff>/: fixed lag_time (the computed lags) and, per grid,
 // subbox_particles, subbox_per_side, grid_spacing, grid_points, n_shells;
 // per shell value q, shell_vectors (grid g's shells follow grid g-1's). Per
-// record: s4, s4_err (records, values) at t_s4; s4_lag (records, lags *
-// values); xi_lag, chi0_lag (records, lags * grids); oz_*, a2_*, chi4,
+// record: s4, s4_err (records, values) at t_s4; s4_lag (records, lags,
+// values); xi_lag, chi0_lag (records, lags, grids); oz_*, a2_*, chi4,
 // chi4_err (records, grids); scalars tau_alpha, t_s4, lag_index, n_origins,
 // xi, xi_err, chi0, chi0_err, chi4_box, chi4_box_err.
 void RunRecorder::write_s4(const s4_t &m) {
@@ -301,34 +364,46 @@ void RunRecorder::write_s4(const s4_t &m) {
     writer_->set_attribute(g, "q_max", m.q_max);
     writer_->set_attribute(g, "qxi_max", m.qxi_max);
     writer_->set_attribute(g, "layout",
-                           "s4[record][value], grid g's shells after grid g-1's; s4_lag[record][lag * n_values + "
-                           "value]; xi_lag, chi0_lag[record][lag * n_grids + grid]");
+                           "s4[record][value], grid g's shells after grid g-1's; s4_lag[record][lag][value]; "
+                           "xi_lag, chi0_lag[record][lag][grid]");
     s4_started_[label] = true;
   }
   if (m.n_values <= 0) return;
-  const int64_t step = m.frame_index;
-  const double t = m.sim_time;
-  const std::pair<const char *, const std::vector<double> *> arrays[] = {
-      {"s4", &m.s4},           {"s4_err", &m.s4_err},           {"s4_lag", &m.s4_lag},
-      {"xi_lag", &m.xi_lag},   {"chi0_lag", &m.chi0_lag},       {"oz_chi0", &m.oz_chi0},
-      {"oz_chi0_err", &m.oz_chi0_err}, {"oz_xi", &m.oz_xi},     {"oz_xi_err", &m.oz_xi_err},
-      {"oz_q_fit_max", &m.oz_q_fit_max}, {"a2_chi0", &m.a2_chi0}, {"a2_chi0_err", &m.a2_chi0_err},
-      {"a2_xi", &m.a2_xi},     {"a2_xi_err", &m.a2_xi_err},     {"a2_a", &m.a2_a},
-      {"a2_a_err", &m.a2_a_err}, {"a2_q_fit_max", &m.a2_q_fit_max}, {"chi4", &m.chi4},
-      {"chi4_err", &m.chi4_err}};
-  for (const auto &[name, v] : arrays) writer_->append_observable(base + name, step, t, *v);
-  writer_->append_observable(base + "oz_n_fit", step, t, m.oz_n_fit);
-  writer_->append_observable(base + "a2_n_fit", step, t, m.a2_n_fit);
+  if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
+  const Stamp at = *at_frame(m.frame_index, m.is_final);
+  const std::pair<const char *, const std::vector<double> *> arrays[] = {{"s4", &m.s4},
+                                                                         {"s4_err", &m.s4_err},
+                                                                         {"oz_chi0", &m.oz_chi0},
+                                                                         {"oz_chi0_err", &m.oz_chi0_err},
+                                                                         {"oz_xi", &m.oz_xi},
+                                                                         {"oz_xi_err", &m.oz_xi_err},
+                                                                         {"oz_q_fit_max", &m.oz_q_fit_max},
+                                                                         {"a2_chi0", &m.a2_chi0},
+                                                                         {"a2_chi0_err", &m.a2_chi0_err},
+                                                                         {"a2_xi", &m.a2_xi},
+                                                                         {"a2_xi_err", &m.a2_xi_err},
+                                                                         {"a2_a", &m.a2_a},
+                                                                         {"a2_a_err", &m.a2_a_err},
+                                                                         {"a2_q_fit_max", &m.a2_q_fit_max},
+                                                                         {"chi4", &m.chi4},
+                                                                         {"chi4_err", &m.chi4_err}};
+  for (const auto &[name, v] : arrays) writer_->append_observable(base + name, at, *v);
+  writer_->append_observable(base + "s4_lag", at, m.s4_lag.data(), {dim(m.n_lags), dim(m.n_values)});
+  writer_->append_observable(base + "xi_lag", at, m.xi_lag.data(), {dim(m.n_lags), dim(m.n_grids)});
+  writer_->append_observable(base + "chi0_lag", at, m.chi0_lag.data(), {dim(m.n_lags), dim(m.n_grids)});
+  writer_->append_observable(base + "oz_n_fit", at, m.oz_n_fit);
+  writer_->append_observable(base + "a2_n_fit", at, m.a2_n_fit);
   const std::pair<const char *, double> scalars[] = {
       {"tau_alpha", m.tau_alpha}, {"t_s4", m.t_s4}, {"xi", m.xi}, {"xi_err", m.xi_err}, {"chi0", m.chi0},
       {"chi0_err", m.chi0_err}, {"chi4_box", m.chi4_box}, {"chi4_box_err", m.chi4_box_err}};
-  for (const auto &[name, v] : scalars) writer_->append_observable(base + name, step, t, &v, 1);
-  writer_->append_observable(base + "lag_index", step, t, &m.lag_index, 1);
-  writer_->append_observable(base + "n_origins", step, t, &m.n_origins, 1);
+  for (const auto &[name, v] : scalars) writer_->append_scalar(base + name, at, v);
+  writer_->append_scalar(base + "lag_index", at, m.lag_index);
+  writer_->append_scalar(base + "n_origins", at, m.n_origins);
 }
 
 bool RunRecorder::on_clusters(const clusters_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
+  if (const std::string bad = frame_problem(m.frame_index); !bad.empty()) return rejected(kChanClusters, bad);
   guarded("clusters", [&] { write_clusters(m); });
   if (m.is_final) completion_.final_result("clusters", m.cutoff_a);
   return true;
@@ -349,12 +424,12 @@ void RunRecorder::write_clusters(const clusters_t &m) {
     writer_->set_attribute("observables/" + base, "kappa_n_max", m.kappa_n_max);
     clusters_started_[label] = true;
   }
-  const int64_t step = m.frame_index;
-  const double t = m.sim_time;
-  auto scalar = [&](const char *name, const auto &v) { writer_->append_observable(base + name, step, t, &v, 1); };
-  auto array = [&](const char *name, const auto &v) { writer_->append_observable(base + name, step, t, v); };
-  writer_->append_observable(base + "neighbour_cutoff", step, t, m.neighbour_cutoff, 3);
-  writer_->append_observable(base + "pooled_minimum", step, t, m.pooled_minimum, 3);
+  if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
+  const Stamp at = *at_frame(m.frame_index, m.is_final);
+  auto scalar = [&](const char *name, const auto &v) { writer_->append_scalar(base + name, at, v); };
+  auto array = [&](const char *name, const auto &v) { writer_->append_observable(base + name, at, v); };
+  writer_->append_observable(base + "neighbour_cutoff", at, m.neighbour_cutoff, {3});
+  writer_->append_observable(base + "pooled_minimum", at, m.pooled_minimum, {3});
   scalar("g_frames", m.g_frames);
   if (m.n_r > 0) {
     if (!clusters_r_written_[label]) writer_->write_fixed(base + "r", m.r);
@@ -395,13 +470,16 @@ void RunRecorder::write_clusters(const clusters_t &m) {
 
 bool RunRecorder::on_chi4(const chi4_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
+  std::string bad = frame_problem(m.frame_index);
+  if (bad.empty() && m.n_values > 0) bad = size_problem("chi4", m.n_values, m.n_grids, m.n_lags);
+  if (!bad.empty()) return rejected(kChanChi4, bad);
   guarded("chi4", [&] { write_chi4(m); });
   if (m.is_final) completion_.final_result("chi4", m.cutoff_a);
   return true;
 }
 
-// chi4/a<cutoff>/{chi4, chi4_err}: value (records, grids, lags) flattened to
-// (records, grids * lags); chi4_peak, tau4 and their errors: (records, grids).
+// chi4/a<cutoff>/{chi4, chi4_err}: (records, grids, lags); chi4_peak, tau4
+// and their errors: (records, grids).
 void RunRecorder::write_chi4(const chi4_t &m) {
   const std::string label = cutoff_label(m.cutoff_a);
   const std::string base = "chi4/" + label + "/";
@@ -410,18 +488,19 @@ void RunRecorder::write_chi4(const chi4_t &m) {
     writer_->write_fixed(base + "subbox_particles", m.subbox_particles);
     writer_->write_fixed(base + "subbox_per_side", m.subbox_per_side);
     writer_->set_attribute("observables/" + base, "cutoff_a", m.cutoff_a);
-    writer_->set_attribute("observables/" + base, "layout", "value[record][grid * n_lags + lag]");
+    writer_->set_attribute("observables/" + base, "layout", "chi4, chi4_err [record][grid][lag]");
     chi4_started_[label] = true;
   }
   if (m.n_values <= 0) return;
-  const int64_t step = m.frame_index;
-  const double t = m.sim_time;
-  writer_->append_observable(base + "chi4", step, t, m.chi4);
-  writer_->append_observable(base + "chi4_err", step, t, m.chi4_err);
-  writer_->append_observable(base + "chi4_peak", step, t, m.chi4_peak);
-  writer_->append_observable(base + "tau4", step, t, m.tau4);
-  writer_->append_observable(base + "chi4_peak_err", step, t, m.chi4_peak_err);
-  writer_->append_observable(base + "tau4_err", step, t, m.tau4_err);
+  if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
+  const Stamp at = *at_frame(m.frame_index, m.is_final);
+  const Shape grid_lag{dim(m.n_grids), dim(m.n_lags)};
+  writer_->append_observable(base + "chi4", at, m.chi4.data(), grid_lag);
+  writer_->append_observable(base + "chi4_err", at, m.chi4_err.data(), grid_lag);
+  writer_->append_observable(base + "chi4_peak", at, m.chi4_peak);
+  writer_->append_observable(base + "tau4", at, m.tau4);
+  writer_->append_observable(base + "chi4_peak_err", at, m.chi4_peak_err);
+  writer_->append_observable(base + "tau4_err", at, m.tau4_err);
 }
 
 void RunRecorder::write_overlap(const overlap_t &m) {
@@ -435,22 +514,22 @@ void RunRecorder::write_overlap(const overlap_t &m) {
     overlap_started_[label] = true;
   }
   if (m.n_lags <= 0) return;
-  const int64_t step = m.frame_index;
-  const double t = m.sim_time;
-  writer_->append_observable(base + "q", step, t, m.q);
-  writer_->append_observable(base + "q_err", step, t, m.q_err);
-  writer_->append_observable(base + "n_origins", step, t, m.n_origins);
-  writer_->append_observable(base + "qr_var", step, t, m.qr_var);
-  writer_->append_observable(base + "tau_alpha", step, t, &m.tau_alpha, 1);
-  writer_->append_observable(base + "tau_alpha_err", step, t, &m.tau_alpha_err, 1);
-  writer_->append_observable(base + "beta", step, t, &m.beta, 1);
-  writer_->append_observable(base + "beta_err", step, t, &m.beta_err, 1);
-  writer_->append_observable(base + "tau0", step, t, &m.tau0, 1);
-  writer_->append_observable(base + "tau0_err", step, t, &m.tau0_err, 1);
+  if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
+  const Stamp at = *at_frame(m.frame_index, m.is_final);
+  writer_->append_observable(base + "q", at, m.q);
+  writer_->append_observable(base + "q_err", at, m.q_err);
+  writer_->append_observable(base + "n_origins", at, m.n_origins);
+  writer_->append_observable(base + "qr_var", at, m.qr_var);
+  writer_->append_scalar(base + "tau_alpha", at, m.tau_alpha);
+  writer_->append_scalar(base + "tau_alpha_err", at, m.tau_alpha_err);
+  writer_->append_scalar(base + "beta", at, m.beta);
+  writer_->append_scalar(base + "beta_err", at, m.beta_err);
+  writer_->append_scalar(base + "tau0", at, m.tau0);
+  writer_->append_scalar(base + "tau0_err", at, m.tau0_err);
   if (m.n_t0 > 0) {
     if (!overlap_t0_written_[label]) writer_->write_fixed(base + "t0", m.t0);
     overlap_t0_written_[label] = true;
-    writer_->append_observable(base + "tau_alpha_t0", step, t, m.tau_alpha_t0);
+    writer_->append_observable(base + "tau_alpha_t0", at, m.tau_alpha_t0);
   }
 }
 
@@ -466,7 +545,7 @@ bool RunRecorder::on_frame_chunk(const frame_chunk_t &m) {
     message_rejected("DYNHET_FRAME", "a chunk that is not one of this run's, or non-finite positions");
     return false;
   }
-  if (f) guarded("frame", [&] { writer_->append_frame(f->index, f->time, f->position); });
+  if (f) guarded("frame", [&] { writer_->append_frame(*at_frame(f->index, false), f->position); });
   return true;
 }
 
@@ -483,11 +562,6 @@ std::vector<std::string> RunRecorder::finish(const std::string &reason) {
     }
     return missing;
   }
-  // The last word of each status stream.
-  if (sim_.held) guarded("sim status", [&] { write_sim(*sim_.held); });
-  for (auto &[key, n] : nodes_)
-    if (n.thin.held) guarded("node status", [&] { write_node(*n.thin.held); });
-
   count_frames();
   for (const std::string &m : completion_.missing()) missing.push_back(m);
   if (write_errors_ > 0) missing.push_back(std::to_string(write_errors_) + " failed writes");

@@ -2,15 +2,29 @@
 // the run (its run_id); messages of other runs are ignored. No bus here:
 // main() hands the messages over, which keeps this testable in-process.
 //
+// Every time series has one clock, the run's frame schedule: step f is
+// frame f (0 .. n_frames - 1) and time its simulation time,
+// schedule/frame_time[f]. A record at step f is based on frames up to f:
+//   results (overlap, chi4, msd, displacement, clusters, s4): published
+//     after frame f was folded in (the message's frame_index);
+//   sim/<field>: the sim had published frames 0 .. f (frames_published - 1);
+//   nodes/<node>/<field>: the node had handled frames_whole + frames_lost =
+//     f + 1 frames (its last one f, when none is still pending).
+// Steps strictly increase in every series: a later message of the same step
+// is dropped unless it is its stream's last word (is_final, the sim's
+// done/failed/interrupted, a node's done/failed), which replaces the record
+// of that step; a message of an older step is dropped. Statuses before the
+// first frame make no record (their last word is in the summary attributes).
+//
 // What goes where (paths under observables/ unless absolute):
 //   /parameters/scene_toml, /parameters/<table>   the scene (H5mdWriter)
 //   /parameters/run_info                          attrs: run id, N, L, phi, ...
 //   /particles/all/{box, species, position, image} (frames only if kept)
-//   schedule/{frame_time, origin_frame, lag_time, pair_frame, cutoff_a}
-//   sim/<field>            {step = collisions + kicks, time = sim time}
-//   nodes/<node>/<field>   {step = frames handled, time = wall s since the first node status}
-//   overlap/a<cutoff>/<field> {step = frame index, time = sim time}, lag_time
-//   chi4/a<cutoff>/..., s4/a<cutoff>/..., msd/... likewise (s4: see write_s4)
+//   schedule/{frame_time, origin_frame, lag_time, pair_frame [origin][lag], cutoff_a}
+//   sim/<field>            the sim's status, with sim_time (its own simulation time)
+//   nodes/<node>/<field>   the node's frame counts, with wall_time (s since the first node status)
+//   overlap/a<cutoff>/<field>, with lag_time
+//   chi4/a<cutoff>/..., s4/a<cutoff>/..., msd/... likewise (see write_chi4, write_s4)
 //   clusters/a<cutoff>/<field> likewise, with lag_time, r and the size bins
 //   msd/<field>, displacement/<field> likewise (one each per run), with
 //   lag_time (msd) and x, the bin centres (displacement)
@@ -39,35 +53,20 @@
 
 namespace dynhet {
 
-// Thins a status stream to about one record a second by the publisher's
-// clock, always keeping a change of phase or state, and holds the latest
-// unwritten message back so that the stream's last word can be written.
-template <class Msg> struct Thinned {
-  std::optional<int64_t> last_utime;
-  std::string last_state;
-  std::optional<Msg> held;
-
-  // True: write `m` now. False: it is held.
-  bool take(const Msg &m, const std::string &state) {
-    if (!last_utime || state != last_state || m.utime - *last_utime >= 1000000) {
-      last_utime = m.utime;
-      last_state = state;
-      held.reset();
-      return true;
-    }
-    held = m;
-    return false;
-  }
-};
-
 class RunRecorder {
 public:
-  RunRecorder(std::string out_path, std::string creator_version);
+  // The file's h5md/author: an empty name means default_author()
+  // ($DYNHET_AUTHOR, $USER, "unknown"); an empty email writes none.
+  RunRecorder(std::string out_path, std::string creator_version, std::string author = "",
+              std::string author_email = "");
 
   // Each returns true when the message belongs to the run and was taken;
   // a node status only when the node made progress, so that the caller
-  // can tell a working pipeline from a stalled one. on_run creates the
-  // file on the first run info and throws if it cannot.
+  // can tell a working pipeline from a stalled one. A result whose frame
+  // index is neither one of the run's nor -1 (no frame yet: taken, not
+  // written), or whose array sizes do not fit its dimensions, is rejected
+  // (message_rejected). on_run creates the file on the first run info and
+  // throws if it cannot.
   bool on_run(const run_info_t &m);
   bool on_sim_status(const sim_status_t &m);
   bool on_node_status(const node_status_t &m);
@@ -92,23 +91,22 @@ public:
   const Completion &completion() const { return completion_; }
   int frames_whole() const { return assembler_.frames_whole(); }
 
-  // Writes the held statuses and the summary attributes (complete,
-  // missing, frames lost per node), closes the file, and returns what is
-  // missing, with `reason` (e.g. "interrupted") first when given.
+  // Writes the summary attributes (complete, missing, frames lost per
+  // node), closes the file, and returns what is missing, with `reason`
+  // (e.g. "interrupted") first when given.
   std::vector<std::string> finish(const std::string &reason = "");
 
 private:
   struct Node {
-    Thinned<node_status_t> thin;
     node_status_t latest;
   };
+  using Stamp = H5mdWriter::Stamp;
 
-  std::string out_path_, creator_version_;
+  std::string out_path_, creator_version_, author_, author_email_;
   std::unique_ptr<run_info_t> info_;
   std::unique_ptr<H5mdWriter> writer_;
   Completion completion_;
   FrameAssembler assembler_{1};
-  Thinned<sim_status_t> sim_;
   std::map<std::string, Node> nodes_;
   std::map<std::string, bool> overlap_started_; // by cutoff label
   std::map<std::string, bool> chi4_started_;    // by cutoff label
@@ -128,6 +126,12 @@ private:
   int frames_published_ = 0; // from the sim's last "done" or "failed"
   std::string last_rejection_;
 
+  // The record of frame `frame` (replacing one of the same step if `last_word`);
+  // none if the run has no such frame.
+  std::optional<Stamp> at_frame(int64_t frame, bool last_word) const;
+  // "" if the result's frame index is one of the run's or -1 (none yet), else why not.
+  std::string frame_problem(int32_t frame_index) const;
+  bool rejected(const char *channel, const std::string &why);
   void write_run_info(const run_info_t &m);
   void write_sim(const sim_status_t &m);
   void write_node(const node_status_t &m);

@@ -140,7 +140,6 @@ def check_displacement(f, unwrapped, origin_frame, pair_frame, lag, scene):
     blocks = min(int(g.attrs["n_blocks"]), n_origins)
     check(blocks == min(sp.get("error_blocks", 20), n_origins), f"displacement: {blocks} blocks of origins")
     block_of = np.arange(n_origins) * blocks // n_origins
-    nt = len(targets)
     rec = {k: g[k]["value"][-1] for k in ("count", "p", "p_err", "gauss_d", "gauss_d_err", "tail_x0",
                                            "tail_x0_err", "tail_x_min", "samples", "fraction_outside")}
     n_fits = 0
@@ -156,8 +155,7 @@ def check_displacement(f, unwrapped, origin_frame, pair_frame, lag, scene):
                 per_block[block_of[k]] += np.bincount(slot[k], minlength=nb + 2)
                 samples[block_of[k]] += len(dx[k])
             count = per_block.sum(axis=0)[1:nb + 1]
-            sl = slice((s * nt + l_) * nb, (s * nt + l_ + 1) * nb)
-            i = s * nt + l_
+            i = sl = (s, l_)  # per series [set][target], per bin [set][target][bin]
             what = f"displacement {('all', 'small')[s]} t = {t:.3g}"
             check(np.array_equal(rec["count"][sl], count) and rec["samples"][i] == samples.sum(),
                   f"{what}: counts equal numpy's ({count.sum()} of {samples.sum()} inside)")
@@ -219,7 +217,8 @@ def check_chi4(f, unwrapped, L, origin_frame, pair_frame):
         a = float(g.attrs["cutoff_a"])
         sides = g["subbox_per_side"][()]
         n_lags = len(g["lag_time"][()])
-        rec = g["chi4"]["value"][-1].reshape(len(sides), n_lags)
+        rec = g["chi4"]["value"][-1]  # [grid][lag]
+        check(rec.shape == (len(sides), n_lags), f"chi4 {name}: the last record is [grid][lag] {rec.shape}")
         for gi, m in enumerate(sides):
             N = n / (m * m)
             chi = np.zeros(n_lags)
@@ -282,7 +281,7 @@ def check_chi4(f, unwrapped, L, origin_frame, pair_frame):
                 k = len(q)
                 loo = np.array([n * np.delete(q, i, axis=0).var(axis=0, ddof=1) for i in range(k)])
                 jk = np.sqrt((k - 1) / k * ((loo - loo.mean(axis=0)) ** 2).sum(axis=0))
-                got = g["chi4_err"]["value"][-1].reshape(len(sides), n_lags)[gi]
+                got = g["chi4_err"]["value"][-1][gi]
                 # Relative to each lag's error, with a floor at 1e-9 of the largest: where Q(t;t0)
                 # is nearly 1 for every origin the variance is a difference of nearly equal
                 # numbers, summed in another order by the node, so its roundoff is relative to
@@ -339,7 +338,8 @@ def check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, sched_lag):
     sides, n_shells = g["subbox_per_side"][()], g["n_shells"][()]
     h, q_rec = g["grid_spacing"][()], g["q"][()]
     lags = g["lag_time"][()]
-    s4_lag = g["s4_lag"]["value"][-1].reshape(len(lags), -1)
+    s4_lag = g["s4_lag"]["value"][-1]  # [lag][value]
+    check(s4_lag.shape == (len(lags), len(q_rec)), f"s4 {name}: s4_lag's last record is [lag][value] {s4_lag.shape}")
     hw = 4  # the Gaussian half-width: the scene's [s4] half_width, default 4
     if "s4" in f["parameters"] and "half_width" in f["parameters/s4"].attrs:
         hw = int(f["parameters/s4"].attrs["half_width"])
@@ -588,7 +588,7 @@ def main(path, scene_path):
     check(int(nodes["frames_lost"]["value"][-1]) == 0, "overlap node lost no frame")
     check(int(nodes["frames_whole"]["value"][-1]) == n_frames, "overlap node got every frame whole")
 
-    pair_frame = pair_frame.reshape(len(origin_frame), len(lag))
+    check(pair_frame.shape == (len(origin_frame), len(lag)), f"schedule: pair_frame is [origin][lag] {pair_frame.shape}")
     for name, g in f["observables/overlap"].items():
         a = float(g.attrs["cutoff_a"])
         q_rec = g["q"]["value"][-1]

@@ -47,13 +47,13 @@ for name, m in runs.items():
         mine = {"tau_alpha": tau, "beta": o["overlap/a0.6/beta/value"][-1],
                 "D": o["msd/diffusion/value"][-1], "Z": o["sim/reduced_pressure/value"][-1]}
         ns = o["chi4/a0.6/subbox_particles"][()]
-        lag = o["chi4/a0.6/lag_time"][()]
+        lag = o["chi4/a0.6/lag_time"][()]  # chi4 records are [grid][lag]
         gi = max((i for i in range(len(ns)) if ns[i] < 0.999 * m["n_particles"]), key=lambda i: ns[i])
-        chi = o["chi4/a0.6/chi4/value"][-1].reshape(len(ns), len(lag))[gi]
+        chi = o["chi4/a0.6/chi4/value"][-1][gi]
         mine["chi4_tau_alpha"] = lin_ln_t(lag, chi, tau)
         s4n = o["s4/a0.6/subbox_particles"][()]
         slag = o["s4/a0.6/lag_time"][()]
-        xi = o["s4/a0.6/xi_lag/value"][-1].reshape(len(slag), len(s4n))[:, int(np.argmax(s4n))]
+        xi = o["s4/a0.6/xi_lag/value"][-1][:, int(np.argmax(s4n))]  # [lag][grid]
         mine["xi_tau_alpha"] = lin_ln_t(slag, xi, tau)
     for k, v in mine.items():
         got = g[k][row, 0]

@@ -84,30 +84,74 @@ inline TypeInfo dataset_type(hid_t file, const std::string &path) {
   return t;
 }
 
-inline std::vector<std::string> read_vlen_strings(hid_t obj, hid_t space, bool attr) {
-  hssize_t n = H5Sget_simple_extent_npoints(space);
-  std::vector<char *> p(static_cast<size_t>(n), nullptr);
+// Strings as H5MD asks for them: fixed-length (any padding). A
+// variable-length string throws, so that every string a test reads is
+// checked to be fixed-length.
+inline std::vector<std::string> read_fixed_strings(hid_t obj, hid_t space, bool attr) {
+  const hssize_t n = H5Sget_simple_extent_npoints(space);
   // Read with the stored type itself: HDF5 does not convert ASCII <-> UTF-8.
   hid_t t = attr ? H5Aget_type(obj) : H5Dget_type(obj);
-  if (H5Tis_variable_str(t) <= 0) throw std::runtime_error("not a variable-length string");
-  ok(attr ? H5Aread(obj, t, p.data()) : H5Dread(obj, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, p.data()),
-     "read strings");
-  std::vector<std::string> out;
-  for (char *s : p) {
-    out.emplace_back(s ? s : "");
-    H5free_memory(s);
+  if (H5Tget_class(t) != H5T_STRING || H5Tis_variable_str(t) != 0) {
+    H5Tclose(t);
+    throw std::runtime_error("not a fixed-length string");
   }
+  const size_t width = H5Tget_size(t);
+  std::vector<char> buf(static_cast<size_t>(n) * width);
+  ok(attr ? H5Aread(obj, t, buf.data()) : H5Dread(obj, t, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf.data()),
+     "read strings");
   H5Tclose(t);
+  std::vector<std::string> out;
+  for (hssize_t i = 0; i < n; ++i) {
+    std::string v(&buf[static_cast<size_t>(i) * width], width);
+    out.push_back(v.substr(0, v.find('\0'))); // NULLPAD or NULLTERM
+  }
   return out;
 }
 
 inline std::string read_string(hid_t file, const std::string &path) {
   hid_t d = ok_id(H5Dopen2(file, path.c_str(), H5P_DEFAULT), "open " + path);
   hid_t s = H5Dget_space(d);
-  std::vector<std::string> v = read_vlen_strings(d, s, false);
+  std::vector<std::string> v = read_fixed_strings(d, s, false);
   H5Sclose(s);
   H5Dclose(d);
   return v.at(0);
+}
+
+// Are the two paths links to one HDF5 object (hard links to the same
+// dataset or group)? And how many hard links an object has.
+struct ObjectInfo {
+  bool valid;
+  unsigned links;
+#if H5_VERSION_GE(1, 12, 0)
+  H5O_token_t token;
+#else
+  haddr_t addr;
+#endif
+};
+inline ObjectInfo object_info(hid_t file, const std::string &path) {
+  ObjectInfo o{};
+#if H5_VERSION_GE(1, 12, 0)
+  H5O_info2_t info;
+  o.valid = H5Oget_info_by_name3(file, path.c_str(), &info, H5O_INFO_BASIC, H5P_DEFAULT) >= 0;
+  o.token = info.token;
+#else
+  H5O_info_t info;
+  o.valid = H5Oget_info_by_name2(file, path.c_str(), &info, H5O_INFO_BASIC, H5P_DEFAULT) >= 0;
+  o.addr = info.addr;
+#endif
+  o.links = info.rc;
+  if (!o.valid) throw std::runtime_error("HDF5 read failed: object info of " + path);
+  return o;
+}
+inline bool same_object(hid_t file, const std::string &a, const std::string &b) {
+  const ObjectInfo x = object_info(file, a), y = object_info(file, b);
+#if H5_VERSION_GE(1, 12, 0)
+  int cmp = 1;
+  H5Otoken_cmp(file, &x.token, &y.token, &cmp);
+  return cmp == 0;
+#else
+  return x.addr == y.addr;
+#endif
 }
 
 // An attribute of the object at `obj_path` ("/" for the root).
@@ -154,7 +198,7 @@ public:
   }
   std::vector<std::string> strings() const {
     hid_t s = H5Aget_space(id_);
-    std::vector<std::string> v = read_vlen_strings(id_, s, true);
+    std::vector<std::string> v = read_fixed_strings(id_, s, true);
     H5Sclose(s);
     return v;
   }

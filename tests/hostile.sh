@@ -53,9 +53,10 @@ check 'same "$tmp/clean/run.h5" "$tmp/attacked/run.h5"' "attacked run: results e
 $py - "$tmp/attacked/run.h5" >"$tmp/counts.txt" <<'PY' || true
 import h5py, sys
 f = h5py.File(sys.argv[1], "r")
-print("recorder", int(f.attrs["messages_rejected_recorder"]), f.attrs["last_rejection_recorder"])
+text = lambda v: v.decode() if isinstance(v, bytes) else str(v)  # fixed-length strings read as bytes
+print("recorder", int(f.attrs["messages_rejected_recorder"]), text(f.attrs["last_rejection_recorder"]))
 for n, g in f["observables/nodes"].items():
-    print(n, int(g.attrs["messages_rejected"]), int(g.attrs["chunks_rejected"]), g.attrs["last_rejection"])
+    print(n, int(g.attrs["messages_rejected"]), int(g.attrs["chunks_rejected"]), text(g.attrs["last_rejection"]))
 PY
 cat "$tmp/counts.txt"
 check '[[ $(awk "\$1 == \"recorder\" && \$2 > 100" "$tmp/counts.txt" | wc -l) == 1 ]]' "the recorder counted the bad messages it dropped"

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <random>
 
 #include "dynhet/h5md.hpp"
@@ -62,7 +63,7 @@ struct Written {
 Written write_small_run() {
   Written w;
   w.path = temp_file("roundtrip");
-  dynhet::H5mdWriter h(w.path, "test creator", "9.9", "tester");
+  dynhet::H5mdWriter h(w.path, "test creator", "9.9", "tester", "tester@example.org");
   h.write_parameters(kScene);
   h.set_particles("all", kBox, std::vector<int8_t>{0, 1, 1, 0});
   for (int f = 0; f < 3; ++f) h.append_frame(10 * f, 0.5 * f, w.frames[f]);
@@ -101,6 +102,10 @@ TEST_F(H5mdRoundTrip, H5mdGroup) {
   EXPECT_EQ(Attr(f, "/h5md/creator", "name").strings().at(0), "test creator");
   EXPECT_EQ(Attr(f, "/h5md/creator", "version").strings().at(0), "9.9");
   EXPECT_EQ(Attr(f, "/h5md/author", "name").strings().at(0), "tester");
+  EXPECT_EQ(Attr(f, "/h5md/author", "email").strings().at(0), "tester@example.org");
+  // Fixed-length, as H5MD asks (strings() refuses variable-length ones): the string's own size.
+  EXPECT_EQ(Attr(f, "/h5md/author", "name").type().cls, H5T_STRING);
+  EXPECT_EQ(Attr(f, "/h5md/author", "name").type().size, 6u);
   EXPECT_EQ(Attr(f, "/", "complete").values<int32_t>(), std::vector<int32_t>{1});
 }
 
@@ -151,6 +156,14 @@ TEST_F(H5mdRoundTrip, PositionPlusImageIsTheUnwrappedInput) {
     EXPECT_EQ(h5read::read<int64_t>(f, base + "/step"), (std::vector<int64_t>{0, 10, 20}));
     EXPECT_EQ(h5read::read<double>(f, base + "/time"), (std::vector<double>{0, 0.5, 1.0}));
   }
+  // image shares position's step and time: hard links to the same datasets.
+  for (const char *d : {"step", "time"}) {
+    EXPECT_TRUE(h5read::same_object(f, std::string("/particles/all/position/") + d,
+                                    std::string("/particles/all/image/") + d))
+        << d;
+    EXPECT_EQ(h5read::object_info(f, std::string("/particles/all/image/") + d).links, 2u) << d;
+  }
+  EXPECT_FALSE(h5read::same_object(f, "/particles/all/position/value", "/particles/all/image/value"));
   EXPECT_EQ(h5read::dataset_type(f, "/particles/all/image/value").cls, H5T_INTEGER);
   const auto pos = h5read::read<double>(f, "/particles/all/position/value");
   const auto img = h5read::read<int32_t>(f, "/particles/all/image/value");
@@ -197,6 +210,88 @@ TEST_F(H5mdRoundTrip, ObservableTimeSeries) {
   EXPECT_EQ(h5read::read<double>(f, "/observables/overlap/a0.6/lag_time"), (std::vector<double>{0.1, 1, 10}));
   EXPECT_EQ(Attr(f, "/observables/overlap/a0.6", "subbox_particles").values<double>(),
             std::vector<double>{62.5});
+}
+
+// Steps strictly increase in every series: a record of an older or equal
+// step is dropped, one of the last step replaces the last record when asked.
+TEST(H5mdSteps, StrictlyIncreaseAndTheLastWordReplaces) {
+  using R = dynhet::H5mdWriter::Recorded;
+  using St = dynhet::H5mdWriter::Stamp;
+  const std::string path = temp_file("steps");
+  {
+    dynhet::H5mdWriter h(path, "t", "0");
+    const std::vector<double> a{1, 2}, b{3, 4}, c{5, 6}, d{7, 8};
+    EXPECT_EQ(h.append_observable("x", St{3, 1.5}, a), R::appended);
+    EXPECT_EQ(h.append_observable("x", St{3, 1.5}, b), R::dropped);       // same step, not the last word
+    EXPECT_EQ(h.append_observable("x", St{2, 1.0, true}, b), R::dropped); // an older step, even replacing
+    EXPECT_EQ(h.append_observable("x", St{5, 2.5}, b), R::appended);
+    EXPECT_EQ(h.append_observable("x", St{5, 2.5, true}, c), R::replaced); // the last word of step 5
+    EXPECT_EQ(h.append_observable("x", St{6, 3.0, true}, d), R::appended); // a new step is appended
+    h.set_particles("all", kBox, std::vector<int32_t>{0, 1});
+    EXPECT_EQ(h.append_frame(St{0, 0.0}, {1, 2, 3, 4}), R::appended);
+    EXPECT_EQ(h.append_frame(St{0, 0.0}, {5, 6, 7, 8}), R::dropped);
+    EXPECT_EQ(h.append_frame(St{1, 0.5, true}, {1, 1, 1, 1}), R::appended);
+    EXPECT_EQ(h.append_frame(St{1, 0.5, true}, {2, 2, 2, 2}), R::replaced);
+  }
+  h5read::File f(path);
+  EXPECT_EQ(h5read::read<int64_t>(f, "/observables/x/step"), (std::vector<int64_t>{3, 5, 6}));
+  EXPECT_EQ(h5read::read<double>(f, "/observables/x/time"), (std::vector<double>{1.5, 2.5, 3.0}));
+  EXPECT_EQ(h5read::read<double>(f, "/observables/x/value"), (std::vector<double>{1, 2, 5, 6, 7, 8}));
+  EXPECT_EQ(h5read::read<int64_t>(f, "/particles/all/image/step"), (std::vector<int64_t>{0, 1}));
+  EXPECT_EQ(h5read::read<double>(f, "/particles/all/position/value"),
+            (std::vector<double>{1, 2, 3, 4, 2, 2, 2, 2}));
+  EXPECT_EQ(h5read::read<int32_t>(f, "/particles/all/image/value"),
+            (std::vector<int32_t>{0, 0, 0, 0, 0, 0, 0, 0}));
+  std::remove(path.c_str());
+}
+
+// A record keeps the dimensions it is given; a later record of another shape is refused.
+TEST(H5mdShapes, RecordsKeepTheirDimensions) {
+  using St = dynhet::H5mdWriter::Stamp;
+  const std::string path = temp_file("shapes");
+  {
+    dynhet::H5mdWriter h(path, "t", "0");
+    const std::vector<double> v{0, 1, 2, 3, 4, 5}; // [2][3]
+    h.append_observable("m", St{0, 0}, v.data(), {2, 3});
+    h.append_observable("m", St{1, 1}, v.data(), {2, 3});
+    EXPECT_THROW(h.append_observable("m", St{2, 2}, v.data(), {3, 2}), std::runtime_error);
+    const int32_t one = 7;
+    h.append_scalar("s", St{0, 0}, one);
+    h.append_observable("v1", St{0, 0}, std::vector<int64_t>{9}); // a vector of one stays a vector
+    h.write_fixed("grid", std::vector<int32_t>{1, 2, 3, 4, 5, 6}, {3, 2});
+    EXPECT_THROW(h.write_fixed("bad", std::vector<int32_t>{1, 2, 3}, {2, 2}), std::runtime_error);
+  }
+  h5read::File f(path);
+  EXPECT_EQ(h5read::shape(f, "/observables/m/value"), (Shape{2, 2, 3}));
+  EXPECT_EQ(h5read::read<double>(f, "/observables/m/value"),
+            (std::vector<double>{0, 1, 2, 3, 4, 5, 0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(h5read::shape(f, "/observables/s/value"), Shape{1});
+  EXPECT_EQ(h5read::shape(f, "/observables/v1/value"), (Shape{1, 1}));
+  EXPECT_EQ(h5read::shape(f, "/observables/grid"), (Shape{3, 2}));
+  std::remove(path.c_str());
+}
+
+// No author given: $DYNHET_AUTHOR, else $USER, else "unknown"; never an email.
+TEST(H5mdAuthor, DefaultsFromTheEnvironment) {
+  const char *keep_author = std::getenv("DYNHET_AUTHOR"), *keep_user = std::getenv("USER");
+  const std::string saved_author = keep_author ? keep_author : "", saved_user = keep_user ? keep_user : "";
+  const std::string path = temp_file("author");
+  auto author_of = [&] {
+    { dynhet::H5mdWriter h(path, "t", "0"); }
+    h5read::File f(path);
+    EXPECT_FALSE(H5Aexists_by_name(f, "/h5md/author", "email", H5P_DEFAULT) > 0);
+    return Attr(f, "/h5md/author", "name").strings().at(0);
+  };
+  setenv("DYNHET_AUTHOR", "Ada Lovelace", 1);
+  setenv("USER", "ada", 1);
+  EXPECT_EQ(author_of(), "Ada Lovelace");
+  unsetenv("DYNHET_AUTHOR");
+  EXPECT_EQ(author_of(), "ada");
+  unsetenv("USER");
+  EXPECT_EQ(author_of(), "unknown");
+  if (keep_author) setenv("DYNHET_AUTHOR", saved_author.c_str(), 1);
+  if (keep_user) setenv("USER", saved_user.c_str(), 1);
+  std::remove(path.c_str());
 }
 
 TEST(H5mdErrors, NameThePathAndLeaveTheFileUsable) {

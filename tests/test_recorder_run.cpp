@@ -51,7 +51,7 @@ dynhet::run_info_t run_info() {
   return m;
 }
 
-dynhet::sim_status_t sim(double wall_s, const std::string &phase, double t) {
+dynhet::sim_status_t sim(double wall_s, const std::string &phase, double t, int frames_published = 3) {
   dynhet::sim_status_t m{};
   m.utime = static_cast<int64_t>(wall_s * 1e6);
   m.run_id = kRun;
@@ -59,7 +59,7 @@ dynhet::sim_status_t sim(double wall_s, const std::string &phase, double t) {
   m.sim_time = t;
   m.n_collisions = static_cast<int64_t>(1000 * t);
   m.kinetic_energy = 1.0;
-  m.frames_published = 3;
+  m.frames_published = frames_published;
   return m;
 }
 
@@ -119,18 +119,21 @@ void send_frame(dynhet::RunRecorder &rec, int f, bool drop_second_chunk = false)
 }
 
 // The run up to the sim saying done: statuses, frames, running results.
+// Statuses before the first frame make no record; after frame f, the sim
+// says it has published f + 1 frames and the node that it has f + 1 whole.
 void run_until_done(dynhet::RunRecorder &rec, bool lose_a_frame = false) {
   ASSERT_TRUE(rec.on_run(run_info()));
   EXPECT_FALSE(rec.on_run(run_info())); // the repeats change nothing
-  EXPECT_TRUE(rec.on_sim_status(sim(1.0, "production", 100)));
+  EXPECT_TRUE(rec.on_sim_status(sim(1.0, "production", 99.9, 0)));
   EXPECT_TRUE(rec.on_node_status(node(1.1, "running", 0)));
   for (int f = 0; f < 3; ++f) {
     send_frame(rec, f, lose_a_frame && f == 1);
     for (double a : {0.6, 1.8}) EXPECT_TRUE(rec.on_overlap(overlap(a, false, f)));
+    EXPECT_TRUE(rec.on_sim_status(sim(1.2 + f, "production", 100.1 + 0.5 * f, f + 1)));
+    EXPECT_TRUE(rec.on_node_status(node(1.2 + 0.1 * f, "running", f + 1)));
   }
-  EXPECT_TRUE(rec.on_sim_status(sim(1.2, "production", 100.5))); // held: < 1 s after the last
-  EXPECT_TRUE(rec.on_sim_status(sim(2.5, "production", 101)));
-  EXPECT_TRUE(rec.on_sim_status(sim(2.6, "done", 101)));
+  EXPECT_TRUE(rec.on_sim_status(sim(3.5, "production", 101.3))); // frame 2 again: dropped
+  EXPECT_TRUE(rec.on_sim_status(sim(3.6, "done", 101.5)));       // the last word: replaces frame 2's
   EXPECT_TRUE(rec.completion().sim_ended());
 }
 
@@ -152,37 +155,61 @@ TEST(RunRecorder, IgnoresOtherRuns) {
 
 TEST(RunRecorder, CompleteRunIsWrittenAndMarkedComplete) {
   const std::string path = temp_file("complete");
-  dynhet::RunRecorder rec(path, "test");
+  dynhet::RunRecorder rec(path, "test", "Tess Ter", "tess@example.org");
   run_until_done(rec);
   EXPECT_FALSE(rec.completion().settled()); // no final results yet
-  for (double a : {0.6, 1.8}) rec.on_overlap(overlap(a, true, 2));
+  for (double a : {0.6, 1.8}) {
+    auto final = overlap(a, true, 2); // the same frame as the last running result
+    final.tau_alpha = 0.75;
+    rec.on_overlap(final);
+  }
   EXPECT_FALSE(rec.completion().settled()); // the node has not said done
   EXPECT_TRUE(rec.on_node_status(node(2.7, "done", 3)));
   EXPECT_TRUE(rec.completion().settled());
   EXPECT_TRUE(rec.finish().empty());
 
   h5read::File f(path);
+  EXPECT_EQ(Attr(f, "/h5md/author", "name").strings().at(0), "Tess Ter");
+  EXPECT_EQ(Attr(f, "/h5md/author", "email").strings().at(0), "tess@example.org");
   EXPECT_EQ(Attr(f, "/", "complete").values<int32_t>(), std::vector<int32_t>{1});
   EXPECT_EQ(Attr(f, "/", "missing").strings().at(0), "");
   EXPECT_EQ(Attr(f, "/", "run_id").values<int64_t>(), std::vector<int64_t>{kRun});
   EXPECT_EQ(Attr(f, "/", "frames_lost_overlap").values<int32_t>(), std::vector<int32_t>{0});
   EXPECT_EQ(Attr(f, "/observables/nodes/overlap", "state").strings().at(0), "done");
 
-  // One record a second plus every change of phase: 100, 101 (2.5 s), done.
-  EXPECT_EQ(h5read::read<double>(f, "/observables/sim/kinetic_energy/time"),
-            (std::vector<double>{100, 101, 101}));
+  // Every series on the frame clock: step f, time frame_time[f] = 100, 100.5, 101.
+  const std::vector<int64_t> steps{0, 1, 2};
+  const std::vector<double> frame_times{100, 100.5, 101};
+  // Sim: the first status after each frame; its "done" replaces frame 2's. sim_time is its own.
+  EXPECT_EQ(h5read::read<int64_t>(f, "/observables/sim/kinetic_energy/step"), steps);
+  EXPECT_EQ(h5read::read<double>(f, "/observables/sim/kinetic_energy/time"), frame_times);
+  EXPECT_EQ(h5read::read<double>(f, "/observables/sim/sim_time/value"),
+            (std::vector<double>{100.1, 100.6, 101.5}));
   EXPECT_EQ(h5read::read<int64_t>(f, "/observables/sim/n_collisions/value"),
-            (std::vector<int64_t>{100000, 101000, 101000}));
-  // Node: running at 1.1 s and done at 2.7 s, in seconds since its first status.
-  const auto t = h5read::read<double>(f, "/observables/nodes/overlap/frames_whole/time");
-  ASSERT_EQ(t.size(), 2u);
-  EXPECT_EQ(t[0], 0.0);
-  EXPECT_NEAR(t[1], 1.6, 1e-12);
+            (std::vector<int64_t>{100100, 100600, 101500}));
+  EXPECT_EQ(h5read::read<int32_t>(f, "/observables/sim/frames_published/value"),
+            (std::vector<int32_t>{1, 2, 3}));
+  // Node: step = frames handled - 1, time that frame's; done (2.7 s) replaces frame 2's;
+  // the wall clock in its own element, seconds since the first node status (1.1 s).
+  EXPECT_EQ(h5read::read<int64_t>(f, "/observables/nodes/overlap/frames_whole/step"), steps);
+  EXPECT_EQ(h5read::read<double>(f, "/observables/nodes/overlap/frames_whole/time"), frame_times);
+  EXPECT_EQ(h5read::read<int32_t>(f, "/observables/nodes/overlap/frames_whole/value"),
+            (std::vector<int32_t>{1, 2, 3}));
+  const auto wall = h5read::read<double>(f, "/observables/nodes/overlap/wall_time/value");
+  ASSERT_EQ(wall.size(), 3u);
+  EXPECT_NEAR(wall[0], 0.1, 1e-5);
+  EXPECT_NEAR(wall[1], 0.2, 1e-5);
+  EXPECT_NEAR(wall[2], 1.6, 1e-5);
 
+  // Results: the final result (frame 2, like the last running one) replaces that record.
   const std::string q = "/observables/overlap/a1.8/q";
-  EXPECT_EQ(h5read::shape(f, q + "/value"), (Shape{4, 2})); // 3 running + the final
-  EXPECT_EQ(h5read::read<int64_t>(f, q + "/step"), (std::vector<int64_t>{0, 1, 2, 2}));
-  EXPECT_EQ(h5read::shape(f, "/observables/overlap/a0.6/tau_alpha/value"), Shape{4});
+  EXPECT_EQ(h5read::shape(f, q + "/value"), (Shape{3, 2}));
+  EXPECT_EQ(h5read::read<int64_t>(f, q + "/step"), steps);
+  EXPECT_EQ(h5read::read<double>(f, q + "/time"), frame_times);
+  const auto tau = h5read::read<double>(f, "/observables/overlap/a0.6/tau_alpha/value");
+  ASSERT_EQ(tau.size(), 3u);
+  EXPECT_EQ(tau[2], 0.75);
+  EXPECT_EQ(h5read::shape(f, "/observables/schedule/pair_frame"), (Shape{1, 2})); // [origin][lag]
   EXPECT_EQ(h5read::read<double>(f, "/observables/overlap/a0.6/lag_time"), (std::vector<double>{0.5, 1}));
   EXPECT_EQ(Attr(f, "/observables/overlap/a0.6", "subbox_per_side").values<int32_t>(),
             std::vector<int32_t>{1});
@@ -190,6 +217,9 @@ TEST(RunRecorder, CompleteRunIsWrittenAndMarkedComplete) {
             (std::vector<double>{100, 100.5, 101}));
 
   EXPECT_EQ(h5read::shape(f, "/particles/all/position/value"), (Shape{3, 4, 2}));
+  EXPECT_EQ(h5read::read<int64_t>(f, "/particles/all/position/step"), steps);
+  EXPECT_TRUE(h5read::same_object(f, "/particles/all/position/step", "/particles/all/image/step"));
+  EXPECT_TRUE(h5read::same_object(f, "/particles/all/position/time", "/particles/all/image/time"));
   const auto pos = h5read::read<double>(f, "/particles/all/position/value");
   EXPECT_EQ(pos[8 + 5], 3.25); // frame 1, particle 2, y: 1 + 2 + 0.25
   EXPECT_EQ(h5read::read<int32_t>(f, "/particles/all/species"), (std::vector<int32_t>{0, 0, 1, 1}));
@@ -277,7 +307,8 @@ TEST(RunRecorder, S4IsRecordedPerCutoff) {
     EXPECT_EQ(Attr(f, g, "cutoff_a").values<double>(), std::vector<double>{a});
     EXPECT_EQ(h5read::read<double>(f, g + "/lag_time"), (std::vector<double>{0.5, 1}));
     EXPECT_EQ(h5read::read<int32_t>(f, g + "/subbox_per_side"), (std::vector<int32_t>{2, 1}));
-    EXPECT_EQ(h5read::shape(f, g + "/s4_lag/value"), (Shape{2, 8}));
+    EXPECT_EQ(h5read::shape(f, g + "/s4_lag/value"), (Shape{2, 2, 4})); // [record][lag][value]
+    EXPECT_EQ(h5read::shape(f, g + "/xi_lag/value"), (Shape{2, 2, 2})); // [record][lag][grid]
     EXPECT_EQ(h5read::shape(f, g + "/oz_xi/value"), (Shape{2, 2}));
     EXPECT_EQ(h5read::read<double>(f, g + "/xi/value"), (std::vector<double>{a, a}));
     EXPECT_EQ(h5read::read<int64_t>(f, g + "/chi0/step"), (std::vector<int64_t>{1, 2}));
@@ -285,20 +316,90 @@ TEST(RunRecorder, S4IsRecordedPerCutoff) {
   std::remove(path.c_str());
 }
 
+// chi4 [record][grid][lag] and P(dx) [record][set][target][bin] keep their
+// dimensions (the messages' flat arrays in C order); a result whose sizes
+// do not fit its dimensions, or whose frame is not one of the run's, is
+// rejected and counted, not written.
+TEST(RunRecorder, MultiDimensionalResultsKeepTheirShape) {
+  const std::string path = temp_file("shapes");
+  dynhet::RunRecorder rec(path, "test");
+  auto info = run_info();
+  info.observables = {"overlap"};
+  info.keep_frames = false;
+  ASSERT_TRUE(rec.on_run(info));
+
+  auto c = result<dynhet::chi4_t>(0.6, false, 1);
+  c.n_grids = 2, c.subbox_particles = {1, 4}, c.subbox_per_side = {2, 1};
+  c.n_lags = 3, c.lag_time = {0.5, 1, 1.5};
+  c.n_values = 6;
+  for (int i = 0; i < 6; ++i) c.chi4.push_back(i), c.chi4_err.push_back(10 + i); // [g * 3 + j] = 3 g + j
+  c.chi4_peak = c.tau4 = c.chi4_peak_err = c.tau4_err = {1, 2};
+  EXPECT_TRUE(rec.on_chi4(c));
+  auto wrong = c;
+  wrong.n_lags = 2, wrong.lag_time = {0.5, 1}; // 6 values are not 2 x 2
+  EXPECT_FALSE(rec.on_chi4(wrong));
+  auto late = c;
+  late.frame_index = 3; // the run has frames 0 .. 2
+  EXPECT_FALSE(rec.on_chi4(late));
+  EXPECT_EQ(rec.messages_rejected(), 2);
+
+  auto d = result<dynhet::displacement_t>(0.6, false, 2);
+  d.n_bins = 3, d.x = {-1, 0, 1}, d.bin_width = 1;
+  d.n_targets = 2, d.target_time = {0.5, 1}, d.target_tau_alpha = {NAN, NAN}, d.lag_index = {0, 1};
+  d.lag_time = {0.5, 1};
+  d.n_sets = 2, d.n_series = 4;
+  d.n_pairs = {1, 2, 3, 4}, d.samples = {1, 2, 3, 4};
+  for (auto *v : {&d.fraction_outside, &d.gauss_d, &d.gauss_d_err, &d.tail_x0, &d.tail_x0_err,
+                  &d.tail_amplitude, &d.tail_x_min, &d.tail_x_max})
+    *v = {0, 1, 10, 11}; // [s * 2 + l] = 10 s + l
+  d.gauss_bins = d.tail_bins = {0, 1, 10, 11};
+  d.n_values = 12;
+  for (int i = 0; i < 12; ++i) d.p.push_back(i), d.p_err.push_back(i), d.count.push_back(i);
+  EXPECT_TRUE(rec.on_displacement(d));
+  rec.finish("test over");
+
+  h5read::File f(path);
+  const std::string g = "/observables/chi4/a0.6";
+  EXPECT_EQ(h5read::shape(f, g + "/chi4/value"), (Shape{1, 2, 3}));
+  EXPECT_EQ(h5read::shape(f, g + "/chi4_err/value"), (Shape{1, 2, 3}));
+  EXPECT_EQ(h5read::read<double>(f, g + "/chi4/value"), (std::vector<double>{0, 1, 2, 3, 4, 5}));
+  EXPECT_EQ(h5read::shape(f, g + "/chi4_peak/value"), (Shape{1, 2}));
+  EXPECT_EQ(h5read::read<int64_t>(f, g + "/chi4/step"), std::vector<int64_t>{1});
+  EXPECT_EQ(h5read::read<double>(f, g + "/chi4/time"), std::vector<double>{100.5});
+  const std::string p = "/observables/displacement";
+  EXPECT_EQ(h5read::shape(f, p + "/p/value"), (Shape{1, 2, 2, 3}));
+  EXPECT_EQ(h5read::shape(f, p + "/count/value"), (Shape{1, 2, 2, 3}));
+  EXPECT_EQ(h5read::shape(f, p + "/gauss_d/value"), (Shape{1, 2, 2}));
+  EXPECT_EQ(h5read::read<double>(f, p + "/gauss_d/value"), (std::vector<double>{0, 1, 10, 11}));
+  EXPECT_EQ(h5read::shape(f, p + "/lag_time/value"), (Shape{1, 2}));
+  EXPECT_EQ(h5read::shape(f, p + "/tau_alpha/value"), Shape{1});
+  EXPECT_EQ(Attr(f, "/", "messages_rejected_recorder").values<int64_t>(), std::vector<int64_t>{2});
+  EXPECT_NE(Attr(f, "/", "last_rejection_recorder").strings().at(0).find("frame_index 3"), std::string::npos);
+  std::remove(path.c_str());
+}
+
+// The sim fails before its first frame: the nodes' final results carry
+// frame_index -1 (no frame yet); they count as final, make no record, and
+// are not rejected.
 TEST(RunRecorder, FailedSimSettlesButIsIncomplete) {
   const std::string path = temp_file("failed");
   dynhet::RunRecorder rec(path, "test");
   ASSERT_TRUE(rec.on_run(run_info()));
-  auto s = sim(1.0, "failed", 100);
+  auto s = sim(1.0, "failed", 100, 0);
   s.message = "boom";
   rec.on_sim_status(s);
-  for (double a : {0.6, 1.8}) rec.on_overlap(overlap(a, true, 0));
+  for (double a : {0.6, 1.8}) EXPECT_TRUE(rec.on_overlap(overlap(a, true, -1)));
   rec.on_node_status(node(1.5, "failed", 0));
   EXPECT_TRUE(rec.completion().settled());
+  EXPECT_EQ(rec.messages_rejected(), 0);
   const auto missing = rec.finish();
   ASSERT_FALSE(missing.empty());
   EXPECT_EQ(missing[0], "sim: failed (boom)");
   EXPECT_EQ(missing[1], "overlap node: failed");
+  h5read::File f(path);
+  EXPECT_FALSE(h5read::exists(f, "/observables/overlap/a0.6/q"));
+  EXPECT_FALSE(h5read::exists(f, "/observables/sim"));
+  EXPECT_TRUE(h5read::exists(f, "/observables/overlap/a0.6/lag_time"));
   std::remove(path.c_str());
 }
 

@@ -3,16 +3,22 @@
 //
 //   /h5md                      attr version = int32[2] {1, 1}
 //   /h5md/creator              attrs name, version
-//   /h5md/author               attr name
+//   /h5md/author               attrs name (and email, if given)
 //   /parameters/scene_toml     the whole scene text (string)
 //   /parameters/<table>        one attribute per TOML key, native types
 //   /particles/<g>/box         attrs dimension = 2, boundary = [periodic, periodic];
 //                              dataset edges = [L, L]
 //   /particles/<g>/species     int32[N]
 //   /particles/<g>/position    {step, time, value (frames, N, 2) folded into [0, L)}
-//   /particles/<g>/image       {step, time, value (frames, N, 2) int32}
+//   /particles/<g>/image       {step, time: hard links to position's; value (frames, N, 2) int32}
 //                              so that unwrapped = position + image * L
-//   /observables/<path>        {step, time, value (records,) or (records, n)}
+//   /observables/<path>        {step, time, value (records, record shape...)}
+//
+// H5MD's rules, kept by the writer for every file: every string (attribute
+// or dataset) is a fixed-length string; in every time series step strictly
+// increases (a record whose step is not above the last is dropped, or
+// replaces the last record of the same step when asked to); a record keeps
+// the shape it is given ({} one number, {n}, {a, b}, ...).
 //
 // Every append is flushed (unless auto flush is turned off), and the
 // metadata cache never writes between flushes, so a writer killed with
@@ -30,12 +36,28 @@
 
 namespace dynhet {
 
+// The author when none is given: $DYNHET_AUTHOR, else $USER, else "unknown".
+std::string default_author();
+
 class H5mdWriter {
 public:
+  // Where a record sits in its time series: step (strictly increasing along
+  // the series) and time. A record whose step is not above the series' last
+  // step is dropped, unless `replace` is set and the step equals the last:
+  // then it overwrites the last record.
+  struct Stamp {
+    int64_t step;
+    double time;
+    bool replace = false;
+  };
+  enum class Recorded { appended, replaced, dropped };
+  // A record's dimensions: {} one number, {n}, {a, b}, ... (C order).
+  using Shape = std::vector<size_t>;
+
   // Creates (or truncates) `path` and writes the h5md group. An empty
-  // author means $USER, or "dynhet user".
+  // author means default_author(); an empty email writes none.
   H5mdWriter(const std::string &path, const std::string &creator_name, const std::string &creator_version,
-             const std::string &author = "");
+             const std::string &author = "", const std::string &author_email = "");
   ~H5mdWriter(); // closes, swallowing errors; call close() to see them
   H5mdWriter(H5mdWriter &&) noexcept;
   H5mdWriter &operator=(H5mdWriter &&) noexcept;
@@ -55,23 +77,42 @@ public:
   void set_particles(const std::string &group, double box_length, const std::vector<int8_t> &species);
 
   // One frame of unwrapped positions x0 y0 x1 y1 ... (2N values), stored
-  // as position folded into the box plus the image count.
-  void append_frame(int64_t step, double time, const std::vector<double> &unwrapped_xy,
-                    const std::string &group = "all");
-
-  // One record of the time series observables/<path>. The record size n
-  // is fixed by the first append (n == 1: value has shape (records,)).
-  void append_observable(const std::string &path, int64_t step, double time, const double *v, size_t n);
-  void append_observable(const std::string &path, int64_t step, double time, const int32_t *v, size_t n);
-  void append_observable(const std::string &path, int64_t step, double time, const int64_t *v, size_t n);
-  template <class T>
-  void append_observable(const std::string &path, int64_t step, double time, const std::vector<T> &v) {
-    append_observable(path, step, time, v.data(), v.size());
+  // as position folded into the box plus the image count; image shares
+  // position's step and time.
+  Recorded append_frame(const Stamp &at, const std::vector<double> &unwrapped_xy,
+                        const std::string &group = "all");
+  Recorded append_frame(int64_t step, double time, const std::vector<double> &unwrapped_xy,
+                        const std::string &group = "all") {
+    return append_frame(Stamp{step, time}, unwrapped_xy, group);
   }
 
-  // A plain dataset observables/<path>, written once (e.g. lag times).
-  void write_fixed(const std::string &path, const std::vector<double> &values);
-  void write_fixed(const std::string &path, const std::vector<int32_t> &values);
+  // One record of the time series observables/<path>, of `shape` (fixed by
+  // the first append; its product is the number of values read from v).
+  Recorded append_observable(const std::string &path, const Stamp &at, const double *v, const Shape &shape);
+  Recorded append_observable(const std::string &path, const Stamp &at, const int32_t *v, const Shape &shape);
+  Recorded append_observable(const std::string &path, const Stamp &at, const int64_t *v, const Shape &shape);
+  // A one-dimensional record (shape {v.size()}) and a single number (shape {}).
+  template <class T>
+  Recorded append_observable(const std::string &path, const Stamp &at, const std::vector<T> &v) {
+    return append_observable(path, at, v.data(), Shape{v.size()});
+  }
+  template <class T> Recorded append_scalar(const std::string &path, const Stamp &at, const T &v) {
+    return append_observable(path, at, &v, Shape{});
+  }
+  // n values, one number per record when n == 1, else shape {n}; never replaces.
+  template <class T>
+  Recorded append_observable(const std::string &path, int64_t step, double time, const T *v, size_t n) {
+    return append_observable(path, Stamp{step, time}, v, n == 1 ? Shape{} : Shape{n});
+  }
+  template <class T>
+  Recorded append_observable(const std::string &path, int64_t step, double time, const std::vector<T> &v) {
+    return append_observable(path, step, time, v.data(), v.size());
+  }
+
+  // A plain dataset observables/<path>, written once (e.g. lag times), of
+  // `shape` (default: one-dimensional).
+  void write_fixed(const std::string &path, const std::vector<double> &values, const Shape &shape = {});
+  void write_fixed(const std::string &path, const std::vector<int32_t> &values, const Shape &shape = {});
 
   // An attribute on the object at `object` (relative to the root, "" is
   // the root); a missing group is created, an existing attribute replaced.
