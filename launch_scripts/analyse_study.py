@@ -271,11 +271,16 @@ def chi4_at_tau(r, a=A_MAIN, g=None, own=False):
 
 def xi_at_tau(r, a=A_MAIN, own=False):
     """The whole box's OZ xi of cutoff a at tau_alpha (of a = 0.6, or own);
-    NaN where it is below XI_MIN (S4 flat over the q range)."""
+    NaN where it is below XI_MIN (S4 flat over the q range) or longer than
+    the box."""
     c = cut(r, a)
     t = tau(r, a if own else A_MAIN)[0]
     g = whole_box_s4(c)
-    xs = np.where(c["xi_t"][:, g] >= XI_MIN, c["xi_t"][:, g], np.nan)
+    off = int(np.sum(c["s4_nshells"][:g]))
+    q = c["s4_q"][off:off + int(c["s4_nshells"][g])]
+    box = 2 * math.pi / q[q > 0].min()   # the box: no longer xi can be measured in it
+    xi = c["xi_t"][:, g]
+    xs = np.where((xi >= XI_MIN) & (xi <= box), xi, np.nan)
     v, ie = sf.interp_ln_t(c["s4_lag"], xs, t)
     rel = c["s4_oz_xi_err"][g] / c["s4_oz_xi"][g] if np.isfinite(c["s4_oz_xi"][g]) and c["s4_oz_xi"][g] > 0 else math.nan
     return v, math.hypot(abs(v) * rel if np.isfinite(rel) else math.nan, ie if np.isfinite(ie) else 0.0)
@@ -448,8 +453,10 @@ def fit_verdict(f, name, paper, transform=lambda v: v):
         return "not determined"
     if not f.determined:
         return "not determined (no divergence resolved)"
-    v = verdict(transform(f.p[name]), f.error(name), paper)
     r = f.chi2_dof()
+    if np.isfinite(r) and r > 100:
+        return f"not judged: χ²/dof {r:.2g}, the form does not describe the points"
+    v = verdict(transform(f.p[name]), f.error(name), paper)
     return v + (f"; χ²/dof {r:.2g}: the form misses the points" if np.isfinite(r) and r > 4 else "")
 
 
@@ -989,15 +996,17 @@ def cutoff_results(A):
     """The cutoff a. Each a is taken at its own tau_alpha(a) where the run's
     lags reach it (solid), and all at tau_alpha of a = 0.6 (dashed); the
     d_f' rows use each a's own tau_alpha."""
-    # per density, the point (this study's or an --also study's) whose lags reach furthest in tau_alpha
+    # the study (this one or an --also one) whose lags reach furthest in tau_alpha(0.6), all its densities
     cands = [p for p in A.series() + [q for q in A.extra.values() if q.pairs == "neighbours" and abs(q.eps - EPS_MAIN) < 1e-9]
              if len(p.runs[0]["cut"]) > 1]
     reach = lambda p: cut(p.runs[0])["lag"][-1] / max(cut(p.runs[0])["tau_alpha"], 1e-300)
-    best = {}
+    by_study = {}
     for p in cands:
-        if p.phi not in best or reach(p) > reach(best[p.phi]):
-            best[p.phi] = p
-    pts = [best[k] for k in sorted(best)]
+        by_study.setdefault(getattr(p, "study", None) or A.study_name, []).append(p)
+    pts = []
+    if by_study:
+        best = max(by_study.values(), key=lambda ps: min(reach(p) for p in ps))
+        pts = sorted(best, key=lambda p: p.phi)
     src = sorted({getattr(p, "study", None) or A.study_name for p in pts})
     if not pts:
         A.row("cutoff a: ξ(τ_α) against a, χ4(t) for several a, ξ(φ) and χ4 against ξ at a = 0.6, 1.4, 3.0",
@@ -1028,7 +1037,7 @@ def cutoff_results(A):
     ax[1].set_xlabel("t")
     ax[1].set_ylabel("χ4(t)")
     ax[1].legend(fontsize=7)
-    ax[1].set_title(f"Fig. chi4-diff-a (φ = {mid.phi:g}; lags to 4 τ_α(0.6))")
+    ax[1].set_title(f"Fig. chi4-diff-a (φ = {mid.phi:g}; lags to {reach(mid):.3g} τ_α(0.6))")
     outs = []
     for a, m in zip(A_THREE, ("o", "s", "^")):
         if a not in cuts:
@@ -1055,9 +1064,11 @@ def cutoff_results(A):
     ax[3].set_title("Fig. diff-a(b)")
     f = A.save(fig, "cutoff.png")
     short = [f"{a:g}" for a in cuts if reached.get(a, 0) < len(pts)]
+    lags = min(reach(p) for p in pts)
     A.row(f"ξ(τ_α) against a ({cuts[0]:g} to {cuts[-1]:g}) for all φ; χ4(t) for several a", "3.4, figs. xi-vs-a, chi4-diff-a",
-          "figure only", f"{len(cuts)} cutoffs, {len(pts)} densities, from {', '.join(src)} (lags to {min(reach(p) for p in pts):.3g} τ_α)" +
-          (f"; τ_α(a) beyond the lags (4 τ_α(0.6)) at some φ for a = {', '.join(short)}" if short else ""), "figure", f, pts)
+          "figure only", f"{len(cuts)} cutoffs, {len(pts)} densities (φ {pts[0].phi:g}-{pts[-1].phi:g}), study {', '.join(src)} (lags to {lags:.3g} τ_α(0.6))" +
+          (f"; ξ at τ_α(a) not determined at some φ for a = {', '.join(short)} (τ_α(a) beyond the lags, "
+           f"{lags:.3g} τ_α(0.6), or ξ < {XI_MIN:g})" if short else ""), "figure", f, pts)
     for a, fd in outs:
         A.row(f"χ4 ∝ ξ^d_f' at a = {a:g} (at τ_α(a))", "3.4, fig. diff-a(b)", "similar for all a (≈ 1.6)", fmt(fd.p["s"], fd.error("s")),
               fit_verdict(fd, "s", 1.6), f, pts, fd.note)
