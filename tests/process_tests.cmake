@@ -109,3 +109,10 @@ set_tests_properties(logplayer_gui PROPERTIES LABELS process TIMEOUT 180)
 add_test(NAME two_hosts_veth
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/two_hosts.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(two_hosts_veth PROPERTIES LABELS process TIMEOUT 180)
+
+# The recorder keeping every frame, stopped for 5 s mid-run
+# (tests/stopped_recorder.sh): the sim waits for it (its own status, node
+# "recorder"); complete, every frame in run.h5.
+add_test(NAME stopped_recorder_loses_nothing
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/stopped_recorder.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(stopped_recorder_loses_nothing PROPERTIES LABELS process TIMEOUT 120)

@@ -33,13 +33,15 @@ cutoff_a = [0.6]
 TOML
 bash "$root/launch_scripts/run_scene.sh" "$tmp/s.toml" --out "$tmp/out" --no-build --run-id 7001 >"$tmp/run.log" 2>&1 &
 rp=$!
-for _ in $(seq 300); do grep -qs "run 7001" "$tmp/out/overlap_node.log" && break; sleep 0.02; done
+# Stopped as production starts (the sim's progress line), not before, when
+# there is nothing to lose: the next 4 s would bring most of the run.
+for _ in $(seq 1200); do grep -qs "production" "$tmp/out/sim_node.log" && break; sleep 0.05; done
 pkill -STOP -f "overlap_node --run-id 7001"
 sleep 4
 pkill -CONT -f "overlap_node --run-id 7001"
 wait $rp && rc=0 || rc=$?
 check '[[ $rc == 0 ]]' "run_scene.sh exits 0 (got $rc)"
-check 'grep -q "waiting for slow nodes" "$tmp/out/sim_node.log"' "the sim waited for the stopped node"
+check 'grep -q "waiting for slow nodes.*: overlap at frame" "$tmp/out/sim_node.log"' "the sim waited for the stopped node"
 check 'grep -q "done: [0-9]* frames whole, 0 lost" "$tmp/out/overlap_node.log"' \
   "the stopped node lost no frame ($(grep -o "done: .*" "$tmp/out/overlap_node.log"))"
 check '/usr/bin/python3 -c "import h5py, sys; sys.exit(0 if int(h5py.File(sys.argv[1], \"r\").attrs[\"complete\"]) == 1 else 1)" "$tmp/out/run.h5"' \
