@@ -316,9 +316,9 @@ int prepare_only(const dynhet::Scene& scene, const std::string& path, bool equil
 // run_scene.sh asks for, dynhet::pacing_window_frames) and loses none.
 // When the scene keeps the frames, the recorder is paced on too (it
 // publishes its own status, node "recorder", after every kept frame). A
-// node that failed or finished is not waited for; one silent for
-// `give_up` seconds is dropped from the pacing with a warning (its losses
-// are then its own, and counted).
+// node that failed or finished is not waited for; one silent for kGiveUp
+// seconds (the recorder: kGiveUpRecorder) is dropped from the pacing with a
+// warning (its losses are then its own, and counted).
 class Pacer {
 public:
   Pacer(lcm::LCM& lcm, int64_t run_id, std::vector<std::string> nodes, long n_particles)
@@ -343,7 +343,7 @@ public:
         if (n.state == "failed" || n.state == "done") continue;
         if (n.whole >= f - window_ && n.seen) continue;
         const double silent = std::chrono::duration<double>(now - (n.seen ? n.last : start_)).count();
-        if (silent > kGiveUp) {
+        if (silent > (name == dynhet::kRecorderNode ? kGiveUpRecorder : kGiveUp)) {
           std::fprintf(stderr, "\nsim_node: node %s silent for %.0f s at frame %d: no longer waited for\n",
                        name.c_str(), silent, f);
           n.gone = true;
@@ -366,7 +366,11 @@ public:
 
 private:
   using Clock = std::chrono::steady_clock;
-  static constexpr double kGiveUp = 300.0;
+  // A node's compute thread, which publishes its status, can be busy for
+  // minutes on one frame at large N (S4 over many pairs); the recorder's
+  // loop publishes every second, so a recorder silent for 30 s is stopped
+  // or dead (killed: the sim then goes on without it after 30 s, not 300).
+  static constexpr double kGiveUp = 300.0, kGiveUpRecorder = 30.0;
   struct Node {
     int whole = -1;
     std::string state;

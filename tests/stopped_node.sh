@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Flow control: a node stopped (SIGSTOP) for 4 s in a run whose frames
+# Flow control: a node stopped (SIGSTOP) for seconds in a run whose frames
 # (N = 20000, 320 KB each) would overflow its socket buffer many times over
 # in that time loses nothing: the sim holds its frames until the node
 # catches up (sim_node --pace-nodes, which run_scene.sh sets), and the run
@@ -33,11 +33,14 @@ cutoff_a = [0.6]
 TOML
 bash "$root/launch_scripts/run_scene.sh" "$tmp/s.toml" --out "$tmp/out" --no-build --run-id 7001 >"$tmp/run.log" 2>&1 &
 rp=$!
-# Stopped as production starts (the sim's progress line), not before, when
-# there is nothing to lose: the next 4 s would bring most of the run.
-for _ in $(seq 1200); do grep -qs "production" "$tmp/out/sim_node.log" && break; sleep 0.05; done
+# Stopped as soon as it has the run info, and held until 3 s into
+# production (the sim's progress line): whatever the machine's speed, the
+# sim reaches its frames while the node is stopped (unpaced, the 108 frames
+# would go out in about a second and overflow its socket buffer).
+for _ in $(seq 300); do grep -qs "run 7001" "$tmp/out/overlap_node.log" && break; sleep 0.02; done
 pkill -STOP -f "overlap_node --run-id 7001"
-sleep 4
+for _ in $(seq 1200); do grep -qs "production" "$tmp/out/sim_node.log" && break; sleep 0.05; done
+sleep 3
 pkill -CONT -f "overlap_node --run-id 7001"
 wait $rp && rc=0 || rc=$?
 check '[[ $rc == 0 ]]' "run_scene.sh exits 0 (got $rc)"

@@ -1,20 +1,24 @@
 #!/usr/bin/env bash
 # Flow control for the kept frames: a recorder that keeps every frame
-# (observables.keep_frames) and is stopped (SIGSTOP) for 5 s mid-run at
-# N = 20000 (320 KB frames: 5 s of them overflow its socket buffer many
-# times over) loses nothing: it publishes its own status (node "recorder")
-# after every kept frame, the sim holds its frames until it catches up,
-# and the run ends complete with every frame in run.h5. In a private
-# network namespace, through run_scene.sh.
+# (observables.keep_frames) and is stopped (SIGSTOP) for 5 s in the middle
+# of production at N = 20000 (320 KB frames: 5 s of them overflow its
+# socket buffer many times over) loses nothing: it publishes its own status
+# (node "recorder") after every kept frame, the sim (--pace-nodes, as
+# run_scene.sh starts it) holds its frames until it catches up, and the run
+# ends complete with every frame in run.h5. In a private network namespace.
+# The processes are started by hand, as run_scene.sh does, to slow the
+# overlap node to 0.05 s a frame (--test-frame-delay): the sim, paced on it,
+# then spends at least 5 s in production on any machine, and the stop comes
+# in the middle of it.
 set -euo pipefail
 root=$1 build=$2
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then exec "$root/launch_scripts/netns.sh" bash "$0" "$@"; fi
-export BUILD_DIR=$build
-export LCM_DEFAULT_URL='udpm://239.255.76.67:7723?ttl=0'
-py=/usr/bin/python3
+export LCM_DEFAULT_URL='udpm://239.255.76.67:7723?ttl=0&recv_buf_size=4194304'
+bin=$build/bin py=/usr/bin/python3
 tmp=$(mktemp -d)
-rec=""
-trap '[[ -n $rec ]] && kill -CONT "$rec" 2>/dev/null || true; [[ -n ${KEEP_TMP:-} ]] && echo "kept $tmp" || rm -rf "$tmp"' EXIT
+pids=() rec=""
+trap '[[ -n $rec ]] && kill -CONT "$rec" 2>/dev/null || true; for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  [[ -n ${KEEP_TMP:-} ]] && echo "kept $tmp" || rm -rf "$tmp"' EXIT
 fail=0
 check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
 cat >"$tmp/s.toml" <<TOML
@@ -36,24 +40,38 @@ compute = ["overlap"]
 cutoff_a = [0.6]
 keep_frames = true
 TOML
+start() { # log, then the command: waits for its ready line
+  local log=$1; shift
+  "$@" 2>"$log" &
+  pids+=($!)
+  for _ in $(seq 100); do grep -qs ready "$log" && return 0; sleep 0.1; done
+  echo "FAIL no ready line in $log"; exit 1
+}
 t0=$SECONDS
-bash "$root/launch_scripts/run_scene.sh" "$tmp/s.toml" --out "$tmp/out" --no-build --run-id 8301 >"$tmp/run.log" 2>&1 &
-rp=$!
-# The recorder this run started (its own output file names it), stopped
-# as production starts (the sim's progress line): the next 5 s would bring
-# most of the run.
-for _ in $(seq 200); do rec=$(pgrep -f "recorder --out $tmp/out/run.h5" || true); [[ -n $rec ]] && break; sleep 0.05; done
-for _ in $(seq 1200); do grep -qs "production" "$tmp/out/sim_node.log" && break; sleep 0.05; done
-check '[[ -n $rec ]]' "found the run's recorder (pid ${rec:-none})"
+start "$tmp/recorder.log" "$bin/recorder" --out "$tmp/run.h5" --run-id 8301
+rec=${pids[-1]}
+start "$tmp/overlap_node.log" "$bin/overlap_node" --run-id 8301 --test-frame-delay 0.05
+"$bin/sim_node" "$tmp/s.toml" --run-id 8301 --pace-nodes 2>"$tmp/sim_node.log" &
+sim=$!
+pids+=($sim)
+# Stopped once production is under way (the sim's progress line, within a
+# second of its start; production lasts at least 108 x 0.05 s).
+for _ in $(seq 1200); do grep -qs "production" "$tmp/sim_node.log" && break; sleep 0.05; done
 kill -STOP "$rec"
+frames_at_stop=$(grep -o "frames [0-9]*/" "$tmp/sim_node.log" | tail -1)
 sleep 5
+frames_after=$(grep -o "frames [0-9]*/" "$tmp/sim_node.log" | tail -1)
 kill -CONT "$rec"
-wait $rp && rc=0 || rc=$?
-echo "   $((SECONDS - t0)) s"
-check '[[ $rc == 0 ]]' "run_scene.sh exits 0 (got $rc)"
-check 'grep -q "waiting for slow nodes.*: recorder at frame" "$tmp/out/sim_node.log"' \
-  "the sim waited for the stopped recorder ($(grep -o "waiting for slow nodes.*recorder.*" "$tmp/out/sim_node.log" | head -1))"
-check '$py - "$tmp/out/run.h5" <<PY
+wait "$sim" && rc=0 || rc=$?
+check '[[ $rc == 0 ]]' "the sim ran to the end (exit $rc)"
+wait "$rec" && rc=0 || rc=$?
+check '[[ $rc == 0 ]]' "the recorder says complete (exit $rc)"
+for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
+pids=() rec=""
+echo "   $((SECONDS - t0)) s; the sim's last progress line before the stop: ${frames_at_stop:-none}, after 5 s: ${frames_after:-none}"
+check 'grep -q "waiting for slow nodes.*: recorder at frame [0-9]*$" "$tmp/sim_node.log"' \
+  "the sim waited for the stopped recorder, behind ($(grep -o "waiting for slow nodes.*recorder.*" "$tmp/sim_node.log" | head -1))"
+check '$py - "$tmp/run.h5" <<PY
 import h5py, numpy as np, sys
 f = h5py.File(sys.argv[1], "r")
 frames = len(f["observables/schedule/frame_time"])
@@ -64,5 +82,5 @@ ok = (int(f.attrs["complete"]) == 1 and int(f.attrs["frames_lost_recorder"]) == 
       and np.array_equal(step, np.arange(frames)) and "recorder" not in f["observables/nodes"])
 sys.exit(0 if ok else 1)
 PY' "complete, 0 frames lost by the recorder, every frame in run.h5 (and no node named recorder)"
-((fail == 0)) || tail -20 "$tmp/run.log"
+((fail == 0)) || tail -5 "$tmp"/*.log
 exit $fail
