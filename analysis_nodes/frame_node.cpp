@@ -1,10 +1,13 @@
 #include "frame_node.hpp"
 
+#include "dynhet/flow_control.hpp"
 #include "dynhet/lcm_guard.hpp"
 #include "dynhet/message_checks.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cstdio>
+#include <thread>
 
 #include <CLI/CLI.hpp>
 
@@ -34,17 +37,55 @@ void FrameNode::check_sim_alive(double timeout) {
   finish(1, "the sim has been silent for " + std::to_string(static_cast<int>(silent)) + " s");
 }
 
-void FrameNode::loop_gap(double seconds) {
-  if (seconds > longest_gap_) longest_gap_ = seconds;
+// What this node observed of why it lost frames, and only that: its queue
+// dropped chunks (counted by the Inbox), the kernel dropped datagrams at its
+// socket (counted in /proc/net/udp), its receive loop stalled for seconds
+// (the process was stopped or starved of CPU).
+std::string FrameNode::loss_cause() const {
+  if (!inbox_) return "unknown (no inbox)";
+  const Inbox::Stats s = inbox_->stats();
+  const auto secs = [](double t) {
+    char b[32];
+    std::snprintf(b, sizeof b, t < 10 ? "%.1f" : "%.0f", t);
+    return std::string(b);
+  };
+  std::vector<std::string> causes;
+  if (s.dropped > 0)
+    causes.push_back("queue full: the node fell more than " + std::to_string(s.bound >> 20) + " MiB behind (" +
+                     std::to_string(s.dropped) + " messages dropped; its longest message took " +
+                     secs(longest_handler_) + " s to handle)");
+  const int64_t drops = udp_socket_drops();
+  const bool stalled = s.longest_receive_gap > 2.0;
+  if (drops > 0)
+    causes.push_back("socket buffer overflow: the kernel dropped " + std::to_string(drops) +
+                     " datagrams at this node's socket" +
+                     (stalled ? ", while the process took nothing for " + secs(s.longest_receive_gap) +
+                                    " s at a stretch (stopped, or starved of CPU)"
+                              : std::string(" (datagrams came faster than this process read them)")));
+  else if (stalled)
+    causes.push_back("stopped: the process took nothing for " + secs(s.longest_receive_gap) +
+                     " s at a stretch (stopped, or starved of CPU)" +
+                     (drops < 0 ? " (the kernel's drop count at its socket could not be read)" : ""));
+  if (!causes.empty()) {
+    std::string out;
+    for (const std::string& c : causes) out += (out.empty() ? "" : "; ") + c;
+    return out;
+  }
+  if (drops < 0) return "not known: this node's queue dropped nothing, and the kernel's drop count at its socket "
+                        "could not be read";
+  return "not at this node: its queue dropped nothing and the kernel dropped no datagram at its socket (the frames "
+         "never reached it: missing from its input, or lost on the way)";
 }
 
-std::string FrameNode::loss_cause() const {
-  if (longest_gap_ > 2.0)
-    return "this node took no frames for " + std::to_string(static_cast<int>(longest_gap_)) +
-           " s at a stretch (stopped, starved of CPU, or busy with one frame) while frames kept coming, and its "
-           "socket buffer overflowed";
-  return "its socket buffer overflowed (frames came faster than this node took them; run_scene.sh's flow control "
-         "prevents that, a bare sim_node without --pace-nodes does not)";
+// A full queue is said at once, not only at the end.
+void FrameNode::watch_inbox() {
+  if (!inbox_) return;
+  const Inbox::Stats s = inbox_->stats();
+  if (s.dropped == inbox_dropped_seen_) return;
+  if (inbox_dropped_seen_ == 0)
+    std::fprintf(stderr, "%s_node: queue full: the node fell more than %lld MiB behind; messages dropped (frames "
+                 "will be lost)\n", name_.c_str(), static_cast<long long>(s.bound >> 20));
+  inbox_dropped_seen_ = s.dropped;
 }
 
 void FrameNode::input_ended() {
@@ -85,6 +126,15 @@ void FrameNode::on_sim_status_raw(const lcm::ReceiveBuffer* rb, const std::strin
   guarded<sim_status_t>(*this, rb, ch, [&](const sim_status_t& m) { on_sim_status(m); });
 }
 
+void FrameNode::handle(const Inbox::Message& m) {
+  lcm::ReceiveBuffer rb{const_cast<uint8_t*>(m.data.data()), static_cast<uint32_t>(m.data.size()), m.recv_utime};
+  const auto t0 = Clock::now();
+  if (m.channel == kChanFrame) on_chunk_raw(&rb, m.channel);
+  else if (m.channel == kChanRun) on_run_raw(&rb, m.channel);
+  else if (m.channel == kChanSimStatus) on_sim_status_raw(&rb, m.channel);
+  longest_handler_ = std::max(longest_handler_, std::chrono::duration<double>(Clock::now() - t0).count());
+}
+
 void FrameNode::on_run(const run_info_t& mm) {
   const run_info_t* m = &mm;
   if (info_ || (run_filter_ && m->run_id != run_filter_)) return;
@@ -95,8 +145,10 @@ void FrameNode::on_run(const run_info_t& mm) {
   status_.run_id = m->run_id;
   status_.frames_expected = m->n_frames;
   status_.state = "running";
-  std::fprintf(stderr, "%s_node: run %lld, N=%d, %d frames, %d origins x %d lags\n", name_.c_str(),
-               static_cast<long long>(m->run_id), m->n_particles, m->n_frames, m->n_origins, m->n_lags);
+  if (inbox_) inbox_->set_bound(queue_bound_bytes(m->n_particles, m->chunk_particles, inbox_->stats().hard_cap));
+  std::fprintf(stderr, "%s_node: run %lld, N=%d, %d frames, %d origins x %d lags, queue of frames up to %lld MiB\n",
+               name_.c_str(), static_cast<long long>(m->run_id), m->n_particles, m->n_frames, m->n_origins,
+               m->n_lags, inbox_ ? static_cast<long long>(inbox_->stats().bound >> 20) : 0LL);
   try {
     start(*info_); // the node may keep references into it: the copy lives as long as the node
   } catch (const std::exception& e) {
@@ -166,6 +218,7 @@ void FrameNode::maybe_done() {
 }
 
 void FrameNode::on_frame(const Frame& f) {
+  if (frame_delay_ > 0) std::this_thread::sleep_for(std::chrono::duration<double>(frame_delay_));
   const int k0 = origin_at_[f.index];
   last_frame_ = f.index;
   last_time_ = f.time;
@@ -207,6 +260,7 @@ void FrameNode::publish_status() {
 }
 
 void FrameNode::tick() {
+  watch_inbox();
   if (info_) maybe_done();
   if (finished_) return;
   if (std::chrono::duration<double>(Clock::now() - last_status_).count() >= 1.0) publish_status();
@@ -216,15 +270,78 @@ void FrameNode::finish(int code, const std::string& why) {
   if (info_) assembler_.finish(info_->n_frames);
   if (info_ && started_) publish_results(true);
   status_.state = code == 0 ? "done" : "failed";
-  status_.message = why;
+  // Frames lost in a run that ended: the cause this node knows, in its
+  // last status (run.h5 keeps it) and its log.
+  const std::string cause = code == 0 && assembler_.frames_lost() > 0 ? loss_cause() : "";
+  status_.message = cause.empty() ? why : std::to_string(assembler_.frames_lost()) + " frames lost: " + cause;
   publish_status();
   std::fprintf(stderr, "%s_node: %s: %d frames whole, %d lost%s%s\n", name_.c_str(), status_.state.c_str(),
                assembler_.frames_whole(), assembler_.frames_lost(), why.empty() ? "" : "; ", why.c_str());
-  if (code == 0 && assembler_.frames_lost() > 0)
-    std::fprintf(stderr, "%s_node: frames lost: %s\n", name_.c_str(), loss_cause().c_str());
+  if (!cause.empty()) std::fprintf(stderr, "%s_node: frames lost: %s\n", name_.c_str(), cause.c_str());
+  if (inbox_) {
+    const Inbox::Stats s = inbox_->stats();
+    std::fprintf(stderr, "%s_node: queue (receive thread -> computation): peak %.2f MiB of %lld MiB, %lld messages "
+                 "dropped; the longest message took %.3f s\n", name_.c_str(), double(s.peak_bytes) / (1 << 20),
+                 static_cast<long long>(s.bound >> 20), static_cast<long long>(s.dropped), longest_handler_);
+  }
   finished_ = true;
   exit_code_ = code;
 }
+
+namespace {
+
+// The receive thread: LCM's handle loop on the input bus, copying each
+// message into the inbox and nothing else (no decoding, no checks: the
+// compute thread does those), so that the socket is drained however long a
+// frame takes to compute. It only calls handle(); the compute thread
+// publishes (LCM 1.3.1's lcm.h: "All LCM functions are internally
+// synchronized and thread-safe", and lcm_publish and lcm_handle may run in
+// different threads). A replayed log waits for room in the inbox instead
+// of dropping.
+class Receiver {
+public:
+  Receiver(lcm::LCM& in, Inbox& inbox, bool replay) : in_(in), inbox_(inbox), replay_(replay) {
+    in_.subscribe(kChanRun, &Receiver::on_message, this);
+    // LCM's own queue between its socket thread and handle(): deep, though
+    // this thread empties it at once.
+    in_.subscribe(kChanFrame, &Receiver::on_message, this)->setQueueCapacity(100000);
+    in_.subscribe(kChanSimStatus, &Receiver::on_message, this);
+    thread_ = std::thread([this] { loop(); });
+  }
+  ~Receiver() {
+    stop_ = true;
+    inbox_.stop(); // wakes a push() waiting for room
+    thread_.join();
+  }
+
+private:
+  void loop() {
+    auto last = FrameNode::Clock::now();
+    while (!stop_) {
+      const int r = in_.handleTimeout(100);
+      const auto now = FrameNode::Clock::now();
+      inbox_.receive_turn(std::chrono::duration<double>(now - last).count());
+      last = now;
+      if (r < 0) { // a replayed log has ended (or the bus failed)
+        inbox_.close();
+        return;
+      }
+    }
+  }
+  void on_message(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+    const auto* p = static_cast<const uint8_t*>(rb->data);
+    inbox_.push(Inbox::Message{ch, std::vector<uint8_t>(p, p + rb->data_size), rb->recv_utime}, ch == kChanFrame,
+                replay_);
+  }
+
+  lcm::LCM& in_;
+  Inbox& inbox_;
+  bool replay_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+} // namespace
 
 int node_main(const std::string& program, const std::string& description, NodeFactory make_node, int argc,
               char** argv) {
@@ -237,6 +354,15 @@ int node_main(const std::string& program, const std::string& description, NodeFa
   app.add_option("--run-id", run_id, "only this run (default: the first one seen)");
   app.add_option("--wait-run", wait_run, "give up after this many seconds without run info");
   app.add_option("--sim-timeout", sim_timeout, "give up if the sim is silent this long (s) during a run");
+  int64_t max_queue_mib = 1024;
+  app.add_option("--max-queue-mib", max_queue_mib,
+                 "at most this many MiB of messages wait between the receive thread and the computation (frames "
+                 "also within a few times the sim's pacing window); beyond, they are dropped and counted")
+      ->check(CLI::Range(int64_t{1}, int64_t{1} << 20))
+      ->capture_default_str();
+  double frame_delay = 0;
+  app.add_option("--test-frame-delay", frame_delay,
+                 "tests only: sleep this many seconds on every frame, a stand-in for heavy computation");
   CLI11_PARSE(app, argc, argv);
 
   const std::string in_url = resolve_lcm_url(url);
@@ -251,20 +377,18 @@ int node_main(const std::string& program, const std::string& description, NodeFa
   }
 
   std::unique_ptr<FrameNode> node = make_node(out, run_id);
-  in.subscribe(kChanRun, &FrameNode::on_run_raw, node.get());
-  in.subscribe(kChanFrame, &FrameNode::on_chunk_raw, node.get())->setQueueCapacity(100000);
-  in.subscribe(kChanSimStatus, &FrameNode::on_sim_status_raw, node.get());
+  Inbox inbox(max_queue_mib << 20);
+  inbox.set_bound(kQueueMin); // until the run info sizes it (frames come only after it)
+  node->attach_inbox(&inbox);
+  node->set_frame_delay(frame_delay);
+  Receiver receiver(in, inbox, replay); // stopped and joined before inbox, node and buses go
 
   std::fprintf(stderr, "%s: ready, reading %s\n", program.c_str(), in_url.c_str());
   const auto start = FrameNode::Clock::now();
-  auto last_turn = FrameNode::Clock::now();
   while (!node->finished()) {
-    // A turn of this loop that took seconds: the process was stopped or
-    // starved (frames lost meanwhile are then explained by it).
-    const auto turn = FrameNode::Clock::now();
-    node->loop_gap(std::chrono::duration<double>(turn - last_turn).count());
-    last_turn = turn;
-    if (in.handleTimeout(200) < 0) { // a replayed log has ended
+    if (const std::optional<Inbox::Message> m = inbox.pop(std::chrono::milliseconds(200))) {
+      node->handle(*m);
+    } else if (inbox.ended()) { // a replayed log has ended, every message of it handled
       node->input_ended();
       break;
     }

@@ -4,7 +4,10 @@
 // and which (origin, lag) pairs it completes, holds each origin frame
 // (16 N bytes) only until the last pair the node uses has been seen,
 // watches the sim (done, failed, interrupted, silent, or a replayed log
-// that ends) and publishes the node status every second. A node derives
+// that ends) and publishes the node status after every frame and every
+// second. Two threads (node_main): a receive thread runs LCM's handle loop
+// and only copies each message into a bounded Inbox; the compute thread
+// (everything here) takes them out and handles them. A node derives
 // from FrameNode and says which lags it uses, what to do with an origin
 // frame and with a pair, and how to publish its results; node_main<Node>()
 // is its main().
@@ -31,6 +34,7 @@
 #include "dynhet/node_status_t.hpp"
 #include "dynhet/run_info_t.hpp"
 #include "dynhet/sim_status_t.hpp"
+#include "inbox.hpp"
 
 namespace dynhet {
 
@@ -50,9 +54,14 @@ public:
   void check_sim_alive(double timeout);
   // The input ended (log replayed to its end) before the sim said done.
   void input_ended();
-  // The wall time one turn of the receive loop took: a turn of seconds
-  // means the node was stopped or starved, the likely cause of lost frames.
-  void loop_gap(double seconds);
+  // The queue from the receive thread: its bound is set from the run's N,
+  // and what it dropped or saw (a stalled receive loop) names the cause of
+  // lost frames.
+  void attach_inbox(Inbox* inbox) { inbox_ = inbox; }
+  // Tests: sleep this long on every frame, a stand-in for heavy physics.
+  void set_frame_delay(double seconds) { frame_delay_ = seconds; }
+  // One message from the inbox, to its raw handler by channel.
+  void handle(const Inbox::Message& m);
   void tick(); // node status once a second
 
   // The handlers take raw buffers: each message is checked (encoding,
@@ -104,7 +113,11 @@ private:
   void on_frame(const Frame& f);
   void maybe_done();
   std::string loss_cause() const;
-  double longest_gap_ = 0;
+  void watch_inbox();
+  Inbox* inbox_ = nullptr;
+  int64_t inbox_dropped_seen_ = 0;
+  double longest_handler_ = 0; // s: the longest one message (a frame's physics) took here
+  double frame_delay_ = 0;
   static constexpr double kDoneGrace = 10.0; // s of silence after "done" before frames count as lost
   void publish_status();
   void finish(int code, const std::string& why);
@@ -126,8 +139,9 @@ private:
 };
 
 // A node's main(): flags (--lcm-url, --publish-url, --run-id, --wait-run,
-// --sim-timeout), the buses (file://LOG?speed=0 replays a log and then
-// publishes on --publish-url), subscriptions and the loop.
+// --sim-timeout, --max-queue-mib), the buses (file://LOG?speed=0 replays a
+// log and then publishes on --publish-url), the receive thread and the
+// compute loop.
 // make_node(out, run_id) builds the node.
 using NodeFactory = std::unique_ptr<FrameNode> (*)(lcm::LCM& out, int64_t run_id);
 int node_main(const std::string& program, const std::string& description, NodeFactory make_node, int argc,

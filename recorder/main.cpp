@@ -4,6 +4,13 @@
 // when the sim has ended and every observable the run names has its final
 // result and its node has said done.
 //
+// When the scene keeps the frames (and they come from the bus), the
+// recorder publishes its own status on DYNHET_NODE_STATUS, node "recorder",
+// after every kept frame and every second, as the analysis nodes do: the
+// sim paces its frames on it (flow control), so that a recorder slowed by
+// its writes, or stopped, loses none. Its own status is not a node's: it
+// ignores it when it reads the nodes' status.
+//
 // `recorder --list-nodes LOG` prints the analysis nodes the run in an
 // lcm-logger log needs (for replays) and exits.
 //
@@ -11,8 +18,10 @@
 // --timeout, no run info within --wait-run); 2 interrupted (SIGINT or
 // SIGTERM; the file is closed cleanly); 3 could not start (bus, log or
 // output file).
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <climits>
 #include <csignal>
 #include <cstdio>
 #include <memory>
@@ -21,6 +30,7 @@
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
 
+#include "dynhet/flow_control.hpp"
 #include "dynhet/lcm_url.hpp"
 #include "dynhet/scene.hpp"
 #include "dynhet/lcm_guard.hpp"
@@ -57,8 +67,9 @@ private:
   std::unique_ptr<lcm::LogFile> log_;
   lcm::Subscription *frames_ = nullptr;
   bool log_done_ = false;
-  Clock::time_point start_, last_sim_, last_progress_;
+  Clock::time_point start_, last_sim_, last_progress_, last_own_status_;
   std::string fatal_, early_failure_;
+  dynhet::node_status_t own_{}; // the recorder's own status (kept frames only)
 
   void subscribe();
   bool read_log(int max_events);
@@ -69,12 +80,20 @@ private:
   void take_run(const dynhet::run_info_t &m);
   void take_sim(const dynhet::sim_status_t &m);
   void take_node(const dynhet::node_status_t &m) {
+    if (m.node == dynhet::kRecorderNode) return; // the recorder's own (or one posing as it): no analysis node
     if (rec_.on_node_status(m)) last_progress_ = Clock::now();
   }
   template <class Msg, bool (dynhet::RunRecorder::*On)(const Msg &)> void take_result(const Msg &m) {
     if ((rec_.*On)(m)) last_progress_ = Clock::now();
   }
-  void take_frame(const dynhet::frame_chunk_t &m) { rec_.on_frame_chunk(m); }
+  void take_frame(const dynhet::frame_chunk_t &m) {
+    const int before = rec_.frames_whole() + rec_.frames_lost();
+    rec_.on_frame_chunk(m);
+    if (rec_.frames_whole() + rec_.frames_lost() != before) publish_own_status("running"); // the sim paces on it
+  }
+  // Only for kept frames from the bus: the sim paces on them.
+  bool paced() const { return rec_.keep_frames() && !log_; }
+  void publish_own_status(const std::string &state, const std::string &message = "");
   // Every message is untrusted: decoded with every check (lcm_guard.hpp),
   // a bad one dropped and counted, and no handler's exception escapes.
   template <class Msg, void (Session::*Take)(const Msg &)>
@@ -221,6 +240,7 @@ int Session::step() {
     lcm_.unsubscribe(frames_);
     frames_ = nullptr;
   }
+  if (paced() && since(last_own_status_) >= 1.0) publish_own_status("running");
   if (rec_.completion().settled()) return finish("");
   const int t = static_cast<int>(opt_.timeout);
   if (sim_ended() && since(last_progress_) > opt_.timeout)
@@ -230,8 +250,26 @@ int Session::step() {
   return -1;
 }
 
+void Session::publish_own_status(const std::string &state, const std::string &message) {
+  if (!paced()) return;
+  own_.utime = dynhet::utime_now();
+  own_.run_id = rec_.run_id();
+  own_.node = dynhet::kRecorderNode;
+  own_.state = state;
+  own_.frames_expected = rec_.n_frames();
+  own_.frames_whole = rec_.frames_whole();
+  own_.frames_lost = rec_.frames_lost();
+  own_.chunks_received = rec_.chunks_received();
+  own_.messages_rejected = static_cast<int32_t>(std::min<int64_t>(rec_.messages_rejected(), INT32_MAX));
+  own_.message = message;
+  lcm_.publish(dynhet::kChanNodeStatus, &own_);
+  last_own_status_ = Clock::now();
+}
+
 int Session::finish(const std::string &reason) {
+  const bool paced_run = paced();
   const std::vector<std::string> missing = rec_.finish(reason);
+  if (paced_run) publish_own_status(missing.empty() ? "done" : "failed", missing.empty() ? "" : missing.front());
   const long long id = rec_.run_id();
   if (missing.empty()) {
     std::fprintf(stderr, "recorder: run %lld complete -> %s\n", id, opt_.out.c_str());

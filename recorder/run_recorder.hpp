@@ -88,8 +88,12 @@ public:
   bool has_run() const { return info_ != nullptr; }
   int64_t run_id() const { return info_ ? info_->run_id : 0; }
   bool keep_frames() const { return info_ && info_->keep_frames; }
+  int n_frames() const { return info_ ? info_->n_frames : 0; }
   const Completion &completion() const { return completion_; }
+  // The kept frames so far (keep_frames): reassembled and written, given up.
   int frames_whole() const { return assembler_.frames_whole(); }
+  int frames_lost() const { return assembler_.frames_lost(); }
+  int64_t chunks_received() const { return assembler_.chunks_received(); }
 
   // Writes the summary attributes (complete, missing, frames lost per
   // node), closes the file, and returns what is missing, with `reason`

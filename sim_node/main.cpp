@@ -23,6 +23,7 @@
 #include "checkpoint.hpp"
 #include "dynhet/chunking.hpp"
 #include "dynhet/engine/engine.hpp"
+#include "dynhet/flow_control.hpp"
 #include "dynhet/frame_chunk_t.hpp"
 #include "dynhet/lcm_guard.hpp"
 #include "dynhet/node_status_t.hpp"
@@ -312,15 +313,18 @@ int prepare_only(const dynhet::Scene& scene, const std::string& path, bool equil
 // on has reassembled frame f - window (from their node status, which they
 // publish after every frame), so that a slow or stopped node finds at most
 // `window` frames waiting in its socket buffer (half of the 4 MiB
-// run_scene.sh asks for) and loses none. A node that failed or finished
-// is not waited for; one silent for `give_up` seconds is dropped from the
-// pacing with a warning (its losses are then its own, and counted).
+// run_scene.sh asks for, dynhet::pacing_window_frames) and loses none.
+// When the scene keeps the frames, the recorder is paced on too (it
+// publishes its own status, node "recorder", after every kept frame). A
+// node that failed or finished is not waited for; one silent for kGiveUp
+// seconds (the recorder: kGiveUpRecorder) is dropped from the pacing with a
+// warning (its losses are then its own, and counted).
 class Pacer {
 public:
   Pacer(lcm::LCM& lcm, int64_t run_id, std::vector<std::string> nodes, long n_particles)
       : lcm_(lcm), run_id_(run_id) {
     for (auto& n : nodes) nodes_[n] = Node{};
-    window_ = std::max<long>(1, (2L << 20) / (16 * n_particles + 64));
+    window_ = dynhet::pacing_window_frames(n_particles);
     if (!nodes_.empty()) sub_ = lcm_.subscribe(dynhet::kChanNodeStatus, &Pacer::on_status, this);
   }
   ~Pacer() {
@@ -339,17 +343,22 @@ public:
         if (n.state == "failed" || n.state == "done") continue;
         if (n.whole >= f - window_ && n.seen) continue;
         const double silent = std::chrono::duration<double>(now - (n.seen ? n.last : start_)).count();
-        if (silent > kGiveUp) {
+        if (silent > (name == dynhet::kRecorderNode ? kGiveUpRecorder : kGiveUp)) {
           std::fprintf(stderr, "\nsim_node: node %s silent for %.0f s at frame %d: no longer waited for\n",
                        name.c_str(), silent, f);
           n.gone = true;
           continue;
         }
         wait = true;
+        // Said once per node: when it is behind, or silent for longer than
+        // its status interval (1 s) allows (stopped, or not started).
+        if (!n.waited_for && (n.seen || silent > 2.0)) {
+          std::fprintf(stderr, "\nsim_node: waiting for slow nodes (flow control, window %ld frames): %s at frame %d%s\n",
+                       window_, name.c_str(), f, n.seen ? "" : " (no status from it yet)");
+          n.waited_for = true;
+        }
       }
       if (!wait) return;
-      if (!waited_) std::fprintf(stderr, "\nsim_node: waiting for slow nodes (flow control, window %ld frames)\n", window_);
-      waited_ = true;
       idle();
       lcm_.handleTimeout(20);
     }
@@ -357,11 +366,15 @@ public:
 
 private:
   using Clock = std::chrono::steady_clock;
-  static constexpr double kGiveUp = 300.0;
+  // A node's compute thread, which publishes its status, can be busy for
+  // minutes on one frame at large N (S4 over many pairs); the recorder's
+  // loop publishes every second, so a recorder silent for 30 s is stopped
+  // or dead (killed: the sim then goes on without it after 30 s, not 300).
+  static constexpr double kGiveUp = 300.0, kGiveUpRecorder = 30.0;
   struct Node {
     int whole = -1;
     std::string state;
-    bool seen = false, gone = false;
+    bool seen = false, gone = false, waited_for = false;
     Clock::time_point last;
   };
   void on_status(const lcm::ReceiveBuffer* rb, const std::string&) {
@@ -383,7 +396,6 @@ private:
   long window_ = 1;
   lcm::Subscription* sub_ = nullptr;
   Clock::time_point start_ = Clock::now();
-  bool waited_ = false;
 };
 
 } // namespace
@@ -414,8 +426,9 @@ int main(int argc, char** argv) {
   app.add_option("--run-id", run_id, "run id (default: random)");
   bool pace = false;
   app.add_flag("--pace-nodes", pace,
-               "flow control: hold each frame until the scene's nodes (their status on DYNHET_NODE_STATUS) have "
-               "caught up to within a socket buffer's worth of frames (run_scene.sh sets it)");
+               "flow control: hold each frame until the scene's nodes, and the recorder when the scene keeps the "
+               "frames (their status on DYNHET_NODE_STATUS), have caught up to within a socket buffer's worth of "
+               "frames (run_scene.sh sets it)");
   bool check = false;
   app.add_flag("--check", check, "validate the scene, print what it needs (nodes, frames) and exit");
   CLI11_PARSE(app, argc, argv);
@@ -615,8 +628,10 @@ int main(int argc, char** argv) {
     chunk.n_particles = static_cast<int32_t>(eng.size());
     chunk.chunk_count = static_cast<int32_t>(ranges.size());
     std::vector<std::string> paced;
-    if (pace)
+    if (pace) {
       for (const auto& n : dynhet::nodes_for(scene.observables)) paced.push_back(n.substr(0, n.size() - 5));
+      if (scene.keep_frames) paced.push_back(dynhet::kRecorderNode); // it writes every frame
+    }
     Pacer pacer(lcm, run_id, paced, eng.size());
     for (int f = next_frame; f < info.n_frames; ++f) {
       advance(sched.frame_time[f]);

@@ -109,3 +109,25 @@ set_tests_properties(logplayer_gui PROPERTIES LABELS process TIMEOUT 180)
 add_test(NAME two_hosts_veth
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/two_hosts.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(two_hosts_veth PROPERTIES LABELS process TIMEOUT 180)
+
+# Flow control inside a node (tests/slow_node.sh): the s4 node slowed to
+# 0.15 s a frame, its receive thread queuing what the computation has not
+# reached and the sim pacing on it: complete, 0 frames lost, equal to an
+# unslowed run bit for bit.
+add_test(NAME slow_node_loses_nothing
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/slow_node.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(slow_node_loses_nothing PROPERTIES LABELS process TIMEOUT 120)
+
+# Without flow control frames are lost, and each node names the cause it
+# saw (tests/loss_named.sh): a full queue, or its socket's overflow while
+# it was stopped.
+add_test(NAME lost_frames_name_their_cause
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/loss_named.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(lost_frames_name_their_cause PROPERTIES LABELS process TIMEOUT 120)
+
+# The recorder keeping every frame, stopped for 5 s mid-run
+# (tests/stopped_recorder.sh): the sim waits for it (its own status, node
+# "recorder"); complete, every frame in run.h5.
+add_test(NAME stopped_recorder_loses_nothing
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/stopped_recorder.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(stopped_recorder_loses_nothing PROPERTIES LABELS process TIMEOUT 120)
