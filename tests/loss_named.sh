@@ -14,12 +14,7 @@ set -euo pipefail
 root=$1 build=$2
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then exec "$root/launch_scripts/netns.sh" bash "$0" "$@"; fi
 export LCM_DEFAULT_URL='udpm://239.255.76.67:7722?ttl=0&recv_buf_size=4194304'
-bin=$build/bin
-tmp=$(mktemp -d)
-pids=()
-trap 'for p in "${pids[@]}"; do kill -CONT "$p" 2>/dev/null || true; kill "$p" 2>/dev/null || true; done; [[ -n ${KEEP_TMP:-} ]] && echo "kept $tmp" || rm -rf "$tmp"' EXIT
-fail=0
-check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
+. "$root/tests/processes.sh"
 cat >"$tmp/s.toml" <<TOML
 [system]
 n_particles = 20000
@@ -40,13 +35,6 @@ cutoff_a = [0.6]
 [s4]
 lags = [0.5]
 TOML
-start() { # log, then the command: waits for its ready line
-  local log=$1; shift
-  "$@" 2>"$log" &
-  pids+=($!)
-  for _ in $(seq 100); do grep -qs ready "$log" && return 0; sleep 0.1; done
-  echo "FAIL no ready line in $log"; exit 1
-}
 id=8201
 t0=$SECONDS
 # (--sim-timeout: the sim may end while the node is stopped, its "done"

@@ -14,13 +14,7 @@ set -euo pipefail
 root=$1 build=$2
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then exec "$root/launch_scripts/netns.sh" bash "$0" "$@"; fi
 export LCM_DEFAULT_URL='udpm://239.255.76.67:7723?ttl=0&recv_buf_size=4194304'
-bin=$build/bin py=/usr/bin/python3
-tmp=$(mktemp -d)
-pids=() rec=""
-trap '[[ -n $rec ]] && kill -CONT "$rec" 2>/dev/null || true; for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
-  [[ -n ${KEEP_TMP:-} ]] && echo "kept $tmp" || rm -rf "$tmp"' EXIT
-fail=0
-check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
+. "$root/tests/processes.sh"
 cat >"$tmp/s.toml" <<TOML
 [system]
 n_particles = 20000
@@ -40,13 +34,6 @@ compute = ["overlap"]
 cutoff_a = [0.6]
 keep_frames = true
 TOML
-start() { # log, then the command: waits for its ready line
-  local log=$1; shift
-  "$@" 2>"$log" &
-  pids+=($!)
-  for _ in $(seq 100); do grep -qs ready "$log" && return 0; sleep 0.1; done
-  echo "FAIL no ready line in $log"; exit 1
-}
 t0=$SECONDS
 start "$tmp/recorder.log" "$bin/recorder" --out "$tmp/run.h5" --run-id 8301
 rec=${pids[-1]}
