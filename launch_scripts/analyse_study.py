@@ -1161,12 +1161,11 @@ def appendix_results(A):
         oz.append(p.mean(lambda r: (cut(r)["s4_oz_chi0"][gw], cut(r)["s4_oz_chi0_err"][gw])))
         a2.append(p.mean(lambda r: (cut(r)["s4_a2_chi0"][gw], cut(r)["s4_a2_chi0_err"][gw])))
         row = []
+        per_run = [(s4_at_tau(r, A_MAIN, gw), chi4_at_tau(r)[0]) for r in p.runs]  # once, for every q_m
         for qm in qms:
             vals = []
-            for r in p.runs:
-                q, s = s4_at_tau(r, A_MAIN, gw)
+            for (q, s), ref in per_run:
                 ch0, _ = oz_fit(q, s, qm)
-                ref = chi4_at_tau(r)[0]
                 vals.append(ch0 / ref if np.isfinite(ch0) and ref > 0 else math.nan)
             row.append(np.nanmean(vals) if np.any(np.isfinite(vals)) else math.nan)
         rat.append(row)
