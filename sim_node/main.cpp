@@ -633,13 +633,22 @@ int main(int argc, char** argv) {
       if (scene.keep_frames) paced.push_back(dynhet::kRecorderNode); // it writes every frame
     }
     Pacer pacer(lcm, run_id, paced, eng.size());
+    // Where the production's wall time goes (the last lines of the log;
+    // bench/bench_bus.py reads them): simulating, waiting for paced nodes,
+    // publishing frames.
+    const auto t_production = Clock::now();
+    const double sim_t_production = eng.time();
+    double wait_seconds = 0, publish_seconds = 0, bytes_published = 0;
     for (int f = next_frame; f < info.n_frames; ++f) {
       advance(sched.frame_time[f]);
+      const auto t_wait = Clock::now();
       pacer.before_frame(f, [&] {
         if (seconds_since(last_info) > 2.0) publish_info();
         rep.update(eng, t_end - eng.time());
         if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
       });
+      wait_seconds += seconds_since(t_wait);
+      const auto t_publish = Clock::now();
       eng.unwrapped_positions(xy);
 #ifndef NDEBUG
       // Debug builds: a full overlap scan at every frame.
@@ -661,9 +670,12 @@ int main(int argc, char** argv) {
         // Pace multi-chunk frames so receivers' socket buffers keep up.
         if (ranges.size() > 1) std::this_thread::sleep_for(std::chrono::microseconds(300));
       }
+      publish_seconds += seconds_since(t_publish);
+      bytes_published += 16.0 * static_cast<double>(eng.size());
       rep.msg().frames_published = next_frame = f + 1;
     }
     advance(t_end);
+    const double production_seconds = seconds_since(t_production);
     if (!checkpoint_path.empty()) {
       eng.synchronize();
       checkpoint();
@@ -692,6 +704,11 @@ int main(int argc, char** argv) {
                  rep.msg().collision_frequency_err,
                  rep.blocks() < 2 ? " (no error: the production was shorter than two fine blocks)" : "",
                  static_cast<long long>(eng.counters().tc));
+    std::fprintf(stderr,
+                 "sim_node: production wall time %.2f s for %.6g time units: %.2f s waiting for paced nodes, "
+                 "%.2f s publishing %.1f MB of frames (%.1f MB/s while publishing, copies and pauses between chunks included)\n",
+                 production_seconds, t_end - sim_t_production, wait_seconds, publish_seconds, bytes_published / 1e6,
+                 publish_seconds > 0 ? bytes_published / 1e6 / publish_seconds : 0.0);
   } catch (const std::exception& e) {
     if (g_signal && checkpoint_written) rep.msg().phase = "interrupted"; // nodes wait for --resume
     fail(e.what());
