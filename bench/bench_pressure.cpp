@@ -1,8 +1,11 @@
 // The reduced pressure Z of elastic monodisperse hard disks against N, as
-// sim_node computes it (engine.hpp reduced_pressure: T = K/(N-1), blocks of
-// simulation time, common/include/dynhet/stats.hpp RatioBlocks), and as it
-// was computed before (T = K/N): a table per packing fraction. Each N runs
-// for the same particle-time (N x T fixed), so the errors are comparable.
+// sim_node computes it (engine.hpp reduced_pressure: the canonical Z at T =
+// K/(N-1), blocks of simulation time, common/include/dynhet/stats.hpp
+// RatioBlocks), the mechanical P A / (N T) of the fixed-momentum system
+// (1/N lower), and as it was computed in session 7 and before (T = K/N): a
+// table per packing fraction. Each N runs for the same particle-time (N x T
+// fixed), so the errors are comparable. bench/pressure_reference.py
+// compares sim_node's Z with published high-precision data.
 //
 //   bench_pressure --phi 0.5 --phi 0.67 --n 100 --n 400 --n 900 --n 6400 --particle-time 6.4e6
 #include <cmath>
@@ -25,7 +28,8 @@ int main(int argc, char** argv) {
   app.add_option("--particle-time", particle_time, "N x measuring time per run");
   app.add_option("--seed", seed);
   CLI11_PARSE(app, argc, argv);
-  std::printf("%6s %7s %10s %12s %10s %14s\n", "phi", "N", "time", "Z (K/(N-1))", "+-", "Z before (K/N)");
+  std::printf("%6s %7s %10s %12s %10s %16s %14s\n", "phi", "N", "time", "Z (sim_node)", "+-", "P A/(N T) (MD)",
+              "Z with K/N");
   for (double phi : phis)
     for (long n : ns) {
       dynhet::engine::Params p;
@@ -52,7 +56,7 @@ int main(int argc, char** argv) {
         c0 = c, t0 = e.time();
       }
       const double f = (n - 1.0) / n;
-      std::printf("%6.3f %7ld %10.1f %12.5f %10.5f %14.5f\n", phi, n, t_run, f * (1 + z.mean()),
-                  f * z.standard_error(), 1 + z.mean());
+      std::printf("%6.3f %7ld %10.1f %12.5f %10.5f %16.5f %14.5f\n", phi, n, t_run, 1 + f * z.mean(),
+                  f * z.standard_error(), f * (1 + z.mean()), 1 + z.mean());
     }
 }

@@ -105,7 +105,7 @@ public:
     const double ke = e.kinetic_energy_per_particle();
     const double dsim = e.time() - s_time_;
     if (dsim > 0 && msg_.phase != "compress") {
-      // Z = (N-1)/N (1 + sum virial / (2 N sum ke dt)) (engine.hpp): the
+      // Z = 1 + (N-1)/N sum virial / (2 N sum ke dt) (engine.hpp): the
       // blocks hold the virial and ke dt; the frequency 2 collisions / N and dt.
       pressure_.add((c.virial - s_virial_) / (2.0 * n), 0.5 * (ke + s_ke_) * dsim, dsim);
       frequency_.add(2.0 * (c.collisions - s_coll_) / double(n), dsim, dsim);
@@ -121,7 +121,7 @@ public:
     const double dpub = e.time() - last_sim_;
     msg_.collisions_per_second = dt > 0 && c.collisions >= last_coll_ ? (c.collisions - last_coll_) / dt : 0;
     const double f = (n - 1.0) / n;
-    msg_.reduced_pressure = f * (1.0 + pressure_.mean());
+    msg_.reduced_pressure = 1.0 + f * pressure_.mean();
     msg_.reduced_pressure_err = f * pressure_.standard_error();
     msg_.collision_frequency = frequency_.mean();
     msg_.collision_frequency_err = frequency_.standard_error();

@@ -111,17 +111,25 @@ struct Counters {
 };
 
 // Reduced pressure Z = P A / (N T) from the collision virial accumulated
-// over a time dt at kinetic energy per particle ke. The virial theorem
-// gives P A = K + virial / (2 dt) in 2D (K the total kinetic energy, in the
-// centre-of-mass frame, where every run is: collisions and kicks conserve
-// momentum, which starts at zero). Equipartition over the 2N - 2 degrees of
-// freedom that a fixed total momentum leaves gives T = K / (N - 1), not
-// K / N, so Z = (N - 1)/N * (1 + virial / (2 dt K)). With K / N instead Z
-// comes out high by a factor N/(N - 1): 0.1% at N = 1000, which published
-// molecular-dynamics equations of state for hard disks resolve.
+// over a time dt at kinetic energy per particle ke, as the canonical
+// ensemble at temperature T defines it, so that it compares with
+// equations of state at the same N (docs/analysis.md, "Which temperature").
+// Every run is in the centre-of-mass frame: collisions and kicks conserve
+// momentum, which starts at zero. Equipartition over the 2N - 2 degrees of
+// freedom that this leaves gives T = K / (N - 1) (K the total kinetic
+// energy), and a pair's relative velocity has exactly the variance 2T
+// (per unit mass) it has in the canonical ensemble, so the collision term
+// virial / (2 dt N T) is the canonical one (hard disks: the configurations
+// are sampled uniformly either way). The kinetic term is the canonical N T,
+// not the N - 1 free momenta's K: the frozen centre of mass would carry
+// the missing T. So Z = 1 + (N - 1)/N virial / (2 dt K).
+// With T = K / N, Z comes out high by about (Z - 1)/N (0.1% at N = 1000);
+// with the mechanical P A = K + virial / (2 dt) of this fixed-momentum
+// system over N T, low by exactly 1/N (-0.0045 at N = 224). Both are
+// resolved by high-precision data (bench/pressure_reference.py).
 inline double temperature(double ke_per_particle, long n) { return ke_per_particle * n / (n - 1.0); }
 inline double reduced_pressure(double virial, double dt, long n, double ke_per_particle) {
-  return (n - 1.0) / n * (1.0 + virial / (2.0 * n * ke_per_particle * dt));
+  return 1.0 + (n - 1.0) / n * virial / (2.0 * n * ke_per_particle * dt);
 }
 
 // Everything needed to continue a run exactly: written to checkpoints.
