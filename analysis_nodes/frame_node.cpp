@@ -187,7 +187,7 @@ void FrameNode::on_chunk(const frame_chunk_t& mm) {
     return reject(kChanFrame, "chunk of frame " + std::to_string(m->frame_index) +
                                   " is not one of this run's (N, frame, range) or has non-finite positions");
   }
-  last_sim_news_ = Clock::now();
+  last_sim_news_ = last_chunk_ = Clock::now();
   if (done_said_) done_said_ = Clock::now(); // frames still coming: wait on
   if (frame && frame->index < info_->n_frames) on_frame(*frame);
   maybe_done();
@@ -198,6 +198,16 @@ void FrameNode::on_sim_status(const sim_status_t& mm) {
   if (!info_ || m->run_id != info_->run_id || finished_) return;
   last_sim_news_ = Clock::now();
   sim_interrupted_ = m->phase == "interrupted"; // checkpointed: wait for --resume
+  // Chunks of a frame the sim has sent stopped coming: the rest are lost
+  // (the sim, pacing on this node, would otherwise wait for it).
+  if (m->frames_published > 0 && std::chrono::duration<double>(Clock::now() - last_chunk_).count() > kChunkGrace) {
+    const int published = std::min(m->frames_published, info_->n_frames);
+    if (const int n = assembler_.give_up_before(published); n > 0) {
+      std::fprintf(stderr, "%s_node: %d frame%s lost (the sim has published %d; no chunk for %.0f s)\n",
+                   name_.c_str(), n, n == 1 ? "" : "s", published, kChunkGrace);
+      publish_status();
+    }
+  }
   if (m->phase == "done") {
     // Anyone on the bus can say "done": it ends the node at once only when
     // every frame is here; else once the sim has been silent (no status, no

@@ -119,6 +119,9 @@ private:
   double longest_handler_ = 0; // s: the longest one message (a frame's physics) took here
   double frame_delay_ = 0;
   static constexpr double kDoneGrace = 10.0; // s of silence after "done" before frames count as lost
+  // s without a chunk after which a frame the sim says it has published,
+  // still incomplete here, is lost (FrameAssembler::give_up_before)
+  static constexpr double kChunkGrace = 2.0;
   void publish_status();
   void finish(int code, const std::string& why);
 
@@ -131,7 +134,7 @@ private:
   std::map<int, std::vector<double>> origins_;             // origin k -> positions at t0
   FrameAssembler assembler_;
   node_status_t status_{};
-  Clock::time_point last_status_ = Clock::now(), last_sim_news_ = Clock::now();
+  Clock::time_point last_status_ = Clock::now(), last_sim_news_ = Clock::now(), last_chunk_ = Clock::now();
   bool sim_interrupted_ = false, started_ = false, finished_ = false;
   std::optional<Clock::time_point> done_said_; // when a "done" of this run came, if one did
   int pairs_done_ = 0, last_frame_ = -1, exit_code_ = 0;

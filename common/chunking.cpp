@@ -72,6 +72,16 @@ std::optional<Frame> FrameAssembler::add(const ChunkHeader& h, const double* pos
   return f;
 }
 
+int FrameAssembler::give_up_before(int published) {
+  int n = 0;
+  for (auto it = pending_.begin(); it != pending_.end() && it->first < published; ++n) {
+    ++lost_;
+    mark_done(it->first);
+    it = pending_.erase(it);
+  }
+  return n;
+}
+
 void FrameAssembler::finish(int frames_expected) {
   pending_.clear();
   lost_ = std::max(0, frames_expected - whole_);

@@ -77,3 +77,25 @@ TEST(Chunking, DuplicatesAndMalformedChunksAreIgnored) {
   ASSERT_TRUE(f.has_value());
   EXPECT_EQ(f->position, xy);
 }
+
+// A paced sim sends no later frame while a node still lacks a chunk of the
+// last one out: once the sim says that frame is out, it is given up as
+// lost (only a frame of which something arrived, only below what the sim
+// has published), and the next frames assemble as before.
+TEST(Chunking, FrameTheSimHasPublishedIsGivenUpWithoutLaterChunks) {
+  FrameAssembler a;
+  a.expect(100, 4, 30);
+  ASSERT_TRUE(feed(a, 100, 30, 0).has_value());
+  EXPECT_FALSE(feed(a, 100, 30, 1, 2).has_value()); // chunk 2 of frame 1 lost
+  EXPECT_EQ(a.give_up_before(1), 0);               // the sim says only frame 0 is out
+  EXPECT_EQ(a.frames_lost(), 0);
+  EXPECT_EQ(a.give_up_before(4), 1);               // frame 1 is out: lost; 2 and 3 never started: untouched
+  EXPECT_EQ(a.frames_whole(), 1);
+  EXPECT_EQ(a.frames_lost(), 1);
+  EXPECT_FALSE(feed(a, 100, 30, 1).has_value()); // its late chunks are ignored
+  auto f2 = feed(a, 100, 30, 2);
+  ASSERT_TRUE(f2.has_value());
+  EXPECT_EQ(f2->position, make_frame(100, 2));
+  EXPECT_EQ(a.frames_whole(), 2);
+  EXPECT_EQ(a.frames_lost(), 1);
+}

@@ -55,6 +55,14 @@ public:
   // now is lost.
   void finish(int frames_expected);
 
+  // The publisher has sent every frame below `published` and no chunk has
+  // come for a while: frames below it that are still incomplete are lost
+  // now. (Otherwise a lost chunk of the last frame out waits for a chunk
+  // of a frame `reorder_window` + 1 later, which a paced sim does not send
+  // until this one is through.) Only frames of which a chunk arrived;
+  // returns how many were given up.
+  int give_up_before(int published);
+
   int frames_whole() const { return whole_; }
   int frames_lost() const { return lost_; }
   int64_t chunks_received() const { return chunks_; }
