@@ -146,9 +146,19 @@ void FrameNode::on_run(const run_info_t& mm) {
   status_.frames_expected = m->n_frames;
   status_.state = "running";
   if (inbox_) inbox_->set_bound(queue_bound_bytes(m->n_particles, m->chunk_particles, inbox_->stats().hard_cap));
-  std::fprintf(stderr, "%s_node: run %lld, N=%d, %d frames, %d origins x %d lags, queue of frames up to %lld MiB\n",
+  // A socket buffer that holds a whole frame: the node's threads may be off
+  // the CPU for as long as a frame takes to arrive (at N = 4 x 10^6 an 8
+  // MiB buffer overflowed by a datagram on the 2-core machine).
+  const int64_t want = frame_receive_buffer_bytes(m->n_particles, m->chunk_particles);
+  const int64_t got = grow_udp_receive_buffers(want);
+  std::fprintf(stderr, "%s_node: run %lld, N=%d, %d frames, %d origins x %d lags, queue of frames up to %lld MiB, "
+               "socket buffer %.1f MiB\n",
                name_.c_str(), static_cast<long long>(m->run_id), m->n_particles, m->n_frames, m->n_origins,
-               m->n_lags, inbox_ ? static_cast<long long>(inbox_->stats().bound >> 20) : 0LL);
+               m->n_lags, inbox_ ? static_cast<long long>(inbox_->stats().bound >> 20) : 0LL, got / 1048576.0);
+  if (got >= 0 && got / 2 < want)
+    std::fprintf(stderr, "%s_node: warning: the socket buffer holds less than a frame (%.1f MiB): frames may be "
+                 "lost if this node is off the CPU while one arrives; raise net.core.rmem_max or run as root\n",
+                 name_.c_str(), want / 1048576.0);
   try {
     start(*info_); // the node may keep references into it: the copy lives as long as the node
   } catch (const std::exception& e) {

@@ -43,4 +43,20 @@ inline int64_t queue_bound_bytes(int64_t n_particles, int64_t chunk_particles, i
 // datagram on the sockets' port, of any channel.
 int64_t udp_socket_drops();
 
+// Grows the receive buffer of each of this process's UDP sockets (LCM's
+// udpm socket: LCM asks for recv_buf_size, which the kernel caps at
+// net.core.rmem_max) to hold at least `bytes`, so that a receiver can hold
+// a whole frame while it is off the CPU: SO_RCVBUF, then SO_RCVBUFFORCE
+// (root, or CAP_NET_ADMIN) past rmem_max. Never shrinks one. Returns the
+// smallest buffer now in place (the kernel's figure, which counts its own
+// overhead: about twice what was asked), or -1 if there is no UDP socket.
+int64_t grow_udp_receive_buffers(int64_t bytes);
+
+// What a receiver of frames asks for: a whole frame and 1 MiB, at least
+// 4 MiB, at most 512 MiB.
+inline int64_t frame_receive_buffer_bytes(int64_t n_particles, int64_t chunk_particles) {
+  return std::clamp<int64_t>(frame_wire_bytes(n_particles, chunk_particles) + (int64_t{1} << 20),
+                             int64_t{4} << 20, int64_t{512} << 20);
+}
+
 } // namespace dynhet
