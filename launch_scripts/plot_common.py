@@ -27,7 +27,11 @@ def save(fig, f, png, dpi):
 
 
 def cli(main, doc):
-    """Runs main(RUN.h5, OUT.png) from the command line and exits with its status."""
+    """Runs main(RUN.h5, OUT.png) from the command line and exits with its
+    status; -h or --help prints the usage (the script's docstring)."""
+    if len(sys.argv) == 2 and sys.argv[1] in ("-h", "--help"):
+        print(doc)
+        sys.exit(0)
     if len(sys.argv) != 3:
         print(doc, file=sys.stderr)
         sys.exit(2)

@@ -11,16 +11,9 @@ import math
 import sys
 
 import h5py
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from plot_common import save  # noqa: E402
-
-
-def last(g, key):
-    return g[key]["value"][-1]
+from plot_common import cli, last, save
+import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
+import numpy as np
 
 
 def main(path, png):
@@ -72,7 +65,4 @@ def main(path, png):
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 3:
-        print(__doc__, file=sys.stderr)
-        sys.exit(2)
-    sys.exit(main(sys.argv[1], sys.argv[2]))
+    cli(main, __doc__)
