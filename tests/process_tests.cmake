@@ -140,3 +140,11 @@ set_tests_properties(stopped_recorder_loses_nothing PROPERTIES LABELS process TI
 add_test(NAME tcpq_runs_complete
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/tcpq_runs.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(tcpq_runs_complete PROPERTIES LABELS process TIMEOUT 180)
+
+# LCM's own player, unfiltered (tests/logplayer_full.sh): a tiny run's whole
+# log (old results included) played with lcm-logplayer into a listening
+# recorder, alone and with live nodes: complete, one series per result
+# (steps strictly increasing, those of the live run), equal to the live run.
+add_test(NAME logplayer_full_log
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/logplayer_full.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(logplayer_full_log PROPERTIES LABELS process TIMEOUT 120)
