@@ -44,11 +44,11 @@
 
 namespace dynhet {
 
-inline bool is_tcpq_url(const std::string& url) { return url.rfind("tcpq://", 0) == 0; }
+inline bool is_tcpq_url(const std::string &url) { return url.rfind("tcpq://", 0) == 0; }
 
 // LCM 1.3.1's tcpq provider says good() when it could not reach the hub,
 // and a later handle() on the missing socket aborts (FD_SET of -1).
-inline bool bus_unreachable(lcm::LCM& lcm, const std::string& url) {
+inline bool bus_unreachable(lcm::LCM &lcm, const std::string &url) {
   return !lcm.good() || (is_tcpq_url(url) && lcm.getFileno() < 0);
 }
 
@@ -78,12 +78,13 @@ inline std::string drain_until_closed(int fd, double timeout_s) {
 // Call after the last publish on `lcm`, once no other thread uses it; then
 // only destroy it. Returns "" when everything published was delivered to
 // the hub (or the bus needs no wait), else what went wrong.
-inline std::string deliver_before_exit(lcm::LCM& lcm, const std::string& url, double timeout_s = 30) {
+inline std::string deliver_before_exit(lcm::LCM &lcm, const std::string &url, double timeout_s = 30) {
   if (!is_tcpq_url(url)) return "";
   const int fd = lcm.getFileno();
   if (fd < 0) return "tcpq: not connected to the hub: what was published last may be lost";
-  const std::string why = ::shutdown(fd, SHUT_WR) == 0 ? detail::drain_until_closed(fd, timeout_s)
-                                                       : std::string("tcpq: shutdown: ") + std::strerror(errno);
+  const std::string why = ::shutdown(fd, SHUT_WR) == 0
+                              ? detail::drain_until_closed(fd, timeout_s)
+                              : std::string("tcpq: shutdown: ") + std::strerror(errno);
   // LCM's destroy unsubscribes every channel by sending on this socket, and
   // on an error reconnects to the hub to do it. Close the finished
   // connection and put one end of a local socket pair in its place (the
