@@ -1,6 +1,7 @@
 #include "frame_node.hpp"
 
 #include "dynhet/flow_control.hpp"
+#include "dynhet/lcm_exit.hpp"
 #include "dynhet/lcm_guard.hpp"
 #include "dynhet/message_checks.hpp"
 
@@ -328,7 +329,10 @@ public:
     in_.subscribe(kChanSimStatus, &Receiver::on_message, this);
     thread_ = std::thread([this] { loop(); });
   }
-  ~Receiver() {
+  ~Receiver() { stop(); }
+  // Stops the thread: the bus is then the caller's alone.
+  void stop() {
+    if (!thread_.joinable()) return;
     stop_ = true;
     inbox_.stop(); // wakes a push() waiting for room
     thread_.join();
@@ -391,7 +395,8 @@ int node_main(const std::string& program, const std::string& description, NodeFa
   std::unique_ptr<lcm::LCM> out_owned;
   if (!publish_url.empty() || replay) out_owned = std::make_unique<lcm::LCM>(resolve_lcm_url(publish_url));
   lcm::LCM& out = out_owned ? *out_owned : in;
-  if (!in.good() || !out.good()) {
+  const std::string out_url = out_owned ? resolve_lcm_url(publish_url) : in_url;
+  if (bus_unreachable(in, in_url) || bus_unreachable(out, out_url)) {
     std::fprintf(stderr, "%s: cannot open LCM (%s)\n", program.c_str(), in_url.c_str());
     return 3;
   }
@@ -405,7 +410,8 @@ int node_main(const std::string& program, const std::string& description, NodeFa
 
   std::fprintf(stderr, "%s: ready, reading %s\n", program.c_str(), in_url.c_str());
   const auto start = FrameNode::Clock::now();
-  while (!node->finished()) {
+  int code = -1;
+  while (code < 0 && !node->finished()) {
     if (const std::optional<Inbox::Message> m = inbox.pop(std::chrono::milliseconds(200))) {
       node->handle(*m);
     } else if (inbox.ended()) { // a replayed log has ended, every message of it handled
@@ -416,10 +422,16 @@ int node_main(const std::string& program, const std::string& description, NodeFa
     if (!replay) node->check_sim_alive(sim_timeout);
     if (!node->has_run() && std::chrono::duration<double>(FrameNode::Clock::now() - start).count() > wait_run) {
       std::fprintf(stderr, "%s: no run info on %s within %g s\n", program.c_str(), in_url.c_str(), wait_run);
-      return 4;
+      code = 4;
     }
   }
-  return node->exit_code();
+  if (code < 0) code = node->exit_code();
+  // The last results and status must reach the bus before the process ends
+  // (tcpq: see dynhet/lcm_exit.hpp; udpm: nothing to wait for).
+  receiver.stop();
+  if (const std::string why = deliver_before_exit(out, out_url); !why.empty())
+    std::fprintf(stderr, "%s: %s\n", program.c_str(), why.c_str());
+  return code;
 }
 
 } // namespace dynhet

@@ -11,7 +11,7 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 case "${1:-}" in
--h | --help) sed -n '2,10p' "$0"; exit 0 ;;
-"") sed -n '8,8p' "$0" >&2; exit 2 ;;
+-h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;;
+"") grep -m1 '^# Usage:' "$0" | sed 's/^# //' >&2; exit 2 ;;
 esac
 exec /usr/bin/python3 "$root/launch_scripts/analyse_study.py" "$@"

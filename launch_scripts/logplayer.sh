@@ -10,7 +10,7 @@
 #   LCM_URL    default $LCM_DEFAULT_URL or udpm://239.255.76.67:7667?ttl=0
 # A display is needed. Headless, use lcm-logplayer (README, "Replays").
 set -euo pipefail
-usage() { sed -n '2,12p' "$0" | sed 's/^# \{0,1\}//'; }
+usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; }
 log="" url="" opts=()
 for a in "$@"; do
   case "$a" in

@@ -8,7 +8,7 @@ import math
 import sys
 
 import h5py
-from plot_common import cli, save
+from plot_common import cli, legend_right, save, tidy_log
 import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
 import numpy as np
 
@@ -19,7 +19,8 @@ def main(path, png):
             print(f"plot_chi4: {path} has no chi4 results", file=sys.stderr)
             return 1
         groups = sorted(f["observables/chi4"].items())
-        fig, axes = plt.subplots(1, len(groups), figsize=(6.0 * len(groups), 4.4), squeeze=False)
+        fig, axes = plt.subplots(1, len(groups), figsize=(7.6 * len(groups), 4.8), squeeze=False,
+                                 layout="constrained")
         for ax, (name, g) in zip(axes[0], groups):
             t = g["lag_time"][()]
             sizes = g["subbox_particles"][()]
@@ -32,12 +33,18 @@ def main(path, png):
                     ax.plot([tau4[i]], [peak[i]], "*", ms=10, color=line[0].get_color())
             ax.set_xscale("log")
             ax.set_yscale("log")
+            # The data's range down to 1e-3 of the peak: a value near zero
+            # (chi4 of a few origins can nearly vanish) would squash the rest.
+            top = np.nanmax(chi) if np.isfinite(chi).any() else 1.0
+            low = chi[np.isfinite(chi) & (chi > 0)]
+            if low.size and top > 0:
+                ax.set_ylim(max(low.min(), top * 1e-3) / 1.5, top * 2)
             ax.set_xlabel("t")
             ax.set_ylabel(r"$\chi_4(t)$")
-            ax.set_title(f"a = {g.attrs.get('cutoff_a', name)} (star: peak at $\\tau_4$)", fontsize=10)
-            ax.legend(fontsize=7)
-        fig.tight_layout()
-        save(fig, f, png, 120)
+            ax.set_title(f"a = {g.attrs.get('cutoff_a', name)} (star: peak at $\\tau_4$)")
+            tidy_log(ax)
+            legend_right(ax, title="sub-boxes of")
+        save(fig, f, png, 110)
     print(f"plot_chi4: wrote {png}", file=sys.stderr)
     return 0
 

@@ -11,7 +11,7 @@ import math
 import sys
 
 import h5py
-from plot_common import cli, last, save
+from plot_common import cli, last, legend_below, save, tidy_log
 import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
 import numpy as np
 
@@ -28,8 +28,8 @@ def plot_g(ax, g):
             ax.axvline(cut[k], color=colour, ls="--", lw=0.8)
     ax.set_xlabel("r")
     ax.set_ylabel(r"$g_{ab}(r)$")
-    ax.set_title(f"g_ab over {int(last(g, 'g_frames'))} origin frames", fontsize=9)
-    ax.legend(fontsize=7)
+    ax.set_title(f"g_ab over {int(last(g, 'g_frames'))} origin frames")
+    legend_below(ax)
 
 
 def plot_rg(ax, g):
@@ -49,7 +49,9 @@ def plot_rg(ax, g):
     ax.set_yscale("log")
     ax.set_xlabel(r"$N_c$")
     ax.set_ylabel(r"$R_g$")
-    ax.legend(fontsize=7)
+    ax.set_title(r"radius of gyration, $R_g \sim N_c^{1/d_f}$")
+    tidy_log(ax)
+    legend_below(ax)
 
 
 def plot_p(ax, g):
@@ -79,7 +81,9 @@ def plot_p(ax, g):
     ax.set_yscale("log")
     ax.set_xlabel(r"$N_c$")
     ax.set_ylabel(r"$P(N_c)$")
-    ax.legend(fontsize=7)
+    ax.set_title("cluster sizes at the lag used")
+    tidy_log(ax)
+    legend_below(ax)
 
 
 def plot_lags(ax, g):
@@ -96,7 +100,9 @@ def plot_lags(ax, g):
     ax.set_yscale("log")
     ax.set_xlabel("t")
     ax.set_ylabel(r"mean $N_c$")
-    ax.legend(fontsize=7)
+    ax.set_title("mean cluster size against the lag")
+    tidy_log(ax)
+    legend_below(ax, ncol=2)
 
 
 def main(path, png):
@@ -105,15 +111,16 @@ def main(path, png):
             print(f"plot_clusters: {path} has no cluster results", file=sys.stderr)
             return 1
         groups = list(f["observables/clusters"].items())
-        fig, axes = plt.subplots(len(groups), 4, figsize=(18, 4.2 * len(groups)), squeeze=False)
+        fig, axes = plt.subplots(len(groups), 4, figsize=(18, 5.2 * len(groups)), squeeze=False,
+                                 layout="constrained")
         for row, (name, g) in zip(axes, groups):
             plot_g(row[0], g)
             plot_rg(row[1], g)
             plot_p(row[2], g)
             plot_lags(row[3], g)
-            row[0].text(0.02, 0.95, name, transform=row[0].transAxes, va="top", fontsize=10, weight="bold")
-        fig.tight_layout()
-        save(fig, f, png, 110)
+            for ax in row:  # each panel names its cutoff
+                ax.set_title(f"a = {g.attrs.get('cutoff_a', name)}: " + ax.get_title())
+        save(fig, f, png, 100)
     print(f"plot_clusters: wrote {png}", file=sys.stderr)
     return 0
 

@@ -1,11 +1,48 @@
 """What every plot_<observable>.py shares: matplotlib without a display,
-the newest record of an H5MD time series, and the command line
-(plot_<observable>.py RUN.h5 OUT.png)."""
+type sizes legible at 100% (10 pt text, 9 pt ticks and legends, at the
+100-120 dpi the plots are written with), log axes labelled legibly, legends
+below their panel instead of over the data, the newest record of an H5MD
+time series, and the command line (plot_<observable>.py RUN.h5 OUT.png)."""
 import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
+matplotlib.rcParams.update({"font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 9,
+                            "xtick.labelsize": 9, "ytick.labelsize": 9, "legend.framealpha": 0.9})
+
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
+
+
+def tidy_log(ax):
+    """Log axes labelled legibly: plain numbers (0.05, 1, 20) where they are
+    short, and on an axis spanning less than about a decade the ticks at 2
+    and 5 labelled too (matplotlib's default there, 2x10^1 3x10^1 ..., runs
+    the labels into each other)."""
+    plain = FuncFormatter(lambda v, _: f"{v:g}")
+    for axis, scale in ((ax.xaxis, ax.get_xscale()), (ax.yaxis, ax.get_yscale())):
+        if scale != "log":
+            continue
+        lo, hi = sorted(axis.get_view_interval())
+        if lo <= 0:
+            continue
+        if hi / lo < 15:
+            axis.set_minor_locator(LogLocator(subs=(2, 5)))
+            axis.set_minor_formatter(plain)
+        else:
+            axis.set_minor_formatter(NullFormatter())
+        if lo >= 1e-3 and hi <= 1e5:
+            axis.set_major_formatter(plain)
+
+
+def legend_below(ax, ncol=1, **kw):
+    """The panel's legend under its x label, outside the data."""
+    return ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=ncol, frameon=False, **kw)
+
+
+def legend_right(ax, **kw):
+    """The panel's legend at its right, outside the data."""
+    return ax.legend(loc="center left", bbox_to_anchor=(1.02, 0.5), frameon=False, **kw)
 
 
 def last(group, name):
@@ -20,14 +57,18 @@ def save(fig, f, png, dpi):
         missing = f.attrs.get("missing", "")
         missing = missing.decode() if isinstance(missing, bytes) else str(missing)
         text = "INCOMPLETE RUN" + (": " + missing[:150] if missing else "")
-        fig.suptitle(text, color="red", fontsize=9, y=1.03)
+        fig.suptitle(text, color="red", fontsize=12, y=1.03)
         fig.savefig(png, dpi=dpi, bbox_inches="tight")
         return
     fig.savefig(png, dpi=dpi)
 
 
 def cli(main, doc):
-    """Runs main(RUN.h5, OUT.png) from the command line and exits with its status."""
+    """Runs main(RUN.h5, OUT.png) from the command line and exits with its
+    status; -h or --help prints the usage (the script's docstring)."""
+    if len(sys.argv) == 2 and sys.argv[1] in ("-h", "--help"):
+        print(doc)
+        sys.exit(0)
     if len(sys.argv) != 3:
         print(doc, file=sys.stderr)
         sys.exit(2)

@@ -10,7 +10,7 @@ import math
 import sys
 
 import h5py
-from plot_common import cli, save
+from plot_common import cli, legend_right, save, tidy_log
 import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
 import numpy as np
 
@@ -22,7 +22,7 @@ def main(path, png):
             return 1
         g = f["observables/msd"]
         t = g["lag_time"][()]
-        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        fig, ax = plt.subplots(figsize=(9.6, 5.0), layout="constrained")
         fractions = {k: float(g.attrs.get(f"fraction_{k}", math.nan)) for k in ("all", "small")}
         for name, ls in (("all", "-"), ("small", "--")):
             curves = [(f"msd_{name}", "green", name)]
@@ -42,9 +42,9 @@ def main(path, png):
         ax.set_yscale("log")
         ax.set_xlabel("t")
         ax.set_ylabel(r"$\Delta(t)$")
-        ax.legend(fontsize=8)
-        fig.tight_layout()
-        save(fig, f, png, 120)
+        tidy_log(ax)
+        legend_right(ax)
+        save(fig, f, png, 110)
     print(f"plot_msd: wrote {png}", file=sys.stderr)
     return 0
 

@@ -9,7 +9,7 @@ import math
 import sys
 
 import h5py
-from plot_common import cli, last, save
+from plot_common import cli, last, legend_below, save, tidy_log
 import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
 import numpy as np
 
@@ -19,7 +19,8 @@ def main(path, png):
         if "observables/overlap" not in f:
             print(f"plot_overlap: {path} has no overlap results", file=sys.stderr)
             return 1
-        fig, (ax, ax2) = plt.subplots(1, 2, figsize=(11, 4.4), gridspec_kw={"width_ratios": [3, 2]})
+        fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 6.0), gridspec_kw={"width_ratios": [3, 2]},
+                                      layout="constrained")
         for name, g in sorted(f["observables/overlap"].items()):
             t = g["lag_time"][()]
             q, err = last(g, "q"), last(g, "q_err")
@@ -51,14 +52,14 @@ def main(path, png):
             p = f["parameters/system"].attrs
             bits = [f"{k}={p[k]}" for k in ("n_particles", "packing_fraction", "restitution") if k in p]
             title += " (" + ", ".join(bits) + ")"
-        ax.set_title(title, fontsize=10)
-        ax.legend(fontsize=8)
+        ax.set_title(title)
+        tidy_log(ax)
+        legend_below(ax, ncol=2)
         ax2.set_xlabel("waiting time $t_0$")
         ax2.set_ylabel(r"$\tau_\alpha(t_0)$")
-        ax2.set_title("aging check: flat if stationary", fontsize=10)
-        ax2.legend(fontsize=8)
-        fig.tight_layout()
-        save(fig, f, png, 120)
+        ax2.set_title("aging check: flat if stationary")
+        ax2.legend()
+        save(fig, f, png, 110)
     print(f"plot_overlap: wrote {png}", file=sys.stderr)
     return 0
 

@@ -5,6 +5,7 @@
 # To record a run started by run_scene.sh, use its --record LOG option (it
 # runs the logger on the run's own, possibly private, bus).
 set -euo pipefail
+case ${1:-} in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac
 [[ $# -ge 1 ]] || { echo "usage: record.sh LOG [LCM_URL]" >&2; exit 2; }
 url=${2:-${LCM_DEFAULT_URL:-udpm://239.255.76.67:7667?ttl=0}}
 # Frames come in bursts of chunks: without a big socket buffer the logger

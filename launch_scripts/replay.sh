@@ -23,7 +23,7 @@ while (($#)); do
   --no-build) build_first=0; shift ;;
   --run-id) run_id=$2; shift 2 ;;
   --list) list=1; shift ;;
-  -h | --help) sed -n '2,14p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;;
   -*) echo "replay: unknown option $1" >&2; exit 2 ;;
   *) log=$1; shift ;;
   esac

@@ -11,6 +11,12 @@
 #                   host can watch; no packet leaves the host
 #   --bus lan       the LAN's bus (ttl=1): other hosts can watch, or run the
 #                   analysis (--role); receive buffers of 4 MiB
+#   --bus tcpq      lossless: LCM's TCP hub (lcm.lcm.TCPService, from
+#                   liblcm-java) on a free loopback port of a private network
+#                   namespace, every process connected to it (tcpq://); the
+#                   hub holds a publisher back instead of dropping (README,
+#                   "Transport"). For a hub of your own: --bus host --url
+#                   tcpq://127.0.0.1:PORT
 #   --role R        all (default): sim, nodes and recorder here; analysis:
 #                   the nodes and the recorder only (results and plots here);
 #                   sim: the sim only. Start the analysis on one host and the
@@ -20,6 +26,8 @@
 #                   ttl=1 with --bus lan)
 #   --record LOG    also record everything with lcm-logger into LOG
 #   --no-build      skip setup.sh (packages and build)
+#   --no-plots      write run.h5 only, no PNGs (plot later with
+#                   launch_scripts/plot_<observable>.py RUN.h5 OUT.png)
 #   --resume CKPT   continue the run saved in checkpoint CKPT (instead of a
 #                   scene) with fresh nodes and recorder: use the run's
 #                   checkpoint_before_frames.h5 (the last one before its
@@ -37,7 +45,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
-scene="" out="" bus=private url="" record="" build_first=1 resume="" run_id="" role=all author="" author_email=""
+scene="" out="" bus=private url="" record="" build_first=1 plots=1 resume="" run_id="" role=all author="" author_email=""
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
@@ -45,12 +53,13 @@ while (($#)); do
   --url) url=$2; shift 2 ;;
   --record) record=$2; shift 2 ;;
   --no-build) build_first=0; shift ;;
+  --no-plots) plots=0; shift ;;
   --resume) resume=$2; shift 2 ;;
   --run-id) run_id=$2; shift 2 ;;
   --role) role=$2; shift 2 ;;
   --author) author=$2; shift 2 ;;
   --author-email) author_email=$2; shift 2 ;;
-  -h | --help) sed -n '2,34p' "$0" | sed 's/^# \{0,1\}//'; exit 0 ;;
+  -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;;
   -*) echo "run_scene: unknown option $1" >&2; exit 2 ;;
   *) [[ -z $scene ]] || { echo "run_scene: one scene only" >&2; exit 2; }; scene=$1; shift ;;
   esac
@@ -61,11 +70,13 @@ if [[ -n $resume ]]; then
   resume=$(cd "$(dirname "$resume")" && pwd)/$(basename "$resume")
   sim_input=(--resume "$resume")
 else
-  [[ -n $scene ]] || { echo "usage: run_scene.sh SCENE.toml [--out DIR] [--bus private|host] [--url URL] [--record LOG] [--resume CKPT]" >&2; exit 2; }
+  [[ -n $scene ]] || { echo "usage: run_scene.sh SCENE.toml [--out DIR] [--bus private|host|lan|tcpq] [--url URL] [--record LOG] [--resume CKPT] (--help: all options)" >&2; exit 2; }
   [[ -f $scene ]] || { echo "run_scene: no scene file $scene" >&2; exit 2; }
   sim_input=("$scene")
 fi
-[[ $bus == private || $bus == host || $bus == lan ]] || { echo "run_scene: --bus is private, host or lan, not $bus" >&2; exit 2; }
+[[ $bus == private || $bus == host || $bus == lan || $bus == tcpq ]] || { echo "run_scene: --bus is private, host, lan or tcpq, not $bus" >&2; exit 2; }
+[[ $bus != tcpq || -z $url ]] || { echo "run_scene: --bus tcpq starts its own hub; for a hub of yours use --bus host --url tcpq://HOST:PORT" >&2; exit 2; }
+[[ $bus != tcpq || $role == all ]] || { echo "run_scene: --bus tcpq is a private bus; across hosts use --url tcpq://HUB:PORT" >&2; exit 2; }
 [[ $role == all || $role == sim || $role == analysis ]] || { echo "run_scene: --role is all, sim or analysis, not $role" >&2; exit 2; }
 if [[ $role != all ]]; then
   [[ $bus == lan || -n $url ]] || { echo "run_scene: --role $role splits a run over hosts: use --bus lan (or --url)" >&2; exit 2; }
@@ -85,8 +96,9 @@ mkdir -p "$out"
 out=$(cd "$out" && pwd)
 [[ -z $record ]] || record=$(cd "$(dirname "$record")" && pwd)/$(basename "$record")
 
-if [[ $bus == private && -z ${DYNHET_IN_NETNS:-} ]]; then
-  args=(--out "$out" --bus private --no-build)
+if [[ ($bus == private || $bus == tcpq) && -z ${DYNHET_IN_NETNS:-} ]]; then
+  args=(--out "$out" --bus "$bus" --no-build)
+  ((plots)) || args+=(--no-plots)
   [[ -z $resume ]] || args+=(--resume "$resume")
   [[ -z $url ]] || args+=(--url "$url")
   [[ -z $record ]] || args+=(--record "$record")
@@ -94,6 +106,29 @@ if [[ $bus == private && -z ${DYNHET_IN_NETNS:-} ]]; then
   [[ -z $author ]] || args+=(--author "$author")
   [[ -z $author_email ]] || args+=(--author-email "$author_email")
   exec "$root/launch_scripts/netns.sh" "$0" ${scene:+"$scene"} "${args[@]}"
+fi
+pids=() names=()
+cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
+trap cleanup EXIT
+trap 'echo "run_scene: interrupted" >&2; exit 130' INT TERM
+
+if [[ $bus == tcpq ]]; then
+  # LCM's TCP hub on a free loopback port of this (private) namespace; it
+  # goes when the run's processes have gone (hub_pid, below).
+  port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+  java -cp /usr/share/java/lcm.jar lcm.lcm.TCPService "$port" >"$out/tcpservice.log" 2>&1 &
+  hub_pid=$!
+  trap 'cleanup; kill "$hub_pid" 2>/dev/null || true' EXIT
+  hub_up=0
+  for _ in $(seq 150); do
+    # Connect, and read the hub's 8-byte greeting (a close with it unread
+    # would reset the connection).
+    (exec 3<>"/dev/tcp/127.0.0.1/$port" && timeout 5 head -c 8 <&3 >/dev/null) 2>/dev/null && { hub_up=1; break; }
+    kill -0 "$hub_pid" 2>/dev/null || break
+    sleep 0.1
+  done
+  ((hub_up)) || { echo "run_scene: the tcpq hub did not start:" >&2; cat "$out/tcpservice.log" >&2; exit 1; }
+  url=tcpq://127.0.0.1:$port
 fi
 if [[ -n $url ]]; then export LCM_DEFAULT_URL=$url; fi
 # Only the LAN bus leaves the host (ttl=1); a private bus never leaves its
@@ -111,11 +146,6 @@ elif [[ -z $run_id ]]; then
   run_id=$(( (RANDOM << 30 | RANDOM << 15 | RANDOM) + 1 ))
 fi
 [[ $run_id =~ ^[1-9][0-9]*$ ]] || { echo "run_scene: --run-id must be a positive integer, not $run_id" >&2; exit 2; }
-
-pids=() names=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
-trap cleanup EXIT
-trap 'echo "run_scene: interrupted" >&2; exit 130' INT TERM
 
 start() { # name, then the command; waits for its "ready" line
   local n=$1; shift
@@ -201,7 +231,7 @@ if [[ -n $record ]]; then
 fi
 grep -h -E "tau_alpha|frames whole|complete|missing" "$out"/*_node.log "$out/recorder.log" >&2 || true
 
-if [[ -f $out/run.h5 ]]; then
+if ((plots)) && [[ -f $out/run.h5 ]]; then
   for obs in chi4 msd displacement clusters s4; do # plots of the observables the run has
     /usr/bin/python3 -c "import h5py,sys; sys.exit(0 if 'observables/$obs' in h5py.File('$out/run.h5','r') else 1)" 2>/dev/null &&
       { /usr/bin/python3 "$root/launch_scripts/plot_$obs.py" "$out/run.h5" "$out/$obs.png" || status=1; }

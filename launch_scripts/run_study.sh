@@ -25,7 +25,7 @@ args=() build_first=1
 for a in "$@"; do
   case "$a" in
   --no-build) build_first=0 ;;
-  -h | --help) sed -n '2,22p' "$0"; exit 0 ;;
+  -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;;
   *) args+=("$a") ;;
   esac
 done

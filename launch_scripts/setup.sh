@@ -3,6 +3,7 @@
 # builds it with CMake in Release mode. Idempotent; quiet unless something
 # fails. Usage: launch_scripts/setup.sh   (env BUILD_DIR, default ./build)
 set -euo pipefail
+case ${1:-} in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;; esac
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 

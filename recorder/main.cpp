@@ -33,6 +33,7 @@
 #include "dynhet/flow_control.hpp"
 #include "dynhet/lcm_url.hpp"
 #include "dynhet/scene.hpp"
+#include "dynhet/lcm_exit.hpp"
 #include "dynhet/lcm_guard.hpp"
 #include "dynhet/message_checks.hpp"
 #include "run_recorder.hpp"
@@ -333,12 +334,17 @@ int main(int argc, char **argv) {
 
   const std::string url = dynhet::resolve_lcm_url(o.url);
   lcm::LCM lcm(url);
-  if (!lcm.good()) {
+  if (dynhet::bus_unreachable(lcm, url)) {
     std::fprintf(stderr, "recorder: cannot open LCM at %s\n", url.c_str());
     return 3;
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
   Session session(lcm, o);
-  return session.run();
+  const int code = session.run();
+  // Its last status (the sim may pace on it) reaches the bus before it ends
+  // (tcpq: dynhet/lcm_exit.hpp).
+  if (const std::string why = dynhet::deliver_before_exit(lcm, url); !why.empty())
+    std::fprintf(stderr, "recorder: %s\n", why.c_str());
+  return code;
 }

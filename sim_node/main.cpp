@@ -25,6 +25,7 @@
 #include "dynhet/engine/engine.hpp"
 #include "dynhet/flow_control.hpp"
 #include "dynhet/frame_chunk_t.hpp"
+#include "dynhet/lcm_exit.hpp"
 #include "dynhet/lcm_guard.hpp"
 #include "dynhet/node_status_t.hpp"
 #include "dynhet/lcm_url.hpp"
@@ -494,7 +495,7 @@ int main(int argc, char** argv) {
   if (run_id == 0) run_id = static_cast<int64_t>(std::random_device{}() & 0x7fffffff) << 20 ^ getpid();
 
   lcm::LCM lcm(dynhet::resolve_lcm_url(url));
-  if (!lcm.good()) {
+  if (dynhet::bus_unreachable(lcm, dynhet::resolve_lcm_url(url))) {
     std::fprintf(stderr, "sim_node: cannot open LCM at %s\n", dynhet::resolve_lcm_url(url).c_str());
     return 3;
   }
@@ -511,6 +512,7 @@ int main(int argc, char** argv) {
   };
 
   bool checkpoint_written = !resume_path.empty();
+  int code = 0;
   try {
     const dynhet::engine::Params p = engine_params(scene);
     dynhet::engine::Engine eng(p);
@@ -716,7 +718,11 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     if (g_signal && checkpoint_written) rep.msg().phase = "interrupted"; // nodes wait for --resume
     fail(e.what());
-    return g_signal ? 128 + g_signal : 1;
+    code = g_signal ? 128 + g_signal : 1;
   }
-  return 0;
+  // The last frames and the "done" (or "failed") reach the bus before the
+  // process ends (tcpq: dynhet/lcm_exit.hpp).
+  if (const std::string why = dynhet::deliver_before_exit(lcm, dynhet::resolve_lcm_url(url)); !why.empty())
+    std::fprintf(stderr, "sim_node: %s\n", why.c_str());
+  return code;
 }

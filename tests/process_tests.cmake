@@ -140,3 +140,20 @@ set_tests_properties(stopped_recorder_loses_nothing PROPERTIES LABELS process TI
 add_test(NAME pressure_matches_published_small_n
   COMMAND bash -c "/usr/bin/python3 ${PROJECT_SOURCE_DIR}/bench/pressure_reference.py --build ${CMAKE_BINARY_DIR} --check 3 --port 7796 --n 72 --phi 0.65 --time 40000 --seeds 2 && /usr/bin/python3 ${PROJECT_SOURCE_DIR}/bench/pressure_reference.py --build ${CMAKE_BINARY_DIR} --check 3 --port 7796 --n 224,870 --phi 0.67 --time 40000")
 set_tests_properties(pressure_matches_published_small_n PROPERTIES LABELS process TIMEOUT 300)
+
+# tcpq, LCM's TCP hub (tests/tcpq_runs.sh): the tiny scene 5 times (twice
+# with run_scene.sh --bus tcpq, three times on one hub carrying a foreign
+# publisher's junk), each complete with 0 frames lost and equal to a udpm
+# run bit for bit; every process closes its connection without a reset, so
+# its last messages are delivered (dynhet/lcm_exit.hpp).
+add_test(NAME tcpq_runs_complete
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/tcpq_runs.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(tcpq_runs_complete PROPERTIES LABELS process TIMEOUT 180)
+
+# LCM's own player, unfiltered (tests/logplayer_full.sh): a tiny run's whole
+# log (old results included) played with lcm-logplayer into a listening
+# recorder, alone and with live nodes: complete, one series per result
+# (steps strictly increasing, those of the live run), equal to the live run.
+add_test(NAME logplayer_full_log
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/logplayer_full.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(logplayer_full_log PROPERTIES LABELS process TIMEOUT 120)

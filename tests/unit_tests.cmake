@@ -9,3 +9,8 @@ target_compile_definitions(test_scene PRIVATE DYNHET_SOURCE_DIR="${PROJECT_SOURC
 add_executable(test_inbox ${CMAKE_CURRENT_SOURCE_DIR}/test_inbox.cpp)
 target_link_libraries(test_inbox PRIVATE dynhet_node dynhet_common GTest::gtest_main)
 gtest_discover_tests(test_inbox DISCOVERY_TIMEOUT 30 PROPERTIES LABELS unit)
+# --help of every launch script prints its usage and starts nothing
+# (tests/script_help.sh).
+add_test(NAME launch_scripts_help
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/script_help.sh ${PROJECT_SOURCE_DIR})
+set_tests_properties(launch_scripts_help PROPERTIES LABELS unit TIMEOUT 120)
