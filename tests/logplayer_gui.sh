@@ -20,16 +20,17 @@ url='udpm://239.255.76.67:7713?ttl=0'
 lcm-logger --lcm-url="\$url" "$tmp/played.lcmlog" >/dev/null 2>&1 &
 logger=\$!
 sleep 1
-xvfb-run -a bash "$root/launch_scripts/logplayer.sh" "$tmp/run.lcmlog" --inputs "\$url" >"$tmp/player.log" 2>&1 &
-player=\$!
+# The player's own pid (logplayer.sh execs java) is written for the end:
+# stopping it, not xvfb-run, lets xvfb-run stop its X server.
+xvfb-run -a bash -c 'bash "\$1" "\$2" --inputs "\$3" & echo \$! >"\$4"; wait' _ \
+  "$root/launch_scripts/logplayer.sh" "$tmp/run.lcmlog" "\$url" "$tmp/player.pid" >"$tmp/player.log" 2>&1 &
 want=\$(/usr/bin/python3 "$tmp/events.py" "$tmp/run.lcmlog" | wc -l)
 for _ in \$(seq 120); do
   sleep 0.5
   [[ -f "$tmp/played.lcmlog" ]] && (( \$(/usr/bin/python3 "$tmp/events.py" "$tmp/played.lcmlog" | wc -l) >= want )) && break
 done
 sleep 1
-kill \$player \$logger 2>/dev/null || true
-pkill -f "LogPlayer.*$tmp" 2>/dev/null || true
+kill \$(cat "$tmp/player.pid") \$logger 2>/dev/null || true
 wait 2>/dev/null || true
 SH
 # The inputs of a log, one line per event: channel and a hash of its bytes.
