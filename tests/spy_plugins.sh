@@ -23,7 +23,9 @@ rm -rf "$out"
 mkdir -p "$out"
 tmp=$(mktemp -d)
 checker=""
-trap '[[ -z $checker ]] || kill "$checker" 2>/dev/null || true; rm -rf "$tmp"' EXIT
+# On an early exit: the checker's processes (java and Xvfb, xvfb-run's
+# children), so that no X server outlives the test.
+trap '[[ -z $checker ]] || kill $(pgrep -P "$checker") 2>/dev/null || true; rm -rf "$tmp"' EXIT
 fail=0
 check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
 for jar in dynhet_spy_plugins dynhet_spy_check; do
