@@ -1,6 +1,6 @@
 // clusters_node: clusters of slow and fast particles (paper sec. 3.3),
-// live from the frames on DYNHET_FRAME, published on DYNHET_CLUSTERS (one
-// message per cutoff a) after every frame that adds a pair. Every cutoff a
+// live from the frames on DYNHET_FRAME, published on DYNHET_CLUSTERS_<a> (one
+// channel per cutoff a) after every frame that adds a pair. Every cutoff a
 // of the scene is done in the same pass over the frames.
 //
 // - Neighbours: |r_i - r_j| < r^min_ab at t0, r^min_ab the first minimum of
@@ -208,7 +208,7 @@ private:
       m.lag_index = chosen_lag(c, q.tau_alpha);
       m.lag = m.lag_index >= 0 ? info().lag_time[m.lag_index] : kNaN;
       fill_at_lag(c, m.lag_index, m);
-      out().publish(dynhet::kChanClusters, &m);
+      out().publish(dynhet::cutoff_channel(dynhet::kChanClusters, m.cutoff_a), &m);
       if (final)
         std::fprintf(stderr,
                      "clusters_node: a=%g tau_alpha=%.4g lag %.4g: slow <N_c>=%.4g d_f=%.3g kappa=%.3g; "

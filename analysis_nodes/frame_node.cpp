@@ -276,7 +276,7 @@ void FrameNode::publish_status() {
   status_.chunks_received = assembler_.chunks_received();
   status_.pairs_done = pairs_done_;
   status_.origins_held = static_cast<int32_t>(origins_.size());
-  out_.publish(kChanNodeStatus, &status_);
+  out_.publish(node_status_channel(name_), &status_);
   last_status_ = Clock::now();
 }
 

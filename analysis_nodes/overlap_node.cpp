@@ -1,11 +1,12 @@
 // overlap_node: the overlap Q(t), its error bars and tau_alpha, computed
-// live from the frames on DYNHET_FRAME and published on DYNHET_OVERLAP (one
-// message per cutoff a) after every frame that adds a pair; if the run asks
-// for chi4, also chi4(t) for every listed sub-box size on DYNHET_CHI4, from
-// the same displacements, and the MSD (with the instantaneous fastest and
-// slowest subsets) on DYNHET_MSD and P(dx, t) on DYNHET_DISPLACEMENT. It
-// holds only the origin frames that some later frame still needs (16 N
-// bytes each, plus 4 N per origin for chi4's sub-box index).
+// live from the frames on DYNHET_FRAME and published on DYNHET_OVERLAP_<a>
+// (one channel per cutoff a, e.g. DYNHET_OVERLAP_a0.6) after every frame
+// that adds a pair; if the run asks for chi4, also chi4(t) for every listed
+// sub-box size on DYNHET_CHI4_<a>, from the same displacements, and the
+// MSD (with the instantaneous fastest and slowest subsets) on DYNHET_MSD
+// and P(dx, t) on DYNHET_DISPLACEMENT. It holds only the origin frames that
+// some later frame still needs (16 N bytes each, plus 4 N per origin for
+// chi4's sub-box index).
 //
 // Usage: overlap_node [--lcm-url URL] [--publish-url URL]
 // With --lcm-url file://LOG?speed=0 it re-runs the analysis from an
@@ -212,7 +213,7 @@ private:
         m.tau4_err.push_back(r.tau4_err);
       }
       m.n_values = static_cast<int32_t>(m.chi4.size());
-      out().publish(dynhet::kChanChi4, &m);
+      out().publish(dynhet::cutoff_channel(dynhet::kChanChi4, m.cutoff_a), &m);
     }
   }
 
@@ -251,7 +252,7 @@ private:
       for (int k = 0; k < info().n_origins; ++k) m.t0.push_back(info().frame_time[info().origin_frame[k]]);
       m.tau_alpha_t0 = an::tau_alpha_per_origin(acc_[c], info().lag_time, info().n_origins);
       m.n_t0 = static_cast<int32_t>(m.t0.size());
-      out().publish(dynhet::kChanOverlap, &m);
+      out().publish(dynhet::cutoff_channel(dynhet::kChanOverlap, m.cutoff_a), &m);
       if (final)
         std::fprintf(stderr, "overlap_node: a=%g tau_alpha=%.5g +- %.2g (%d pairs)\n", m.cutoff_a,
                      m.tau_alpha, m.tau_alpha_err, pairs_done());

@@ -1,6 +1,7 @@
 // s4_node: the four-point structure factor S4(q,t) (paper eqs. 15-16) and
 // the correlation length xi, live from the frames on DYNHET_FRAME, published
-// on DYNHET_S4 at most once a second and at the end.
+// on DYNHET_S4_<a> (one channel per cutoff a) at most once a second and at
+// the end.
 //
 // For each (origin, lag) pair it uses, the node computes the displacements
 // |r_i(t0+t) - r_i(t0)|^2 once, and for every cutoff a of the scene weighs
@@ -164,7 +165,7 @@ private:
     m.n_lags = static_cast<int32_t>(lags_.size());
     m.n_lag_values = static_cast<int32_t>(m.s4_lag.size());
     m.n_lag_fits = static_cast<int32_t>(m.xi_lag.size());
-    if (out().publish(dynhet::kChanS4, &m) != 0)
+    if (out().publish(dynhet::cutoff_channel(dynhet::kChanS4, m.cutoff_a), &m) != 0)
       std::fprintf(stderr, "s4_node: could not publish S4 (%d bytes)\n", m.getEncodedSize());
     if (final)
       std::fprintf(stderr, "s4_node: a=%g t_s4=%.4g (tau_alpha %.4g), whole box xi=%.4g +- %.2g chi0=%.4g +- %.2g, chi4=%.4g +- %.2g (%d origins)\n",

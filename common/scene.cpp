@@ -14,6 +14,7 @@
 
 #include <toml++/toml.h>
 
+#include "dynhet/lcm_url.hpp" // cutoff_label
 #include "dynhet/model.hpp"
 
 namespace dynhet {
@@ -333,8 +334,13 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
            double v;
            if (!c.get_double(key, e, v)) return;
            if (v <= 0) return c.bad_value(key, e, "every cutoff a must be > 0");
-           if (std::find(s.cutoff_a.begin(), s.cutoff_a.end(), v) != s.cutoff_a.end())
-             return c.bad_value(key, e, "each cutoff may be listed once");
+           // A cutoff names its results' channels and groups (a0.6, six
+           // significant digits): two that print alike would share them.
+           for (double w : s.cutoff_a)
+             if (cutoff_label(w) == cutoff_label(v))
+               return c.bad_value(key, e, "each cutoff may be listed once (and cutoffs must differ in their "
+                                          "first six significant digits, which name their results: " +
+                                          cutoff_label(v) + ")");
            s.cutoff_a.push_back(v);
          }
        }},

@@ -7,8 +7,10 @@ case ${1:-} in -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, "
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 
+# Java: the headless JDK builds the types' and the lcm-spy plugins' jars;
+# default-jre is the JRE with a GUI that lcm-spy and lcm-logplayer-gui need.
 packages=(build-essential cmake pkg-config git
-  liblcm-dev liblcm-bin liblcm-java libglib2.0-dev default-jdk-headless libjchart2d-java
+  liblcm-dev liblcm-bin liblcm-java libglib2.0-dev default-jdk-headless default-jre libjchart2d-java
   libeigen3-dev libfftw3-dev libhdf5-dev hdf5-tools libgtest-dev
   libtomlplusplus-dev libcli11-dev
   python3-matplotlib python3-h5py python3-numpy python3-scipy iproute2 util-linux xvfb xauth

@@ -1,7 +1,6 @@
 #include "completion.hpp"
 
 #include <algorithm>
-#include <cstdio>
 
 #include "dynhet/scene.hpp"
 
@@ -14,12 +13,6 @@ bool recordable(const std::string &observable) {
          observable == "clusters" || observable == "s4";
 }
 } // namespace
-
-std::string cutoff_label(double cutoff_a) {
-  char buf[64];
-  std::snprintf(buf, sizeof buf, "a%g", cutoff_a);
-  return buf;
-}
 
 Completion::Completion(const std::vector<std::string> &observables, const std::vector<double> &cutoffs)
     : observables_(observables) {

@@ -9,10 +9,9 @@
 #include <string>
 #include <vector>
 
-namespace dynhet {
+#include "dynhet/lcm_url.hpp" // cutoff_label
 
-// "a0.6": how a cutoff names its results in the file and in messages.
-std::string cutoff_label(double cutoff_a);
+namespace dynhet {
 
 class Completion {
 public:

@@ -5,7 +5,7 @@
 // result and its node has said done.
 //
 // When the scene keeps the frames (and they come from the bus), the
-// recorder publishes its own status on DYNHET_NODE_STATUS, node "recorder",
+// recorder publishes its own status on DYNHET_NODE_STATUS_recorder,
 // after every kept frame and every second, as the analysis nodes do: the
 // sim paces its frames on it (flow control), so that a recorder slowed by
 // its writes, or stopped, loses none. Its own status is not a node's: it
@@ -51,6 +51,25 @@ struct Options {
   double timeout = 60, wait_run = 120;
   int64_t run_id = 0; // 0: the first run seen
 };
+
+// The one channel each message may come on (lcm_url.hpp: one channel per
+// source): a message whose cutoff or node disagrees with its channel's is
+// dropped and counted, whatever else it says.
+std::string channel_of(const dynhet::run_info_t &) { return dynhet::kChanRun; }
+std::string channel_of(const dynhet::sim_status_t &) { return dynhet::kChanSimStatus; }
+std::string channel_of(const dynhet::frame_chunk_t &) { return dynhet::kChanFrame; }
+std::string channel_of(const dynhet::node_status_t &m) { return dynhet::node_status_channel(m.node); }
+using dynhet::cutoff_channel;
+std::string channel_of(const dynhet::overlap_t &m) {
+  return cutoff_channel(dynhet::kChanOverlap, m.cutoff_a);
+}
+std::string channel_of(const dynhet::chi4_t &m) { return cutoff_channel(dynhet::kChanChi4, m.cutoff_a); }
+std::string channel_of(const dynhet::s4_t &m) { return cutoff_channel(dynhet::kChanS4, m.cutoff_a); }
+std::string channel_of(const dynhet::clusters_t &m) {
+  return cutoff_channel(dynhet::kChanClusters, m.cutoff_a);
+}
+std::string channel_of(const dynhet::msd_t &) { return dynhet::kChanMsd; }
+std::string channel_of(const dynhet::displacement_t &) { return dynhet::kChanDisplacement; }
 
 // The bus (and optionally a log) on one side, the RunRecorder on the
 // other, and the clocks that decide when to stop waiting.
@@ -106,6 +125,8 @@ private:
     Msg m;
     std::string why;
     if (!dynhet::guard::safe_decode(data, size, m, why)) return reject(ch, why);
+    if (const std::string own = channel_of(m); ch != own)
+      return reject(ch, "not this message's channel, which is " + own.substr(0, 80));
     try {
       (this->*Take)(m);
     } catch (const std::exception &e) {
@@ -136,25 +157,30 @@ void Session::subscribe() {
     frames_ = lcm_.subscribe(dynhet::kChanFrame, &Session::raw<dynhet::frame_chunk_t, &Session::take_frame>, this);
     frames_->setQueueCapacity(10000);
   }
+  // Every channel of each family (a cutoff's, a node's), and names outside
+  // the scheme that start like it, to be dropped and counted.
   using R = dynhet::RunRecorder;
-  lcm_.subscribe(dynhet::kChanNodeStatus, &Session::raw<dynhet::node_status_t, &Session::take_node>, this)
+  using dynhet::channel_family;
+  lcm_.subscribe(channel_family(dynhet::kChanNodeStatus),
+                 &Session::raw<dynhet::node_status_t, &Session::take_node>, this)
       ->setQueueCapacity(1000);
-  lcm_.subscribe(dynhet::kChanOverlap,
+  lcm_.subscribe(channel_family(dynhet::kChanOverlap),
                  &Session::raw<dynhet::overlap_t, &Session::take_result<dynhet::overlap_t, &R::on_overlap>>, this)
       ->setQueueCapacity(10000);
-  lcm_.subscribe(dynhet::kChanChi4, &Session::raw<dynhet::chi4_t, &Session::take_result<dynhet::chi4_t, &R::on_chi4>>,
-                 this)
+  lcm_.subscribe(channel_family(dynhet::kChanChi4),
+                 &Session::raw<dynhet::chi4_t, &Session::take_result<dynhet::chi4_t, &R::on_chi4>>, this)
       ->setQueueCapacity(10000);
-  lcm_.subscribe(dynhet::kChanMsd, &Session::raw<dynhet::msd_t, &Session::take_result<dynhet::msd_t, &R::on_msd>>,
-                 this)
+  lcm_.subscribe(channel_family(dynhet::kChanMsd),
+                 &Session::raw<dynhet::msd_t, &Session::take_result<dynhet::msd_t, &R::on_msd>>, this)
       ->setQueueCapacity(10000);
-  lcm_.subscribe(dynhet::kChanS4, &Session::raw<dynhet::s4_t, &Session::take_result<dynhet::s4_t, &R::on_s4>>, this)
+  lcm_.subscribe(channel_family(dynhet::kChanS4),
+                 &Session::raw<dynhet::s4_t, &Session::take_result<dynhet::s4_t, &R::on_s4>>, this)
       ->setQueueCapacity(1000);
-  lcm_.subscribe(dynhet::kChanClusters,
+  lcm_.subscribe(channel_family(dynhet::kChanClusters),
                  &Session::raw<dynhet::clusters_t, &Session::take_result<dynhet::clusters_t, &R::on_clusters>>, this)
       ->setQueueCapacity(10000);
   lcm_.subscribe(
-         dynhet::kChanDisplacement,
+         channel_family(dynhet::kChanDisplacement),
          &Session::raw<dynhet::displacement_t, &Session::take_result<dynhet::displacement_t, &R::on_displacement>>,
          this)
       ->setQueueCapacity(1000);
@@ -263,7 +289,7 @@ void Session::publish_own_status(const std::string &state, const std::string &me
   own_.chunks_received = rec_.chunks_received();
   own_.messages_rejected = static_cast<int32_t>(std::min<int64_t>(rec_.messages_rejected(), INT32_MAX));
   own_.message = message;
-  lcm_.publish(dynhet::kChanNodeStatus, &own_);
+  lcm_.publish(dynhet::node_status_channel(dynhet::kRecorderNode), &own_);
   last_own_status_ = Clock::now();
 }
 

@@ -58,7 +58,7 @@ std::string RunRecorder::frame_problem(int32_t frame_index) const {
          std::to_string(info_->n_frames) + " frames (nor -1, none yet)";
 }
 
-bool RunRecorder::rejected(const char *channel, const std::string &why) {
+bool RunRecorder::rejected(const std::string &channel, const std::string &why) {
   message_rejected(channel, why);
   return false;
 }
@@ -226,7 +226,8 @@ void RunRecorder::write_node(const node_status_t &m) {
 
 bool RunRecorder::on_overlap(const overlap_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
-  if (const std::string bad = frame_problem(m.frame_index); !bad.empty()) return rejected(kChanOverlap, bad);
+  if (const std::string bad = frame_problem(m.frame_index); !bad.empty())
+    return rejected(cutoff_channel(kChanOverlap, m.cutoff_a), bad);
   guarded("overlap", [&] { write_overlap(m); });
   if (m.is_final) completion_.final_result("overlap", m.cutoff_a);
   return true;
@@ -338,7 +339,7 @@ bool RunRecorder::on_s4(const s4_t &m) {
   if (bad.empty() && m.n_values > 0) bad = size_problem("s4_lag", m.n_lag_values, m.n_lags, m.n_values);
   if (bad.empty() && m.n_values > 0)
     bad = size_problem("xi_lag, chi0_lag", m.n_lag_fits, m.n_lags, m.n_grids);
-  if (!bad.empty()) return rejected(kChanS4, bad);
+  if (!bad.empty()) return rejected(cutoff_channel(kChanS4, m.cutoff_a), bad);
   guarded("s4", [&] { write_s4(m); });
   if (m.is_final) completion_.final_result("s4", m.cutoff_a);
   return true;
@@ -407,7 +408,8 @@ void RunRecorder::write_s4(const s4_t &m) {
 
 bool RunRecorder::on_clusters(const clusters_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
-  if (const std::string bad = frame_problem(m.frame_index); !bad.empty()) return rejected(kChanClusters, bad);
+  if (const std::string bad = frame_problem(m.frame_index); !bad.empty())
+    return rejected(cutoff_channel(kChanClusters, m.cutoff_a), bad);
   guarded("clusters", [&] { write_clusters(m); });
   if (m.is_final) completion_.final_result("clusters", m.cutoff_a);
   return true;
@@ -476,7 +478,7 @@ bool RunRecorder::on_chi4(const chi4_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
   std::string bad = frame_problem(m.frame_index);
   if (bad.empty() && m.n_values > 0) bad = size_problem("chi4", m.n_values, m.n_grids, m.n_lags);
-  if (!bad.empty()) return rejected(kChanChi4, bad);
+  if (!bad.empty()) return rejected(cutoff_channel(kChanChi4, m.cutoff_a), bad);
   guarded("chi4", [&] { write_chi4(m); });
   if (m.is_final) completion_.final_result("chi4", m.cutoff_a);
   return true;
@@ -546,7 +548,7 @@ bool RunRecorder::on_frame_chunk(const frame_chunk_t &m) {
   const int64_t bad = assembler_.chunks_malformed();
   std::optional<Frame> f = assembler_.add(h, m.position.data());
   if (assembler_.chunks_malformed() > bad) {
-    message_rejected("DYNHET_FRAME", "a chunk that is not one of this run's, or non-finite positions");
+    message_rejected(kChanFrame, "a chunk that is not one of this run's, or non-finite positions");
     return false;
   }
   if (f) guarded("frame", [&] { writer_->append_frame(*at_frame(f->index, false), f->position); });

@@ -135,7 +135,7 @@ private:
   std::optional<Stamp> at_frame(int64_t frame, bool last_word) const;
   // "" if the result's frame index is one of the run's or -1 (none yet), else why not.
   std::string frame_problem(int32_t frame_index) const;
-  bool rejected(const char *channel, const std::string &why);
+  bool rejected(const std::string &channel, const std::string &why);
   void write_run_info(const run_info_t &m);
   void write_sim(const sim_status_t &m);
   void write_node(const node_status_t &m);

@@ -326,10 +326,13 @@ public:
       : lcm_(lcm), run_id_(run_id) {
     for (auto& n : nodes) nodes_[n] = Node{};
     window_ = dynhet::pacing_window_frames(n_particles);
-    if (!nodes_.empty()) sub_ = lcm_.subscribe(dynhet::kChanNodeStatus, &Pacer::on_status, this);
+    // Each node's own channel (DYNHET_NODE_STATUS_<node>; node names hold
+    // no regex characters).
+    for (auto& [name, n] : nodes_)
+      subs_.push_back(lcm_.subscribe(dynhet::node_status_channel(name), &Pacer::on_status, this));
   }
   ~Pacer() {
-    if (sub_) lcm_.unsubscribe(sub_);
+    for (lcm::Subscription* s : subs_) lcm_.unsubscribe(s);
   }
   long window() const { return window_; }
   // Waits until frame f may go out; `idle` is called every ~20 ms meanwhile.
@@ -378,11 +381,11 @@ private:
     bool seen = false, gone = false, waited_for = false;
     Clock::time_point last;
   };
-  void on_status(const lcm::ReceiveBuffer* rb, const std::string&) {
+  void on_status(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     dynhet::node_status_t m;
     std::string why;
     if (!dynhet::guard::safe_decode(rb->data, static_cast<int>(rb->data_size), m, why)) return;
-    if (m.run_id != run_id_) return;
+    if (m.run_id != run_id_ || channel != dynhet::node_status_channel(m.node)) return; // not this node's own
     auto it = nodes_.find(m.node);
     if (it == nodes_.end()) return;
     Node& n = it->second;
@@ -395,7 +398,7 @@ private:
   int64_t run_id_;
   std::map<std::string, Node> nodes_;
   long window_ = 1;
-  lcm::Subscription* sub_ = nullptr;
+  std::vector<lcm::Subscription*> subs_;
   Clock::time_point start_ = Clock::now();
 };
 
@@ -428,8 +431,8 @@ int main(int argc, char** argv) {
   bool pace = false;
   app.add_flag("--pace-nodes", pace,
                "flow control: hold each frame until the scene's nodes, and the recorder when the scene keeps the "
-               "frames (their status on DYNHET_NODE_STATUS), have caught up to within a socket buffer's worth of "
-               "frames (run_scene.sh sets it)");
+               "frames (their status on DYNHET_NODE_STATUS_<node>), have caught up to within a socket "
+               "buffer's worth of frames (run_scene.sh sets it)");
   bool check = false;
   app.add_flag("--check", check, "validate the scene, print what it needs (nodes, frames) and exit");
   CLI11_PARSE(app, argc, argv);

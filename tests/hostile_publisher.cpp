@@ -13,12 +13,21 @@
 // run's results must equal a clean run's bit for bit. With --forge-done it
 // also sends a well-formed "done" status of this run (a forgery no check
 // can tell from the sim's), which must not end a node before its frames.
+//
+// With --relay it sends nothing of its own: it republishes every result and
+// node status of the run, byte for byte, on another source's channel (the
+// other cutoff's, a0.6 <-> a1, the tiny scene's; another node's): genuine
+// messages whose channel disagrees with their own cutoff or node, which the
+// recorder and the sim must drop (channels carry one source each).
+#include <atomic>
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
 #include <random>
+#include <set>
 #include <string>
 #include <thread>
 #include <vector>
@@ -109,11 +118,54 @@ dynhet::run_info_t bad_run_info(int64_t run) {
   return m;
 }
 
+std::atomic<bool> g_stop{false};
+void on_signal(int) { g_stop = true; }
+
+// The channel of another source of the same family: the other cutoff of
+// the tiny scene, or the next node; "" if none.
+std::string other_source(const std::string& ch) {
+  auto ends = [&](const std::string& tail) {
+    return ch.size() > tail.size() && ch.compare(ch.size() - tail.size(), tail.size(), tail) == 0;
+  };
+  auto swap_tail = [&](size_t n, const std::string& tail) { return ch.substr(0, ch.size() - n) + tail; };
+  if (ends("_a0.6")) return swap_tail(4, "a1");
+  if (ends("_a1")) return swap_tail(2, "a0.6");
+  if (ends("_overlap")) return swap_tail(7, "clusters");
+  if (ends("_clusters")) return swap_tail(8, "s4");
+  if (ends("_s4")) return swap_tail(2, "overlap");
+  return "";
+}
+
+// Republishes each message once (its own copies come back over the bus:
+// a payload already relayed is not relayed again).
+class Relay {
+public:
+  explicit Relay(lcm::LCM& lcm) : lcm_(lcm) {
+    for (const char* family : {"DYNHET_OVERLAP_.*", "DYNHET_CHI4_.*", "DYNHET_S4_.*", "DYNHET_CLUSTERS_.*",
+                               "DYNHET_NODE_STATUS_.*"})
+      lcm_.subscribe(family, &Relay::on_message, this)->setQueueCapacity(10000);
+  }
+  long relayed() const { return relayed_; }
+
+private:
+  void on_message(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+    const std::string to = other_source(ch);
+    if (to.empty()) return;
+    const auto* p = static_cast<const char*>(rb->data);
+    if (!seen_.insert(std::string(p, rb->data_size)).second) return;
+    lcm_.publish(to, rb->data, rb->data_size);
+    ++relayed_;
+  }
+  lcm::LCM& lcm_;
+  std::set<std::string> seen_;
+  long relayed_ = 0;
+};
+
 } // namespace
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: hostile_publisher URL RUN_ID SECONDS [--forge-done]\n");
+    std::fprintf(stderr, "usage: hostile_publisher URL RUN_ID SECONDS [--forge-done | --relay]\n");
     return 2;
   }
   lcm::LCM lcm(argv[1]);
@@ -121,6 +173,16 @@ int main(int argc, char** argv) {
   const int64_t run = std::stoll(argv[2]);
   const double seconds = std::stod(argv[3]);
   const bool forge_done = argc > 4 && std::string(argv[4]) == "--forge-done";
+  if (argc > 4 && std::string(argv[4]) == "--relay") {
+    Relay relay(lcm);
+    std::signal(SIGTERM, on_signal);
+    std::signal(SIGINT, on_signal);
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!g_stop && std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < seconds)
+      lcm.handleTimeout(100);
+    std::printf("hostile_publisher: relayed %ld messages to another source's channel\n", relay.relayed());
+    return 0;
+  }
   std::mt19937_64 gen(12345);
   const auto t0 = std::chrono::steady_clock::now();
   long rounds = 0;
@@ -129,12 +191,12 @@ int main(int argc, char** argv) {
     random_after_fingerprint<dynhet::run_info_t>(lcm, "DYNHET_RUN", gen);
     random_after_fingerprint<dynhet::frame_chunk_t>(lcm, "DYNHET_FRAME", gen);
     random_after_fingerprint<dynhet::sim_status_t>(lcm, "DYNHET_SIM_STATUS", gen);
-    random_after_fingerprint<dynhet::node_status_t>(lcm, "DYNHET_NODE_STATUS", gen);
-    random_after_fingerprint<dynhet::overlap_t>(lcm, "DYNHET_OVERLAP", gen);
-    random_after_fingerprint<dynhet::chi4_t>(lcm, "DYNHET_CHI4", gen);
+    random_after_fingerprint<dynhet::node_status_t>(lcm, "DYNHET_NODE_STATUS_overlap", gen);
+    random_after_fingerprint<dynhet::overlap_t>(lcm, "DYNHET_OVERLAP_a0.6", gen);
+    random_after_fingerprint<dynhet::chi4_t>(lcm, "DYNHET_CHI4_a0.6", gen);
     random_after_fingerprint<dynhet::msd_t>(lcm, "DYNHET_MSD", gen);
-    random_after_fingerprint<dynhet::s4_t>(lcm, "DYNHET_S4", gen);
-    random_after_fingerprint<dynhet::clusters_t>(lcm, "DYNHET_CLUSTERS", gen);
+    random_after_fingerprint<dynhet::s4_t>(lcm, "DYNHET_S4_a1", gen);
+    random_after_fingerprint<dynhet::clusters_t>(lcm, "DYNHET_CLUSTERS_a1", gen);
     random_after_fingerprint<dynhet::displacement_t>(lcm, "DYNHET_DISPLACEMENT", gen);
     // Declared lengths the message cannot hold: negative, and 2^31 - 1.
     chunk(lcm, run, 0, 300, 0, 3, 0, 128, -5, 0, 0.0);

@@ -95,6 +95,9 @@ TEST(Scene, ImpossibleValuesAreRefused) {
   expect_error("[driving]\ncontact_value = \"carnahan\"\n", {"driving.contact_value", "\"mixture\", \"henderson\""});
   expect_error("[transport]\nchunk_particles = 100000\n", {"transport.chunk_particles", "65000"});
   expect_error("[observables]\ncutoff_a = [0.6, 0.6]\n", {"observables.cutoff_a", "once"});
+  // Two cutoffs that print alike would share a channel and a group (a0.6).
+  expect_error("[observables]\ncutoff_a = [0.6, 0.6000001]\n",
+               {"observables.cutoff_a", "six significant", "a0.6"});
   expect_error("[observables]\ncompute = [\"overlap\", \"overlap\"]\n", {"observables.compute", "once"});
   expect_error("[system]\nn_particles = 2147483648\n", {"system.n_particles", "2147483647"});
   expect_error("[overlap]\nsubbox_particles = 2147483648\n", {"overlap.subbox_particles"});

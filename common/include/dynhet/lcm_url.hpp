@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <cstdlib>
 #include <string>
 
@@ -24,16 +25,48 @@ inline int64_t utime_now() {
       .count();
 }
 
-// Channel names.
+// Channel names. One channel carries one source, so that lcm-spy (which
+// charts a channel as one series) and channel filters see each source on
+// its own:
+//   DYNHET_RUN, DYNHET_FRAME, DYNHET_SIM_STATUS       the sim
+//   DYNHET_NODE_STATUS_<node>                         each node's status (overlap,
+//                                                     clusters, s4; recorder)
+//   DYNHET_OVERLAP_<a>, DYNHET_CHI4_<a>,              results, one channel per
+//   DYNHET_CLUSTERS_<a>, DYNHET_S4_<a>                cutoff a: <a> is cutoff_label
+//                                                     (a0.6), as in run.h5's groups
+//   DYNHET_MSD, DYNHET_DISPLACEMENT                   results of all cutoffs at once
+// The names are also LCM subscription patterns (regular expressions): a
+// channel with a cutoff holds a '.', so subscribe to the family
+// (channel_family) and compare names, never subscribe to a name.
 inline constexpr const char* kChanRun = "DYNHET_RUN";
 inline constexpr const char* kChanFrame = "DYNHET_FRAME";
 inline constexpr const char* kChanSimStatus = "DYNHET_SIM_STATUS";
-inline constexpr const char* kChanNodeStatus = "DYNHET_NODE_STATUS";
-inline constexpr const char* kChanOverlap = "DYNHET_OVERLAP";
-inline constexpr const char* kChanChi4 = "DYNHET_CHI4";
+inline constexpr const char* kChanNodeStatus = "DYNHET_NODE_STATUS"; // + "_<node>"
+inline constexpr const char* kChanOverlap = "DYNHET_OVERLAP";         // + "_<a>"
+inline constexpr const char* kChanChi4 = "DYNHET_CHI4";               // + "_<a>"
 inline constexpr const char* kChanMsd = "DYNHET_MSD";
-inline constexpr const char* kChanS4 = "DYNHET_S4";
-inline constexpr const char* kChanClusters = "DYNHET_CLUSTERS";
+inline constexpr const char* kChanS4 = "DYNHET_S4";                   // + "_<a>"
+inline constexpr const char* kChanClusters = "DYNHET_CLUSTERS";       // + "_<a>"
 inline constexpr const char* kChanDisplacement = "DYNHET_DISPLACEMENT";
+
+// "a0.6": how a cutoff names its results in channels and in run.h5 (six
+// significant digits; a scene's cutoffs must differ in their labels).
+inline std::string cutoff_label(double cutoff_a) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "a%g", cutoff_a);
+  return buf;
+}
+// The channel of one cutoff's results: DYNHET_OVERLAP_a0.6.
+inline std::string cutoff_channel(const char* family, double cutoff_a) {
+  return std::string(family) + "_" + cutoff_label(cutoff_a);
+}
+// The channel of one node's status: DYNHET_NODE_STATUS_overlap.
+inline std::string node_status_channel(const std::string& node) {
+  return std::string(kChanNodeStatus) + "_" + node;
+}
+// An LCM subscription pattern for every channel of a family, and for
+// names outside the scheme that start like it (the bare family name of
+// older builds, say), so that those are dropped and counted, not unheard.
+inline std::string channel_family(const char* family) { return std::string(family) + ".*"; }
 
 } // namespace dynhet
