@@ -25,12 +25,21 @@ sleep 1
 xvfb-run -a bash -c 'bash "\$1" "\$2" --inputs "\$3" & echo \$! >"\$4"; wait' _ \
   "$root/launch_scripts/logplayer.sh" "$tmp/run.lcmlog" "\$url" "$tmp/player.pid" >"$tmp/player.log" 2>&1 &
 want=\$(/usr/bin/python3 "$tmp/events.py" "$tmp/run.lcmlog" | wc -l)
+# lcm-logger writes a message out only when the next one comes (or at its
+# end): once its file has stopped growing for 3 s the player is through,
+# and SIGINT makes the logger write what it holds.
+last=-1 still=0
 for _ in \$(seq 120); do
   sleep 0.5
-  [[ -f "$tmp/played.lcmlog" ]] && (( \$(/usr/bin/python3 "$tmp/events.py" "$tmp/played.lcmlog" | wc -l) >= want )) && break
+  got=\$( [[ -f "$tmp/played.lcmlog" ]] && /usr/bin/python3 "$tmp/events.py" "$tmp/played.lcmlog" | wc -l || echo 0)
+  (( got >= want )) && break
+  if (( got > 0 && got == last )); then ((++still)); else still=0; fi
+  (( still >= 6 )) && break
+  last=\$got
 done
-sleep 1
-kill \$(cat "$tmp/player.pid") \$logger 2>/dev/null || true
+kill -INT \$logger 2>/dev/null || true
+wait \$logger 2>/dev/null || true
+kill \$(cat "$tmp/player.pid") 2>/dev/null || true
 wait 2>/dev/null || true
 SH
 # The inputs of a log, one line per event: channel and a hash of its bytes.
