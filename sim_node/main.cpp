@@ -672,12 +672,15 @@ int main(int argc, char** argv) {
         chunk.position.assign(xy.begin() + 2 * ranges[c].first,
                               xy.begin() + 2 * (ranges[c].first + ranges[c].count));
         lcm.publish(dynhet::kChanFrame, &chunk);
-        // Pace multi-chunk frames so receivers' socket buffers keep up: at
-        // most about 440 MB/s (300 us per 8192-particle chunk, whatever
-        // the chunk size: a pause per chunk let 1 MB chunks go out at 3
-        // GB/s, and a receiver on a busy core lost datagrams at N = 10^6).
+        // Pace multi-chunk frames so receivers' socket buffers keep up:
+        // 300 us after a chunk of up to 8192 particles (an unpaced
+        // lcm-logger keeps up with small chunks at that pace: at 5 us per
+        // 128-particle chunk it lost 4 of 56 frames), and in proportion
+        // beyond, about 440 MB/s (300 us per chunk whatever its size let 1
+        // MB chunks go out at 3 GB/s, and a receiver on a busy core lost
+        // datagrams at N = 10^6).
         if (ranges.size() > 1)
-          std::this_thread::sleep_for(std::chrono::microseconds(300 * ranges[c].count / 8192 + 1));
+          std::this_thread::sleep_for(std::chrono::microseconds(300 * std::max(1, ranges[c].count / 8192)));
       }
       publish_seconds += seconds_since(t_publish);
       bytes_published += 16.0 * static_cast<double>(eng.size());
