@@ -86,8 +86,13 @@ print(int(f.attrs['messages_rejected_recorder']), t(f.attrs['last_rejection_reco
 echo "relayed ${relayed:-?} messages on other sources' channels; the recorder dropped $dropped (last: $last)"
 check '[[ $rc == 0 ]] && complete "$tmp/relayed/run.h5"' "relayed run: complete (run_scene.sh exit $rc)"
 # Each copy reaches the recorder over loopback (its queues hold them all),
-# but for the last few: those the relay sent after the recorder had closed.
-check '(( ${relayed:-0} > 300 && dropped <= relayed && dropped >= relayed - 10 )) && [[ $last == *channel,_which_is* ]]' \
+# but for the last few: copies of the final messages that arrive while the
+# recorder closes (it ends once the run is complete, with what is still
+# queued behind the last final unread; 2-11 of 496 in runs seen on a busy
+# machine, so up to 5% here), and those the relay sends before it hears the
+# recorder's "done" (it relays nothing after that). None may be taken:
+# the results are checked bit for bit below.
+check '(( ${relayed:-0} > 300 && dropped <= relayed && 20 * dropped >= 19 * relayed )) && [[ $last == *channel,_which_is* ]]' \
   "relayed run: the recorder dropped and counted every copy on another source's channel"
 check 'same "$tmp/clean/run.h5" "$tmp/relayed/run.h5"' "relayed run: results equal the clean run's bit for bit"
 

@@ -149,6 +149,15 @@ public:
 
 private:
   void on_message(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+    // Once the recorder has said it is done, copies would only count as
+    // relayed without a recorder to drop them: stop.
+    if (ch == "DYNHET_NODE_STATUS_recorder") {
+      dynhet::node_status_t m;
+      if (m.decode(rb->data, 0, static_cast<int>(rb->data_size)) > 0 && (m.state == "done" || m.state == "failed"))
+        recorder_done_ = true;
+      return;
+    }
+    if (recorder_done_) return;
     const std::string to = other_source(ch);
     if (to.empty()) return;
     const auto* p = static_cast<const char*>(rb->data);
@@ -159,6 +168,7 @@ private:
   lcm::LCM& lcm_;
   std::set<std::string> seen_;
   long relayed_ = 0;
+  bool recorder_done_ = false;
 };
 
 } // namespace
