@@ -90,7 +90,8 @@ int main(int argc, char** argv) {
       if (tf >= rows[row]) {
         const double cpu = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
         const auto r = acc.result();
-        const double f = (n - 1.0) / n, zm = 1 + f * z[row].mean(), ze = f * z[row].standard_error();
+        const double zm = dynhet::engine::reduced_pressure_from_ratio(z[row].mean(), n),
+                     ze = (n - 1.0) / n * z[row].standard_error();
         std::printf("%6.3f %8.0f %8.1f %9.4f %9.4f %8.3f %10.4f %10.4f %8.3f\n", phi, rows[row] - t_eq, cpu, zm, ze,
                     100 * ze / zm, r.tau_alpha, r.tau_alpha_err, 100 * r.tau_alpha_err / r.tau_alpha);
         std::fflush(stdout);

@@ -56,7 +56,7 @@ int main(int argc, char** argv) {
         c0 = c, t0 = e.time();
       }
       const double f = (n - 1.0) / n;
-      std::printf("%6.3f %7ld %10.1f %12.5f %10.5f %16.5f %14.5f\n", phi, n, t_run, 1 + f * z.mean(),
+      std::printf("%6.3f %7ld %10.1f %12.5f %10.5f %16.5f %14.5f\n", phi, n, t_run, dynhet::engine::reduced_pressure_from_ratio(z.mean(), n),
                   f * z.standard_error(), f * (1 + z.mean()), 1 + z.mean());
     }
 }

@@ -200,8 +200,14 @@ void Session::take_run(const dynhet::run_info_t &m) {
     return;
   }
   last_sim_ = last_progress_ = Clock::now();
-  std::fprintf(stderr, "recorder: run %lld, N=%d, %d frames%s -> %s\n", static_cast<long long>(m.run_id),
+  // Its socket gets every frame's datagrams, kept or not (results arrive
+  // between them): a buffer that holds a whole frame, as the nodes ask.
+  const int64_t got =
+      dynhet::grow_udp_receive_buffers(dynhet::frame_receive_buffer_bytes(m.n_particles, m.chunk_particles));
+  std::fprintf(stderr, "recorder: run %lld, N=%d, %d frames%s -> %s", static_cast<long long>(m.run_id),
                m.n_particles, m.n_frames, m.keep_frames ? " (kept)" : "", opt_.out.c_str());
+  if (got >= 0) std::fprintf(stderr, ", socket buffer %.1f MiB", got / 1048576.0);
+  std::fprintf(stderr, "\n");
 }
 
 void Session::take_sim(const dynhet::sim_status_t &m) {

@@ -4,7 +4,6 @@
 
 #include <cstdio>
 
-#include "dynhet/flow_control.hpp"
 #include "dynhet/lcm_url.hpp"
 #include "dynhet/model.hpp"
 
@@ -109,9 +108,6 @@ bool RunRecorder::on_run(const run_info_t &m) {
       std::make_unique<H5mdWriter>(out_path_, "dynhet recorder", creator_version_, author_, author_email_);
   info_ = std::make_unique<run_info_t>(m);
   assembler_.expect(m.n_particles, m.n_frames, m.chunk_particles);
-  // Its socket gets every frame's datagrams, kept or not (results arrive
-  // between them): a buffer that holds a whole frame, as the nodes ask.
-  grow_udp_receive_buffers(frame_receive_buffer_bytes(m.n_particles, m.chunk_particles));
   writer_->set_auto_flush(false); // one flush per message, in guarded()
   completion_ = Completion(m.observables, m.cutoff_a);
   write_run_info(m);

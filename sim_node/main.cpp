@@ -122,7 +122,7 @@ public:
     const double dpub = e.time() - last_sim_;
     msg_.collisions_per_second = dt > 0 && c.collisions >= last_coll_ ? (c.collisions - last_coll_) / dt : 0;
     const double f = (n - 1.0) / n;
-    msg_.reduced_pressure = 1.0 + f * pressure_.mean();
+    msg_.reduced_pressure = dynhet::engine::reduced_pressure_from_ratio(pressure_.mean(), n);
     msg_.reduced_pressure_err = f * pressure_.standard_error();
     msg_.collision_frequency = frequency_.mean();
     msg_.collision_frequency_err = frequency_.standard_error();

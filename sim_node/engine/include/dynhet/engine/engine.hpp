@@ -128,8 +128,12 @@ struct Counters {
 // system over N T, low by exactly 1/N (-0.0045 at N = 224). Both are
 // resolved by high-precision data (bench/pressure_reference.py).
 inline double temperature(double ke_per_particle, long n) { return ke_per_particle * n / (n - 1.0); }
+// Z from x = virial / (2 dt K), or from a mean of such ratios (sim_node
+// averages the virial and K dt over blocks first); its error is (N-1)/N
+// times x's.
+inline double reduced_pressure_from_ratio(double x, long n) { return 1.0 + (n - 1.0) / n * x; }
 inline double reduced_pressure(double virial, double dt, long n, double ke_per_particle) {
-  return 1.0 + (n - 1.0) / n * virial / (2.0 * n * ke_per_particle * dt);
+  return reduced_pressure_from_ratio(virial / (2.0 * n * ke_per_particle * dt), n);
 }
 
 // Everything needed to continue a run exactly: written to checkpoints.
