@@ -11,8 +11,9 @@
 //   - messages of another run (run info, chunks, a "done" status).
 // Every one of them must be dropped (and counted) by every receiver; the
 // run's results must equal a clean run's bit for bit. With --forge-done it
-// also sends a well-formed "done" status of this run (a forgery no check
-// can tell from the sim's), which must not end a node before its frames.
+// also sends a well-formed "done" status of this run, saying INT32_MAX or -7
+// frames are out (a forgery no check can tell from the sim's), which must
+// not end a node before its frames nor make it give up frames.
 //
 // With --relay it sends nothing of its own: it republishes every result and
 // node status of the run, byte for byte, on another source's channel (the
@@ -232,7 +233,10 @@ int main(int argc, char** argv) {
     done.phase = "done";
     lcm.publish("DYNHET_SIM_STATUS", &done);
     if (forge_done) {
+      // This run's "done", saying every frame (or a negative count) is out:
+      // nodes must neither end early nor give up frames still coming.
       done.run_id = run;
+      done.frames_published = rounds % 2 ? INT32_MAX : -7;
       lcm.publish("DYNHET_SIM_STATUS", &done);
     }
     ++rounds;
