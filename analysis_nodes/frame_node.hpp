@@ -38,6 +38,15 @@
 
 namespace dynhet {
 
+// The mean time between the run's origins (0 with fewer than two): the
+// jackknife blocks of origins span the longest lag an estimate uses
+// (analysis::origin_block). run_info_problem has checked the indices.
+inline double origin_spacing(const run_info_t& m) {
+  if (m.n_origins < 2) return 0;
+  const double first = m.frame_time[m.origin_frame.front()], last = m.frame_time[m.origin_frame.back()];
+  return (last - first) / (m.n_origins - 1);
+}
+
 class FrameNode {
 public:
   using Clock = std::chrono::steady_clock;

@@ -46,7 +46,7 @@ public:
 private:
   void start(const dynhet::run_info_t& m) override {
     grid_ = an::make_subbox_grid(m.n_particles, m.box_length, m.overlap_subbox_particles);
-    for (int c = 0; c < m.n_cutoffs; ++c) acc_.emplace_back(m.n_origins, m.lag_time);
+    for (int c = 0; c < m.n_cutoffs; ++c) acc_.emplace_back(m.n_origins, m.lag_time, dynhet::origin_spacing(m));
     want_chi4_ = wants("chi4");
     want_msd_ = wants("msd");
     const bool want_displacement = wants("displacement");
@@ -99,10 +99,9 @@ private:
     const auto p = fit(r.q);
     m.beta = p[0], m.tau0 = p[1];
     if (std::isnan(m.beta)) return;
-    // Blocks of 1 and 2 origins: blocks as long as the longest lag fitted
-    // (2 blocks of 4 origins in studies/seeds.toml) gave errors too noisy
-    // to be of use (spread/error 2.2 against 1.7).
-    const auto e = an::origin_jackknife(acc.table(), acc.n_origins(), static_cast<int>(r.q.size()), fit);
+    // Blocks spanning the longest lag fitted (origin_block).
+    const int block = an::origin_block(info().lag_time[lags.back()], acc.origin_spacing(), acc.n_origins());
+    const auto e = an::origin_jackknife(acc.table(), acc.n_origins(), static_cast<int>(r.q.size()), fit, block);
     if (e.size() == 2) m.beta_err = e[0], m.tau0_err = e[1];
   }
 
@@ -114,6 +113,13 @@ private:
     msd_all_.assign(pairs, std::numeric_limits<double>::quiet_NaN());
     msd_small_ = msd_all_;
     for (auto& v : msd_extreme_) v = msd_all_;
+    if (want_msd_) {
+      std::vector<int> nx, ny;
+      an::wave_vectors(kFlowModes, nx, ny);
+      n_modes_ = nx.size();
+      flow_t_.assign(pairs * n_modes_, std::numeric_limits<double>::quiet_NaN());
+      flow_l_ = flow_t_;
+    }
     if (displacement_) displacement_->configure(spec_);
     if (want_msd_) d2_.resize(m.n_particles);
     spec_.grids = an::nested_subbox_grids(m.n_particles, m.box_length, m.chi4_subbox_particles);
@@ -121,7 +127,7 @@ private:
     std::sort(spec_.cutoffs.begin(), spec_.cutoffs.end()); // the pass wants them ascending
     species_ = dynhet::species_by_rule(m.n_particles, m.n_small);
     for (const auto& g : spec_.grids)
-      for (size_t c = 0; c < spec_.cutoffs.size(); ++c) chi4_acc_.emplace_back(m.n_origins, m.lag_time, g);
+      for (size_t c = 0; c < spec_.cutoffs.size(); ++c) chi4_acc_.emplace_back(m.n_origins, m.lag_time, g, dynhet::origin_spacing(m));
   }
   void add_pass(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) {
     const long n = info().n_particles;
@@ -137,6 +143,10 @@ private:
                                                            msd_spec_.fraction_small, select_);
       msd_extreme_[0][kj] = all.fast, msd_extreme_[1][kj] = all.slow;
       msd_extreme_[2][kj] = small.fast, msd_extreme_[3][kj] = small.slow;
+      const an::WaveModes w = an::collective_modes(pos0.data(), f.position.data(), n, info().box_length, kFlowModes,
+                                                   pass_.msd_all);
+      std::copy(w.transverse.begin(), w.transverse.end(), flow_t_.begin() + kj * n_modes_);
+      std::copy(w.longitudinal.begin(), w.longitudinal.end(), flow_l_.begin() + kj * n_modes_);
     }
     if (displacement_) displacement_->add(k, j, pass_, pass_.n_small);
   }
@@ -171,7 +181,7 @@ private:
     origin_mean(msd_extreme_[1], m.msd_slow_all, m.msd_slow_all_err);
     origin_mean(msd_extreme_[2], m.msd_fast_small, m.msd_fast_small_err);
     origin_mean(msd_extreme_[3], m.msd_slow_small, m.msd_slow_small_err);
-    m.diffusion = m.diffusion_err = std::numeric_limits<double>::quiet_NaN();
+    m.diffusion = m.diffusion_err = m.diffusion_flow = m.diffusion_flow_err = std::numeric_limits<double>::quiet_NaN();
     if (std::isfinite(m.fit_t_min) && m.fit_t_min < m.fit_t_max) {
       // Unweighted over the range, the error from a jackknife over blocks
       // of origins (the lags of one origin are correlated).
@@ -180,14 +190,42 @@ private:
         return std::vector<double>{d.n >= 3 ? d.d : std::numeric_limits<double>::quiet_NaN()};
       };
       m.diffusion = fit(m.msd_all)[0];
-      // Blocks of 1 and 2 origins. Blocks as long as the fit's longest lag
-      // (origins closer than that measure overlapping windows) did not
-      // help: D's spread between seeds lies beyond a run (docs/analysis.md).
-      const auto e = an::origin_jackknife(msd_all_, info().n_origins, static_cast<int>(m.lag_time.size()), fit);
+      // Blocks spanning the fit's longest lag (origin_block).
+      const int block = an::origin_block(m.fit_t_max, dynhet::origin_spacing(info()), info().n_origins);
+      const auto e = an::origin_jackknife(msd_all_, info().n_origins, static_cast<int>(m.lag_time.size()), fit, block);
       if (std::isfinite(m.diffusion) && e.size() == 1) m.diffusion_err = e[0];
+      flow_part(m);
+      // The flows frozen over the run vary between runs, not between its
+      // blocks of origins: their spread adds to the jackknife's.
+      if (std::isfinite(m.diffusion_flow_err)) m.diffusion_err = std::hypot(m.diffusion_err, m.diffusion_flow_err);
     }
     out().publish(dynhet::kChanMsd, &m);
   }
+  // D_flow = sum over the modes of c = the slope / 4 of the mode's MSD
+  // share over D's fit range, and its spread between runs: a mode frozen
+  // over the run has a Gaussian amplitude, so c is exponential (variance
+  // c^2, and E c^2 = 2 var): var = sum c^2 / 2. Measured in 12 seeds of
+  // N = 4096, phi = 0.76 (docs/analysis.md): D_flow is a third of D, D - D_flow
+  // scatters as the jackknife says, D itself 3.2 times more.
+  void flow_part(dynhet::msd_t& m) const {
+    const size_t nj = m.lag_time.size();
+    double sum = 0, var = 0;
+    std::vector<double> mean_t, mean_l, err;
+    for (size_t q = 0; q < n_modes_; ++q) {
+      std::vector<double> t(nj * info().n_origins), l(t.size());
+      for (size_t kj = 0; kj < t.size(); ++kj) t[kj] = flow_t_[kj * n_modes_ + q], l[kj] = flow_l_[kj * n_modes_ + q];
+      origin_mean(t, mean_t, err);
+      origin_mean(l, mean_l, err);
+      for (const auto* v : {&mean_t, &mean_l}) {
+        const auto d = an::fit_diffusion(m.lag_time, *v, m.fit_t_min, m.fit_t_max);
+        if (d.n < 3 || !std::isfinite(d.d)) return;
+        sum += d.d, var += d.d * d.d / 2;
+      }
+    }
+    if (n_modes_ == 0) return;
+    m.diffusion_flow = sum, m.diffusion_flow_err = std::sqrt(var);
+  }
+
   void publish_chi4(bool final) {
     const size_t nc = spec_.cutoffs.size(), ng = spec_.grids.size(), nj = info().lag_time.size();
     for (size_t c = 0; c < nc; ++c) {
@@ -266,6 +304,9 @@ private:
   bool pass_on_ = false, want_chi4_ = false, want_msd_ = false;
   std::vector<double> msd_all_, msd_small_; // per (origin, lag)
   std::vector<double> msd_extreme_[4];       // per (origin, lag): fast all, slow all, fast small, slow small
+  static constexpr int kFlowModes = 4;       // |n| <= 4: waves of L / 4 and longer
+  size_t n_modes_ = 0;
+  std::vector<double> flow_t_, flow_l_;      // per (origin, lag, mode): collective_modes
   std::vector<double> d2_, select_;          // |dr|^2 of the pair; the selection's buffer
   dynhet::Scene::Msd msd_spec_;
   std::unique_ptr<dynhet::DisplacementResults> displacement_;

@@ -912,6 +912,12 @@ def run_local(sd, jobs):
             except StudyInterrupted as e:
                 st = {"state": "interrupted", "message": str(e)}
                 write_status(sd.run_dir(p), dict(st, **{a: p[a] for a in AXES}))
+            except OSError as e:
+                # A program that cannot be started (a build replacing it
+                # meanwhile, a full disk): this run failed, the study goes on
+                # (the same command again reruns it).
+                st = {"state": "failed", "message": f"{type(e).__name__}: {e}"}
+                write_status(sd.run_dir(p), dict(st, **{a: p[a] for a in AXES}))
             with lock:
                 state["running"] -= 1
                 if st.get("state") == "complete":

@@ -266,6 +266,8 @@ void RunRecorder::write_msd(const msd_t &m) {
   for (const auto &[name, v] : per_lag) writer_->append_observable("msd/" + std::string(name), at, *v);
   writer_->append_scalar("msd/diffusion", at, m.diffusion);
   writer_->append_scalar("msd/diffusion_err", at, m.diffusion_err);
+  writer_->append_scalar("msd/diffusion_flow", at, m.diffusion_flow);
+  writer_->append_scalar("msd/diffusion_flow_err", at, m.diffusion_flow_err);
   writer_->append_scalar("msd/fit_t_min", at, m.fit_t_min);
   writer_->append_scalar("msd/fit_t_max", at, m.fit_t_max);
 }

@@ -134,6 +134,26 @@ TEST(Chi4, PeakOfAParabolaInLnTIsExact) {
   EXPECT_NEAR(p.y, 12.0, 1e-10);
 }
 
+TEST(Chi4, PeakAtGivenLagsKeepsItsParabola) {
+  // A flat top: the largest point moves from lag 10 to lag 11 when y[11]
+  // rises a little; peak_at(…, 10) keeps the parabola through 9, 10, 11 and
+  // moves its vertex continuously, find_peak jumps to 10, 11, 12.
+  std::vector<double> t, y;
+  for (int j = 0; j <= 20; ++j) t.push_back(std::pow(10.0, j / 8.0));
+  for (double x : t) y.push_back(5.0 - 0.1 * std::pow(std::log(x) - 0.5 * (std::log(t[10]) + std::log(t[11])), 2));
+  y[10] += 1e-6;
+  ASSERT_EQ(peak_index(y), 10);
+  const Peak a = peak_at(t, y, 10);
+  y[11] += 2e-6;
+  ASSERT_EQ(peak_index(y), 11);
+  const Peak b = peak_at(t, y, 10), c = find_peak(t, y);
+  EXPECT_NEAR(std::log(b.t), std::log(a.t), 1e-3);
+  EXPECT_NEAR(b.y, a.y, 1e-5);
+  EXPECT_EQ(c.t, peak_at(t, y, 11).t);
+  EXPECT_FALSE(peak_at(t, y, 0).interior);
+  EXPECT_TRUE(std::isnan(peak_at(t, y, -1).y));
+}
+
 TEST(Chi4, TauAlphaPerWaitingTime) {
   // Origin k decays as exp(-t/tau_k): its own tau_alpha is tau_k, to the
   // accuracy of linear interpolation in ln t over 1/40 decade (< 1e-3 relative).

@@ -292,3 +292,31 @@ TEST(Displacement, SampledExtremesFallBackWhereTheSampleMisleads) {
   std::vector<std::uint8_t> large(n, 1);
   expect_extremes_match_sort(d2, large, 0.1, 0.2, buffer, "no small");
 }
+
+TEST(Displacement, CollectiveModesCarryAFlowAndNothingElse) {
+  // Independent displacements (sd 0.3) plus a shear flow A sin(2 pi y / L)
+  // along x (transverse, n = (0, 1)) and a compression wave B cos(4 pi x / L)
+  // along x (longitudinal, n = (2, 0)). 2 |u_k . e|^2 - MSD/N of each mode
+  // is A^2 / 2 and B^2 / 2 there and 0 elsewhere, up to the noise of N
+  // independent displacements (MSD / N per mode, about 2e-5 here) and, on
+  // the two waves, the sampling of the wave by N random positions (relative
+  // error of u_k about 1 / sqrt(N), so 3 x 2 / sqrt(N) of A^2 / 2 at most).
+  System s = random_system(20000, 40.0, 0.3, 11);
+  const double a = 0.5, b = 0.2, two_pi_l = 2 * M_PI / s.box;
+  double msd = 0;
+  for (long i = 0; i < s.n; ++i) {
+    s.pt[2 * i] += a * std::sin(two_pi_l * s.p0[2 * i + 1]) + b * std::cos(2 * two_pi_l * s.p0[2 * i]);
+    msd += (std::pow(s.pt[2 * i] - s.p0[2 * i], 2) + std::pow(s.pt[2 * i + 1] - s.p0[2 * i + 1], 2)) / s.n;
+  }
+  const WaveModes w = collective_modes(s.p0.data(), s.pt.data(), s.n, s.box, 3, msd);
+  ASSERT_EQ(w.nx.size(), 14u); // 28 lattice points with 0 < |n| <= 3, one of each pair
+  const double noise = 8 * msd / s.n; // 8 x the per-mode floor
+  for (size_t k = 0; k < w.nx.size(); ++k) {
+    const bool shear = w.nx[k] == 0 && w.ny[k] == 1, wave = w.nx[k] == 2 && w.ny[k] == 0;
+    const double sampling = 6 / std::sqrt(double(s.n));
+    EXPECT_NEAR(w.transverse[k], shear ? a * a / 2 : 0.0, noise + (shear ? sampling * a * a / 2 : 0))
+        << w.nx[k] << "," << w.ny[k];
+    EXPECT_NEAR(w.longitudinal[k], wave ? b * b / 2 : 0.0, noise + (wave ? sampling * b * b / 2 : 0))
+        << w.nx[k] << "," << w.ny[k];
+  }
+}

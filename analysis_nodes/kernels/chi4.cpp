@@ -1,5 +1,6 @@
 #include "dynhet/analysis/chi4.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -12,8 +13,9 @@ namespace {
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }
 
-Chi4Accumulator::Chi4Accumulator(int n_origins, std::vector<double> lag_time, const SubboxGrid& grid)
-    : n_origins_(n_origins), lag_(std::move(lag_time)), grid_(grid),
+Chi4Accumulator::Chi4Accumulator(int n_origins, std::vector<double> lag_time, const SubboxGrid& grid,
+                                 double origin_spacing)
+    : n_origins_(n_origins), lag_(std::move(lag_time)), grid_(grid), spacing_(origin_spacing),
       s1_(static_cast<size_t>(n_origins) * lag_.size(), kNaN), s2_(s1_) {}
 
 void Chi4Accumulator::add(int k, int j, double q_r_sum, double q_r_sum2) {
@@ -55,26 +57,28 @@ Chi4Accumulator::Result Chi4Accumulator::result() const {
       r.chi4_pooled_err[j] = jackknife_error(loo);
     }
   }
-  const Peak p = find_peak(lag_, nb > 1 ? r.chi4 : r.chi4_pooled); // chi4^P at tau4
+  const int best = peak_index(nb > 1 ? r.chi4 : r.chi4_pooled);
+  const Peak p = peak_at(lag_, nb > 1 ? r.chi4 : r.chi4_pooled, best); // chi4^P at tau4
   r.chi4_peak = p.y, r.tau4 = p.t;
   r.chi4_peak_err = r.tau4_err = kNaN;
   if (std::isnan(p.y)) return r;
   // Their errors: a jackknife over blocks of origins (fits.hpp,
-  // origin_jackknife), the peak found again in each replicate.
+  // origin_jackknife), blocks spanning the last lag of the parabola, the
+  // vertex through the same three lags in every replicate.
   const int nl = static_cast<int>(nj);
+  const int block = origin_block(lag_[std::min(best + 1, nl - 1)], spacing_, n_origins_);
   std::vector<double> e;
   if (nb > 1) {
     std::vector<double> c(s1_.size(), kNaN); // per-origin chi4, the terms of eq. (14)
     for (size_t i = 0; i < c.size(); ++i)
       if (!std::isnan(s1_[i])) c[i] = big_n * (s2_[i] / nb - (s1_[i] / nb) * (s1_[i] / nb));
     e = origin_jackknife(c, n_origins_, nl, [&](const std::vector<double>& chi4) {
-      const Peak q = find_peak(lag_, chi4);
+      const Peak q = peak_at(lag_, chi4, best);
       return std::vector<double>{q.y, q.t};
-    });
+    }, block);
   } else {
     // The whole box: the pooled variance is no mean over origins, so the
-    // replicates are made here, with the same blocks (1 and 2 origins, the
-    // larger error).
+    // replicates (the same blocks) are made here.
     std::vector<int> used;
     for (int k = 0; k < n_origins_; ++k)
       for (size_t j = 0; j < nj; ++j)
@@ -83,9 +87,9 @@ Chi4Accumulator::Result Chi4Accumulator::result() const {
           break;
         }
     const int u = static_cast<int>(used.size());
-    for (int b : {1, 2}) {
-      const int blocks = (u + b - 1) / b;
-      if (blocks < (b == 1 ? 3 : 4)) continue;
+    const int b = std::clamp(block, 1, std::max(1, u / 2));
+    const int blocks = (u + b - 1) / b;
+    if (blocks >= 3) {
       std::vector<double> ys, ts;
       for (int blk = 0; blk < blocks; ++blk) {
         std::vector<double> v(nj, kNaN);
@@ -100,13 +104,10 @@ Chi4Accumulator::Result Chi4Accumulator::result() const {
           }
           if (n > 1) v[j] = big_n * (t2 - t1 * t1 / n) / (n - 1);
         }
-        const Peak q = find_peak(lag_, v);
+        const Peak q = peak_at(lag_, v, best);
         ys.push_back(q.y), ts.push_back(q.t);
       }
-      const double ey = jackknife_error(ys), et = jackknife_error(ts);
-      if (e.empty()) e = {ey, et};
-      else e = {std::isnan(ey) || std::isnan(e[0]) ? kNaN : std::max(e[0], ey),
-                std::isnan(et) || std::isnan(e[1]) ? kNaN : std::max(e[1], et)};
+      e = {jackknife_error(ys), jackknife_error(ts)};
     }
   }
   if (e.size() == 2) r.chi4_peak_err = e[0], r.tau4_err = e[1];

@@ -2,6 +2,7 @@
 #include "dynhet/subbox.hpp"
 
 #include <algorithm>
+#include <complex>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -511,6 +512,45 @@ DisplacementDensity displacement_density(const DisplacementSpec& s, const std::v
     d.p.push_back(counts[b] / (double(n_total) * s.hist_width));
   }
   return d;
+}
+
+void wave_vectors(int n_max, std::vector<int>& nx, std::vector<int>& ny) {
+  nx.clear(), ny.clear();
+  for (int b = 0; b <= n_max; ++b)
+    for (int a = -n_max; a <= n_max; ++a)
+      if ((b > 0 || a > 0) && a * a + b * b <= n_max * n_max) nx.push_back(a), ny.push_back(b);
+}
+
+WaveModes collective_modes(const double* pos0, const double* pos_t, long n, double box, int n_max, double msd) {
+  using C = std::complex<double>;
+  WaveModes w;
+  wave_vectors(n_max, w.nx, w.ny);
+  const size_t m = w.nx.size();
+  std::vector<C> ux(m), uy(m), px(2 * n_max + 1), py(n_max + 1);
+  const double two_pi_l = 2 * 3.14159265358979323846 / box;
+  for (long i = 0; i < n; ++i) {
+    const double x = pos0[2 * i], y = pos0[2 * i + 1];
+    const double dx = pos_t[2 * i] - x, dy = pos_t[2 * i + 1] - y;
+    // exp(-i k . r) = exp(-i 2 pi a x / L) exp(-i 2 pi b y / L), a = -n_max..n_max, b = 0..n_max
+    const C ex = std::polar(1.0, -two_pi_l * x), ey = std::polar(1.0, -two_pi_l * y);
+    px[n_max] = 1, py[0] = 1;
+    for (int a = 1; a <= n_max; ++a) px[n_max + a] = px[n_max + a - 1] * ex, px[n_max - a] = std::conj(px[n_max + a]);
+    for (int b = 1; b <= n_max; ++b) py[b] = py[b - 1] * ey;
+    for (size_t k = 0; k < m; ++k) {
+      const C e = px[n_max + w.nx[k]] * py[w.ny[k]];
+      ux[k] += dx * e, uy[k] += dy * e;
+    }
+  }
+  w.transverse.resize(m), w.longitudinal.resize(m);
+  const double floor = msd / double(n);
+  for (size_t k = 0; k < m; ++k) {
+    const double kn = std::hypot(double(w.nx[k]), double(w.ny[k]));
+    const double ex = w.nx[k] / kn, ey = w.ny[k] / kn; // k-hat; the transverse direction is (-ey, ex)
+    const C ul = (ux[k] * ex + uy[k] * ey) / double(n), ut = (-ux[k] * ey + uy[k] * ex) / double(n);
+    w.longitudinal[k] = 2 * std::norm(ul) - floor;
+    w.transverse[k] = 2 * std::norm(ut) - floor;
+  }
+  return w;
 }
 
 } // namespace dynhet::analysis

@@ -86,7 +86,7 @@ double jackknife_error(const std::vector<double>& x) {
 
 std::vector<double> origin_jackknife(const std::vector<double>& table, int n_origins, int n_lags,
                                      const std::function<std::vector<double>(const std::vector<double>&)>& estimate,
-                                     int min_block) {
+                                     int block) {
   std::vector<int> used;
   for (int k = 0; k < n_origins; ++k)
     for (int j = 0; j < n_lags; ++j)
@@ -94,35 +94,35 @@ std::vector<double> origin_jackknife(const std::vector<double>& table, int n_ori
         used.push_back(k);
         break;
       }
-  std::vector<double> err;
   const int u = static_cast<int>(used.size());
-  const int b1 = std::clamp(min_block, 1, std::max(1, u / 2));
-  for (int b : {b1, 2 * b1}) {
-    const int blocks = (u + b - 1) / b;
-    if (blocks < (b == b1 ? 2 : 4)) continue;
-    std::vector<std::vector<double>> rep; // [estimate][block]
-    for (int blk = 0; blk < blocks; ++blk) {
-      std::vector<char> skip(n_origins, 0);
-      for (int i = blk * b; i < std::min(u, (blk + 1) * b); ++i) skip[used[i]] = 1;
-      std::vector<double> mean(n_lags, std::numeric_limits<double>::quiet_NaN());
-      for (int j = 0; j < n_lags; ++j) {
-        double s = 0;
-        int n = 0;
-        for (int k : used)
-          if (const double v = table[size_t(k) * n_lags + j]; !skip[k] && !std::isnan(v)) s += v, ++n;
-        if (n) mean[j] = s / n;
-      }
-      const std::vector<double> e = estimate(mean);
-      rep.resize(e.size());
-      for (size_t i = 0; i < e.size(); ++i) rep[i].push_back(e[i]);
+  if (u < 2) return {};
+  const int b = std::clamp(block, 1, std::max(1, u / 2));
+  const int blocks = (u + b - 1) / b;
+  std::vector<std::vector<double>> rep; // [estimate][block]
+  for (int blk = 0; blk < blocks; ++blk) {
+    std::vector<char> skip(n_origins, 0);
+    for (int i = blk * b; i < std::min(u, (blk + 1) * b); ++i) skip[used[i]] = 1;
+    std::vector<double> mean(n_lags, std::numeric_limits<double>::quiet_NaN());
+    for (int j = 0; j < n_lags; ++j) {
+      double s = 0;
+      int n = 0;
+      for (int k : used)
+        if (const double v = table[size_t(k) * n_lags + j]; !skip[k] && !std::isnan(v)) s += v, ++n;
+      if (n) mean[j] = s / n;
     }
-    err.resize(rep.size(), 0.0);
-    for (size_t i = 0; i < rep.size(); ++i) {
-      const double e = jackknife_error(rep[i]);
-      err[i] = std::isnan(e) || std::isnan(err[i]) ? std::numeric_limits<double>::quiet_NaN() : std::max(err[i], e);
-    }
+    const std::vector<double> e = estimate(mean);
+    rep.resize(e.size());
+    for (size_t i = 0; i < e.size(); ++i) rep[i].push_back(e[i]);
   }
+  std::vector<double> err(rep.size());
+  for (size_t i = 0; i < rep.size(); ++i) err[i] = jackknife_error(rep[i]);
   return err;
+}
+
+int origin_block(double longest_lag, double origin_spacing, int n_origins) {
+  if (!(origin_spacing > 0) || !std::isfinite(longest_lag) || !(longest_lag > 0)) return 1;
+  const int span = static_cast<int>(std::ceil(longest_lag / origin_spacing - 1e-9));
+  return std::clamp(span, 1, std::max(1, n_origins / kMinJackknifeBlocks));
 }
 
 std::vector<int> overlap_fit_lags(const std::vector<double>& q, double q_lo, double q_hi) {

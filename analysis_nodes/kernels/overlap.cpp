@@ -53,8 +53,8 @@ double crossing_time(const std::vector<double>& t, const std::vector<double>& q,
   return kNaN;
 }
 
-OverlapAccumulator::OverlapAccumulator(int n_origins, std::vector<double> lag_time)
-    : n_origins_(n_origins), lag_(std::move(lag_time)),
+OverlapAccumulator::OverlapAccumulator(int n_origins, std::vector<double> lag_time, double origin_spacing)
+    : n_origins_(n_origins), lag_(std::move(lag_time)), spacing_(origin_spacing),
       q_(static_cast<size_t>(n_origins) * lag_.size(), kNaN),
       var_(static_cast<size_t>(n_origins) * lag_.size(), kNaN) {}
 
@@ -108,10 +108,17 @@ OverlapAccumulator::Result OverlapAccumulator::result() const {
   const double level = std::exp(-1.0); // Q(tau_alpha) = 1/e
   r.tau_alpha = crossing_time(lag_, r.q, level);
 
-  // Jackknife over blocks of the origins that contributed.
+  // Jackknife over blocks of the origins that contributed, each block
+  // spanning the lag just beyond the crossing (the longest one it reads).
+  double longest = kNaN;
+  for (double t : lag_)
+    if (t >= r.tau_alpha) {
+      longest = t;
+      break;
+    }
   const auto e = origin_jackknife(q_, n_origins_, static_cast<int>(nj), [&](const std::vector<double>& q) {
     return std::vector<double>{crossing_time(lag_, q, level)};
-  });
+  }, origin_block(longest, spacing_, n_origins_));
   r.tau_alpha_err = std::isnan(r.tau_alpha) || e.empty() ? kNaN : e[0];
   return r;
 }

@@ -20,12 +20,11 @@ std::vector<double> tau_alpha_per_origin(const OverlapAccumulator& acc, const st
   return tau;
 }
 
-Peak find_peak(const std::vector<double>& t, const std::vector<double>& y) {
-  int best = -1;
-  for (size_t j = 0; j < y.size(); ++j)
-    if (std::isfinite(y[j]) && (best < 0 || y[j] > y[best])) best = static_cast<int>(j);
-  if (best < 0) return {kNaN, kNaN, false};
+Peak find_peak(const std::vector<double>& t, const std::vector<double>& y) { return peak_at(t, y, peak_index(y)); }
+
+Peak peak_at(const std::vector<double>& t, const std::vector<double>& y, int best) {
   const int n = static_cast<int>(y.size());
+  if (best < 0 || best >= n || !std::isfinite(y[best])) return {kNaN, kNaN, false};
   if (best == 0 || best == n - 1 || !std::isfinite(y[best - 1]) || !std::isfinite(y[best + 1]))
     return {t[best], y[best], false};
   // Parabola through (ln t, y) at the three lags; its vertex.
@@ -37,6 +36,13 @@ Peak find_peak(const std::vector<double>& t, const std::vector<double>& y) {
   const double xv = -b / (2 * c);
   const double yv = y0 + d01 * (xv - x0) + c * (xv - x0) * (xv - x1);
   return {std::exp(xv), yv, true};
+}
+
+int peak_index(const std::vector<double>& y) {
+  int best = -1;
+  for (size_t j = 0; j < y.size(); ++j)
+    if (std::isfinite(y[j]) && (best < 0 || y[j] > y[best])) best = static_cast<int>(j);
+  return best;
 }
 
 int nearest_lag(const std::vector<double>& lag_time, double t) {

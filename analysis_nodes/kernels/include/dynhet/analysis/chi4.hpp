@@ -14,7 +14,9 @@ namespace dynhet::analysis {
 // sum_r Q_r and sum_r Q_r^2 that displacement_pass returns.
 class Chi4Accumulator {
 public:
-  Chi4Accumulator(int n_origins, std::vector<double> lag_time, const SubboxGrid& grid);
+  // origin_spacing: the time between origins, for the jackknife blocks of
+  // chi4^P and tau4 (origin_block); 0 if unknown (blocks of 1).
+  Chi4Accumulator(int n_origins, std::vector<double> lag_time, const SubboxGrid& grid, double origin_spacing = 0);
 
   void add(int k, int j, double q_r_sum, double q_r_sum2);
 
@@ -31,7 +33,9 @@ public:
     // chi4^P and tau4 (of chi4, or of chi4_pooled for one sub-box): the
     // vertex of the parabola in ln t through the largest point and its two
     // neighbours (the largest point itself at either end of the lags), with
-    // jackknife errors over blocks of origins (NaN below 3 origins).
+    // jackknife errors over blocks of origins (NaN below 3 origins): blocks
+    // span the last of the three lags (origin_block), and every replicate
+    // takes the vertex through the full data's three lags (peak_at).
     double chi4_peak, tau4, chi4_peak_err, tau4_err;
   };
   Result result() const;
@@ -41,6 +45,7 @@ private:
   int n_origins_;
   std::vector<double> lag_;
   SubboxGrid grid_;
+  double spacing_;
   std::vector<double> s1_, s2_; // per (origin, lag); NaN: not measured
 };
 

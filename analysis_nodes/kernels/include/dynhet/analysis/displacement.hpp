@@ -150,4 +150,26 @@ struct DisplacementDensity {
 DisplacementDensity displacement_density(const DisplacementSpec& spec, const std::vector<long>& counts,
                                          long n_total);
 
+// The displacement field's longest waves: for every wave vector
+// k = 2 pi n / L with 0 < |n| <= n_max (one of each pair n, -n), the
+// Fourier amplitude u_k = (1/N) sum_i dr_i exp(-i k . r_i(t0)) of one
+// (origin, lag) pair, split into its transverse (flow, shear) and
+// longitudinal parts. By Parseval the MSD is the sum of 2 |u_k|^2 over all
+// k; independent displacements give each part of each pair an expected
+// 2 |u_k . e|^2 = MSD / N, which is subtracted: what remains is the MSD the
+// collective motion at that wavelength carries. In a momentum-conserving
+// fluid the transverse modes decay as exp(-nu k^2 t), far slower than a run
+// at the smallest k of a large box: they are the long-lived flows behind
+// D's spread between runs (docs/analysis.md "D and the long-lived flows").
+struct WaveModes {
+  std::vector<int> nx, ny; // the n of each mode
+  std::vector<double> transverse, longitudinal; // 2 |u_k . e|^2 - MSD / N per mode
+};
+// The wave vectors of collective_modes, in its order.
+void wave_vectors(int n_max, std::vector<int>& nx, std::vector<int>& ny);
+// One pair's modes (positions unwrapped, x0 y0 x1 y1 ...; msd the pair's
+// mean squared displacement). O(N (2 n_max + 1)^2) operations: the phases
+// exp(i 2 pi x / L) once per particle, their powers by multiplication.
+WaveModes collective_modes(const double* pos0, const double* pos_t, long n, double box, int n_max, double msd);
+
 } // namespace dynhet::analysis

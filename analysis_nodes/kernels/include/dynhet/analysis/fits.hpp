@@ -32,20 +32,28 @@ double jackknife_error(const std::vector<double>& leave_one_out);
 // jackknife over blocks of consecutive origins: `table` holds the curve of
 // each origin (origin k, lag j at k * n_lags + j; NaN where not measured),
 // `estimate` maps an origin-averaged curve to the estimates. Every origin
-// with a measured lag counts. Blocks are `min_block` origins long and
-// twice that (the latter only if it leaves at least 4 blocks; never fewer
-// than 2 blocks), and the larger of the two errors is returned: origins
-// are correlated where the time windows they measure overlap (a lag longer
-// than their spacing) or where dynamic heterogeneity outlives the spacing,
-// which single-origin blocks miss; min_block should make a block at least
-// as long as the longest lag the estimate uses. Errors of lags taken one
-// by one and propagated through a fit would miss the correlation between
-// lags of the same origin as well (10 times too small for beta, tau0 and D
-// against the spread of seeds). NaN where an estimate is NaN in any
-// replicate; empty with fewer than 2 origins.
+// with a measured lag counts. Blocks are `block` origins long (shorter if
+// that would leave fewer than 2 blocks; the last one may be shorter).
+// Origins are correlated where the time windows they measure overlap (a
+// lag longer than their spacing), which blocks shorter than the longest lag
+// an estimate uses miss: origin_block says how long a block must be.
+// Errors of lags taken one by one and propagated through a fit would miss
+// the correlation between lags of the same origin as well (10 times too
+// small for beta, tau0 and D against the spread of seeds). NaN where an
+// estimate is NaN in any replicate; empty with fewer than 2 origins.
 std::vector<double> origin_jackknife(const std::vector<double>& table, int n_origins, int n_lags,
                                      const std::function<std::vector<double>(const std::vector<double>&)>& estimate,
-                                     int min_block = 1);
+                                     int block = 1);
+
+// The block length (in origins) for origin_jackknife of an estimate whose
+// longest lag is `longest_lag`, origins `origin_spacing` apart: the
+// smallest number of origins that spans the lag (blocks then share no time
+// window but at their ends), but no longer than leaves kMinJackknifeBlocks
+// blocks of the n_origins (a shorter block then, and the error may be
+// low: the docs say so). 1 where the spacing is unknown (<= 0) or the lag
+// is not finite.
+constexpr int kMinJackknifeBlocks = 4;
+int origin_block(double longest_lag, double origin_spacing, int n_origins);
 
 // Minimises |r(p)|^2 for residuals r already divided by their errors.
 struct LmResult {

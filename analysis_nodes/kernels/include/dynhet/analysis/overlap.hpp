@@ -34,7 +34,9 @@ double crossing_time(const std::vector<double>& t, const std::vector<double>& q,
 // jackknife error over blocks of origins (origin_jackknife, fits.hpp).
 class OverlapAccumulator {
 public:
-  OverlapAccumulator(int n_origins, std::vector<double> lag_time);
+  // origin_spacing: the time between origins (jackknife blocks span the
+  // lag tau_alpha is read at, origin_block); 0 if unknown (blocks of 1).
+  OverlapAccumulator(int n_origins, std::vector<double> lag_time, double origin_spacing = 0);
 
   // Q_r over the sub-boxes (m*m values) for origin k at lag j.
   void add(int k, int j, const double* q_r, int n_subboxes);
@@ -51,12 +53,14 @@ public:
   // All of them, origin-major, for origin_jackknife.
   const std::vector<double>& table() const { return q_; }
   int n_origins() const { return n_origins_; }
+  double origin_spacing() const { return spacing_; }
 
 private:
   std::size_t index(int k, int j) const { return static_cast<size_t>(k) * lag_.size() + j; }
   std::vector<double> mean_over_origins(int skip) const;
   int n_origins_;
   std::vector<double> lag_;
+  double spacing_;
   std::vector<double> q_, var_; // per (k, j): <Q_r> and <Q_r^2> - <Q_r>^2
 };
 

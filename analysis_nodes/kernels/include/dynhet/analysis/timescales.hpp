@@ -23,6 +23,15 @@ struct Peak {
 };
 Peak find_peak(const std::vector<double>& t, const std::vector<double>& y);
 
+// The same with the three lags centred on lag `best` (the vertex of the
+// parabola through them), whatever y's largest point: the jackknife
+// replicates of a peak keep the full data's lags, so that a replicate whose
+// largest point moves one lag over does not jump to another parabola.
+Peak peak_at(const std::vector<double>& t, const std::vector<double>& y, int best);
+
+// Index of the largest finite y (-1 if none).
+int peak_index(const std::vector<double>& y);
+
 // Index of the lag closest to t in ln t (-1 if lags is empty or t <= 0).
 // Clusters at t = tau_alpha: tau_alpha is known only once Q(t) has crossed
 // 1/e, so cluster statistics are gathered at every scheduled lag (about
