@@ -232,6 +232,12 @@ void bench_extremes(const Frames& f, const std::vector<double>& d2, const an::Di
     tally.add(0, 0, 1, r.hist[0].data(), r.n_small);
   });
   row("P(dx) tally of one pair (400 bins, 2 sets)", t_tally, false);
+  // The flow part of D: the 24 longest waves of the displacement field.
+  const Timing t_modes = time_calls(reps, [&] {
+    const an::WaveModes w = an::collective_modes(f.p0.data(), f.pt.data(), f.n, f.box, 4, r.msd_all);
+    if (w.transverse.size() != 24) std::abort();
+  });
+  row("collective modes |n| <= 4 (24 waves, D's flow part)", t_modes, false);
 }
 
 // Largest relative difference of S4 over the shells with 0 < q <= q_max

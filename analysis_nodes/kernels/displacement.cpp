@@ -2,7 +2,6 @@
 #include "dynhet/subbox.hpp"
 
 #include <algorithm>
-#include <complex>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -522,33 +521,68 @@ void wave_vectors(int n_max, std::vector<int>& nx, std::vector<int>& ny) {
 }
 
 WaveModes collective_modes(const double* pos0, const double* pos_t, long n, double box, int n_max, double msd) {
-  using C = std::complex<double>;
   WaveModes w;
   wave_vectors(n_max, w.nx, w.ny);
   const size_t m = w.nx.size();
-  std::vector<C> ux(m), uy(m), px(2 * n_max + 1), py(n_max + 1);
-  const double two_pi_l = 2 * 3.14159265358979323846 / box;
+  // The displacements summed on a kGrid x kGrid grid by the cell holding
+  // r_i(t0) (3 ns a particle), then the Fourier sums over the cells,
+  // separable: rows first (a = -n_max..n_max), then columns (b = 0..n_max).
+  constexpr int kGrid = 64; // cells of L/64: at |n| <= 4 the window is 0.99 or more
+  static_assert((kGrid & (kGrid - 1)) == 0, "a power of 2: the cell index wraps by a mask");
+  std::vector<double> gx(kGrid * kGrid, 0.0), gy(kGrid * kGrid, 0.0);
+  const double inv_h = kGrid / box;
   for (long i = 0; i < n; ++i) {
     const double x = pos0[2 * i], y = pos0[2 * i + 1];
-    const double dx = pos_t[2 * i] - x, dy = pos_t[2 * i + 1] - y;
-    // exp(-i k . r) = exp(-i 2 pi a x / L) exp(-i 2 pi b y / L), a = -n_max..n_max, b = 0..n_max
-    const C ex = std::polar(1.0, -two_pi_l * x), ey = std::polar(1.0, -two_pi_l * y);
-    px[n_max] = 1, py[0] = 1;
-    for (int a = 1; a <= n_max; ++a) px[n_max + a] = px[n_max + a - 1] * ex, px[n_max - a] = std::conj(px[n_max + a]);
-    for (int b = 1; b <= n_max; ++b) py[b] = py[b - 1] * ey;
-    for (size_t k = 0; k < m; ++k) {
-      const C e = px[n_max + w.nx[k]] * py[w.ny[k]];
-      ux[k] += dx * e, uy[k] += dy * e;
-    }
+    const long ix = static_cast<long>(std::floor(x * inv_h)) & (kGrid - 1);
+    const long iy = static_cast<long>(std::floor(y * inv_h)) & (kGrid - 1);
+    gx[iy * kGrid + ix] += pos_t[2 * i] - x, gy[iy * kGrid + ix] += pos_t[2 * i + 1] - y;
   }
+  const double pi = 3.14159265358979323846;
+  // exp(-i 2 pi a (c + 1/2) / kGrid) for a = 0..n_max: the cell centres' phases
+  std::vector<double> cs((n_max + 1) * kGrid), sn(cs.size());
+  for (int a = 0; a <= n_max; ++a)
+    for (int c = 0; c < kGrid; ++c) {
+      const double ph = 2 * pi * a * (c + 0.5) / kGrid;
+      cs[a * kGrid + c] = std::cos(ph), sn[a * kGrid + c] = -std::sin(ph);
+    }
+  // Rows: F(a, iy) for both components, a = -n_max..n_max (index a + n_max).
+  const int na = 2 * n_max + 1;
+  std::vector<double> fxr(na * kGrid), fxi(fxr.size()), fyr(fxr.size()), fyi(fxr.size());
+  for (int iy = 0; iy < kGrid; ++iy)
+    for (int a = 0; a <= n_max; ++a) {
+      double xr = 0, xi = 0, yr = 0, yi = 0;
+      for (int ix = 0; ix < kGrid; ++ix) {
+        const double c = cs[a * kGrid + ix], s = sn[a * kGrid + ix];
+        const double vx = gx[iy * kGrid + ix], vy = gy[iy * kGrid + ix];
+        xr += vx * c, xi += vx * s, yr += vy * c, yi += vy * s;
+      }
+      // the real data's transform at -a is the conjugate
+      fxr[(n_max + a) * kGrid + iy] = xr, fxi[(n_max + a) * kGrid + iy] = xi;
+      fyr[(n_max + a) * kGrid + iy] = yr, fyi[(n_max + a) * kGrid + iy] = yi;
+      fxr[(n_max - a) * kGrid + iy] = xr, fxi[(n_max - a) * kGrid + iy] = -xi;
+      fyr[(n_max - a) * kGrid + iy] = yr, fyi[(n_max - a) * kGrid + iy] = -yi;
+    }
   w.transverse.resize(m), w.longitudinal.resize(m);
-  const double floor = msd / double(n);
   for (size_t k = 0; k < m; ++k) {
-    const double kn = std::hypot(double(w.nx[k]), double(w.ny[k]));
-    const double ex = w.nx[k] / kn, ey = w.ny[k] / kn; // k-hat; the transverse direction is (-ey, ex)
-    const C ul = (ux[k] * ex + uy[k] * ey) / double(n), ut = (-ux[k] * ey + uy[k] * ex) / double(n);
-    w.longitudinal[k] = 2 * std::norm(ul) - floor;
-    w.transverse[k] = 2 * std::norm(ut) - floor;
+    const int a = w.nx[k], b = w.ny[k];
+    double xr = 0, xi = 0, yr = 0, yi = 0; // u_k times n, components x and y
+    for (int iy = 0; iy < kGrid; ++iy) {
+      const double c = cs[b * kGrid + iy], s = sn[b * kGrid + iy];
+      const size_t j = static_cast<size_t>(n_max + a) * kGrid + iy;
+      xr += fxr[j] * c - fxi[j] * s, xi += fxr[j] * s + fxi[j] * c;
+      yr += fyr[j] * c - fyi[j] * s, yi += fyr[j] * s + fyi[j] * c;
+    }
+    // Positions spread uniformly over a cell put the cell-centre sum at
+    // W = sinc(pi a / kGrid) sinc(pi b / kGrid) of the exact one, on
+    // average: divided out, the floor MSD / N divided likewise.
+    auto sinc = [&](int q) { return q == 0 ? 1.0 : std::sin(pi * q / kGrid) / (pi * q / kGrid); };
+    const double win = sinc(a) * sinc(b), scale = 1.0 / (double(n) * win);
+    const double kn = std::hypot(double(a), double(b)), ex = a / kn, ey = b / kn; // k-hat; transverse (-ey, ex)
+    const double lr = (xr * ex + yr * ey) * scale, li = (xi * ex + yi * ey) * scale;
+    const double tr = (-xr * ey + yr * ex) * scale, ti = (-xi * ey + yi * ex) * scale;
+    const double floor = msd / double(n) / (win * win);
+    w.longitudinal[k] = 2 * (lr * lr + li * li) - floor;
+    w.transverse[k] = 2 * (tr * tr + ti * ti) - floor;
   }
   return w;
 }

@@ -168,8 +168,11 @@ struct WaveModes {
 // The wave vectors of collective_modes, in its order.
 void wave_vectors(int n_max, std::vector<int>& nx, std::vector<int>& ny);
 // One pair's modes (positions unwrapped, x0 y0 x1 y1 ...; msd the pair's
-// mean squared displacement). O(N (2 n_max + 1)^2) operations: the phases
-// exp(i 2 pi x / L) once per particle, their powers by multiplication.
+// mean squared displacement). The displacements are summed on a 64 x 64
+// grid of cells by r_i(t0) (O(N), a few ns a particle), the Fourier sums
+// taken over the cell centres and divided by the cells' window (exact on
+// average for positions spread over a cell; the window is 0.99 or more
+// for |n| <= 4 of L/64 cells).
 WaveModes collective_modes(const double* pos0, const double* pos_t, long n, double box, int n_max, double msd);
 
 } // namespace dynhet::analysis
