@@ -190,39 +190,59 @@ private:
         return std::vector<double>{d.n >= 3 ? d.d : std::numeric_limits<double>::quiet_NaN()};
       };
       m.diffusion = fit(m.msd_all)[0];
-      // Blocks spanning the fit's longest lag (origin_block).
+      // D = D_local + D_flow (flow_part). The local part's error: a
+      // jackknife over blocks of origins spanning the fit's longest lag
+      // (origin_block) of the MSD less the modes' share; the flows'
+      // spread, which blocks of one run do not see, added in quadrature.
+      // Without the modes (no waves measured), the jackknife of the MSD.
       const int block = an::origin_block(m.fit_t_max, dynhet::origin_spacing(info()), info().n_origins);
-      const auto e = an::origin_jackknife(msd_all_, info().n_origins, static_cast<int>(m.lag_time.size()), fit, block);
-      if (std::isfinite(m.diffusion) && e.size() == 1) m.diffusion_err = e[0];
+      const int nl = static_cast<int>(m.lag_time.size());
       flow_part(m);
-      // The flows frozen over the run vary between runs, not between its
-      // blocks of origins: their spread adds to the jackknife's.
-      if (std::isfinite(m.diffusion_flow_err)) m.diffusion_err = std::hypot(m.diffusion_err, m.diffusion_flow_err);
+      if (std::isfinite(m.diffusion_flow_err)) {
+        std::vector<double> local(msd_all_);
+        for (size_t kj = 0; kj < local.size(); ++kj)
+          for (size_t q = 0; q < n_modes_; ++q) local[kj] -= flow_t_[kj * n_modes_ + q] + flow_l_[kj * n_modes_ + q];
+        const auto e = an::origin_jackknife(local, info().n_origins, nl, fit, block);
+        if (std::isfinite(m.diffusion) && e.size() == 1) m.diffusion_err = std::hypot(e[0], m.diffusion_flow_err);
+      } else {
+        const auto e = an::origin_jackknife(msd_all_, info().n_origins, nl, fit, block);
+        if (std::isfinite(m.diffusion) && e.size() == 1) m.diffusion_err = e[0];
+      }
     }
     out().publish(dynhet::kChanMsd, &m);
   }
-  // D_flow = sum over the modes of c = the slope / 4 of the mode's MSD
-  // share over D's fit range, and its spread between runs: a mode frozen
-  // over the run has a Gaussian amplitude, so c is exponential (variance
-  // c^2, and E c^2 = 2 var): var = sum c^2 / 2. Measured in 12 seeds of
-  // N = 4096, phi = 0.76 (docs/analysis.md): D_flow is a third of D, D - D_flow
-  // scatters as the jackknife says, D itself 3.2 times more.
+  // D_flow = sum over the modes of c = a quarter of the slope of the mode's
+  // share of the MSD over D's fit range, and the spread of D_flow between
+  // runs. A transverse mode is an Ornstein-Uhlenbeck velocity (linear
+  // fluctuating hydrodynamics: rate nu k^2) with a Gaussian amplitude: a
+  // mode frozen over the run gives an exponential c (variance = mean^2,
+  // E c^2 = 2 var); one that renews itself nu times in the run a Gamma
+  // (variance mean^2 / nu, E c^2 = (1 + 1/nu) mean^2). So var c = c^2 /
+  // (1 + nu), nu = 1 + T / tau, T the time the run's origins and lags
+  // span, tau the mode's time from its displacement's growth between the
+  // lag nearest t_max / 2 and t_max (ou_time_from_ratio: t^2 while
+  // frozen, t once renewed).
   void flow_part(dynhet::msd_t& m) const {
-    const size_t nj = m.lag_time.size();
-    double sum = 0, var = 0;
-    std::vector<double> mean_t, mean_l, err;
-    for (size_t q = 0; q < n_modes_; ++q) {
-      std::vector<double> t(nj * info().n_origins), l(t.size());
-      for (size_t kj = 0; kj < t.size(); ++kj) t[kj] = flow_t_[kj * n_modes_ + q], l[kj] = flow_l_[kj * n_modes_ + q];
-      origin_mean(t, mean_t, err);
-      origin_mean(l, mean_l, err);
-      for (const auto* v : {&mean_t, &mean_l}) {
-        const auto d = an::fit_diffusion(m.lag_time, *v, m.fit_t_min, m.fit_t_max);
-        if (d.n < 3 || !std::isfinite(d.d)) return;
-        sum += d.d, var += d.d * d.d / 2;
-      }
-    }
     if (n_modes_ == 0) return;
+    const size_t nj = m.lag_time.size();
+    const int j2 = static_cast<int>(nj) - 1, j1 = an::nearest_lag(m.lag_time, m.lag_time.back() / 2);
+    const double span = (info().n_origins - 1) * dynhet::origin_spacing(info()) + m.lag_time.back();
+    double sum = 0, var = 0;
+    std::vector<double> mean, err;
+    for (size_t q = 0; q < n_modes_; ++q)
+      for (const auto* table : {&flow_t_, &flow_l_}) {
+        std::vector<double> v(nj * info().n_origins);
+        for (size_t kj = 0; kj < v.size(); ++kj) v[kj] = (*table)[kj * n_modes_ + q];
+        origin_mean(v, mean, err);
+        const auto d = an::fit_diffusion(m.lag_time, mean, m.fit_t_min, m.fit_t_max);
+        if (d.n < 3 || !std::isfinite(d.d)) return;
+        double tau = std::numeric_limits<double>::infinity(); // frozen unless the data say otherwise
+        if (j1 >= 0 && j1 < j2 && mean[j1] > 0 && mean[j2] > 0)
+          tau = an::ou_time_from_ratio(m.lag_time[j1], m.lag_time[j2], mean[j2] / mean[j1]);
+        const double nu = 1 + (tau > 0 ? span / tau : std::numeric_limits<double>::infinity());
+        sum += d.d;
+        if (std::isfinite(nu)) var += d.d * d.d / (1 + nu);
+      }
     m.diffusion_flow = sum, m.diffusion_flow_err = std::sqrt(var);
   }
 

@@ -60,6 +60,9 @@ def quantities(path, a):
         pair("beta", f"{o}/overlap/a{a}/beta", f"{o}/overlap/a{a}/beta_err")
         pair("tau0", f"{o}/overlap/a{a}/tau0", f"{o}/overlap/a{a}/tau0_err")
         pair("D", f"{o}/msd/diffusion", f"{o}/msd/diffusion_err")
+        flow, flow_e = last(f, f"{o}/msd/diffusion_flow"), last(f, f"{o}/msd/diffusion_flow_err")
+        if flow is not None and "D" in out:
+            out["_D_flow"] = (float(flow), float(flow_e))
         pair("Z", f"{o}/sim/reduced_pressure", f"{o}/sim/reduced_pressure_err")
         pair("collision frequency", f"{o}/sim/collision_frequency", f"{o}/sim/collision_frequency_err")
         # chi4(t) of every sub-box size at the lag of its largest value
@@ -141,6 +144,28 @@ def main():
         rows.append((n, r))
         flag = "" if 0.7 <= r <= 1.5 else "  <- outside 0.7-1.5"
         print(f"{n:44s} {used:6d} {dof:5d} {r:13.2f} {r / math.sqrt(2 * dof):6.2f} {nan:8d}{flag}")
+    flow_report(points)
+
+
+def flow_report(points):
+    """D's flow part (docs/analysis.md, "D and the long-lived flows"): per
+    point, its share of D, and the spread of D and of D - D_flow over the
+    error without the flows' part (the jackknife's)."""
+    lines = []
+    for key, runs_ in points.items():
+        ok = [q for q in runs_ if "_D_flow" in q and all(map(math.isfinite, q["D"] + q["_D_flow"]))]
+        if len(ok) < 2:
+            continue
+        d = np.array([q["D"][0] for q in ok])
+        fl = np.array([q["_D_flow"][0] for q in ok])
+        jk = np.mean([math.sqrt(max(q["D"][1] ** 2 - q["_D_flow"][1] ** 2, 0.0)) for q in ok])
+        tot = np.mean([q["D"][1] for q in ok])
+        lines.append(f"  {key}: D {d.mean():.4g}, D_flow {fl.mean():.4g} ({fl.mean() / d.mean():.0%}); "
+                     f"spread of D / jackknife error {d.std(ddof=1) / jk:.2f}, of D - D_flow {np.std(d - fl, ddof=1) / jk:.2f}; "
+                     f"spread of D / quoted error {d.std(ddof=1) / tot:.2f}")
+    if lines:
+        print("D's flow part per point (packing fraction, restitution, N, pairs):")
+        print("\n".join(lines))
 
 
 if __name__ == "__main__":

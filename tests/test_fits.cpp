@@ -194,3 +194,15 @@ TEST(Fits, OriginJackknifeWithBlocksAsLongAsTheCorrelationMatchesTheSpread) {
   EXPECT_NEAR(e4 / sd, std::sqrt(2.75 / 4.0), 0.06);
   EXPECT_NEAR(e1 / sd, 0.5, 0.06);
 }
+
+TEST(Fits, OrnsteinUhlenbeckTimeFromTwoLags) {
+  auto p = [](double t, double tau) { return t / tau - 1 + std::exp(-t / tau); };
+  for (double tau : {0.3, 2.0, 15.0, 400.0}) {
+    const double t1 = 7.0, t2 = 14.5;
+    EXPECT_NEAR(ou_time_from_ratio(t1, t2, p(t2, tau) / p(t1, tau)) / tau, 1.0, 1e-6) << tau;
+  }
+  EXPECT_TRUE(std::isinf(ou_time_from_ratio(1.0, 2.0, 4.0))); // ballistic
+  EXPECT_EQ(ou_time_from_ratio(1.0, 2.0, 1.9), 0.0);          // below diffusive
+  EXPECT_TRUE(std::isnan(ou_time_from_ratio(2.0, 1.0, 3.0)));
+  EXPECT_TRUE(std::isnan(ou_time_from_ratio(1.0, 2.0, NAN)));
+}

@@ -119,6 +119,21 @@ std::vector<double> origin_jackknife(const std::vector<double>& table, int n_ori
   return err;
 }
 
+double ou_time_from_ratio(double t1, double t2, double r) {
+  if (!(t1 > 0) || !(t2 > t1) || !std::isfinite(r)) return kNaN;
+  const double rho = t2 / t1;
+  auto p = [](double x) { return x + std::expm1(-x); }; // x - 1 + e^-x without cancellation
+  auto g = [&](double x) { return p(rho * x) / p(x); };    // falls from rho^2 to rho as x grows
+  if (r >= g(1e-6)) return std::numeric_limits<double>::infinity();
+  if (r <= g(1e6)) return 0.0;
+  double lo = std::log(1e-6), hi = std::log(1e6);
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (g(std::exp(mid)) > r ? lo : hi) = mid;
+  }
+  return t1 / std::exp(0.5 * (lo + hi));
+}
+
 int origin_block(double longest_lag, double origin_spacing, int n_origins) {
   if (!(origin_spacing > 0) || !std::isfinite(longest_lag) || !(longest_lag > 0)) return 1;
   const int span = static_cast<int>(std::ceil(longest_lag / origin_spacing - 1e-9));

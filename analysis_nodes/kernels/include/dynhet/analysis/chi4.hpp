@@ -34,8 +34,8 @@ public:
     // vertex of the parabola in ln t through the largest point and its two
     // neighbours (the largest point itself at either end of the lags), with
     // jackknife errors over blocks of origins (NaN below 3 origins): blocks
-    // span the last of the three lags (origin_block), and every replicate
-    // takes the vertex through the full data's three lags (peak_at).
+    // span the last of the three lags (origin_block), the peak found anew
+    // in every replicate.
     double chi4_peak, tau4, chi4_peak_err, tau4_err;
   };
   Result result() const;

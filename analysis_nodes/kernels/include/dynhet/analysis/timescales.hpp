@@ -24,9 +24,7 @@ struct Peak {
 Peak find_peak(const std::vector<double>& t, const std::vector<double>& y);
 
 // The same with the three lags centred on lag `best` (the vertex of the
-// parabola through them), whatever y's largest point: the jackknife
-// replicates of a peak keep the full data's lags, so that a replicate whose
-// largest point moves one lag over does not jump to another parabola.
+// parabola through them), whatever y's largest point.
 Peak peak_at(const std::vector<double>& t, const std::vector<double>& y, int best);
 
 // Index of the largest finite y (-1 if none).
