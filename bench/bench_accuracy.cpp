@@ -50,7 +50,7 @@ int main(int argc, char** argv) {
     // Lags up to 20 (several tau_alpha at these densities); origins every `spacing`.
     dynhet::ScheduleSpec spec{static_cast<int>((t_max - 20.0) / spacing) + 1, spacing, 0.05, 20.0, 8, {}};
     const auto s = dynhet::make_schedule(spec, t_eq);
-    an::OverlapAccumulator acc(s.n_origins(), s.lag_time);
+    an::OverlapAccumulator acc(s.n_origins(), s.lag_time, spacing); // the overlap node's jackknife blocks
     const auto grid = an::make_subbox_grid(n, e.box_length(), static_cast<int>(n)); // whole box
     std::map<int, std::vector<double>> origin_pos;
     std::vector<std::vector<std::pair<int, int>>> pairs_at(s.frame_time.size());

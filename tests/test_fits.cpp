@@ -206,3 +206,30 @@ TEST(Fits, OrnsteinUhlenbeckTimeFromTwoLags) {
   EXPECT_TRUE(std::isnan(ou_time_from_ratio(2.0, 1.0, 3.0)));
   EXPECT_TRUE(std::isnan(ou_time_from_ratio(1.0, 2.0, NAN)));
 }
+
+TEST(Fits, OzRangeScanIsFlatOnOzDataAndDriftsWithAQuarticTerm) {
+  std::vector<double> q, s, s2;
+  for (int k = 1; k <= 80; ++k) {
+    q.push_back(0.025 * k);
+    const double x2 = std::pow(q.back() * 6.0, 2);
+    s.push_back(30.0 / (1 + x2));
+    s2.push_back(30.0 / (1 + x2 + 0.25 * x2 * x2)); // A = 0.5
+  }
+  const OzRangeScan a = scan_oz_range(q, s);
+  ASSERT_EQ(a.xi.size(), kOzRangeScan.size());
+  EXPECT_LT(half_range(a.xi), 1e-5); // exact OZ: every range gives xi = 6
+  EXPECT_LT(half_range(a.chi0), 1e-4);
+  const OzRangeScan b = scan_oz_range(q, s2);
+  // The OZ form misses the quartic term: its xi moves with the range by a
+  // good part of A^2 (q xi)^2 relative (several percent of xi here), the
+  // form with A^2 does not.
+  EXPECT_GT(half_range(b.xi), 0.05 * 6.0);
+  EXPECT_LT(half_range(b.xi_a2), 1e-3);
+  // Too few shells: q = 0.025 k with q xi <= 0.5 holds 3 shells at xi = 6
+  // (k <= 3), so all ranges are finite; a coarse q grid leaves NaN.
+  std::vector<double> qc{0.2, 0.4, 0.6}, sc;
+  for (double x : qc) sc.push_back(30.0 / (1 + std::pow(x * 6.0, 2)));
+  const OzRangeScan c = scan_oz_range(qc, sc);
+  EXPECT_TRUE(std::isnan(c.xi.front()));
+  EXPECT_TRUE(std::isnan(half_range({1.0, NAN})));
+}

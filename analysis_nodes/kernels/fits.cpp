@@ -461,4 +461,36 @@ OzFit fit_oz_a2(const std::vector<double>& q, const std::vector<double>& s4,
   return oz_result(oz_lm(q, s4, s4_err, k, p), q, k, !s4_err.empty(), ok);
 }
 
+OzRangeScan scan_oz_range(const std::vector<double>& q, const std::vector<double>& s4,
+                          const std::vector<double>& qxi_max) {
+  OzRangeScan r;
+  r.qxi_max = qxi_max;
+  for (double c : qxi_max) {
+    OzFit f{}, g{};
+    f.xi = f.chi0 = g.xi = g.chi0 = kNaN;
+    try {
+      f = fit_oz(q, s4, {}, c);
+      if (!f.range_ok) f.xi = f.chi0 = kNaN;
+    } catch (const std::exception&) {
+      f.xi = f.chi0 = kNaN;
+    }
+    try {
+      g = fit_oz_a2(q, s4, {}, c);
+      if (!g.range_ok) g.xi = g.chi0 = kNaN;
+    } catch (const std::exception&) {
+      g.xi = g.chi0 = kNaN;
+    }
+    r.xi.push_back(f.xi), r.chi0.push_back(f.chi0), r.xi_a2.push_back(g.xi), r.chi0_a2.push_back(g.chi0);
+  }
+  return r;
+}
+
+double half_range(const std::vector<double>& v) {
+  double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  int n = 0;
+  for (double x : v)
+    if (std::isfinite(x)) lo = std::min(lo, x), hi = std::max(hi, x), ++n;
+  return n >= 2 ? (hi - lo) / 2 : kNaN;
+}
+
 } // namespace dynhet::analysis

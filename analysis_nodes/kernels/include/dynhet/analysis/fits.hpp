@@ -175,4 +175,19 @@ OzFit fit_oz(const std::vector<double>& q, const std::vector<double>& s4,
 OzFit fit_oz_a2(const std::vector<double>& q, const std::vector<double>& s4,
                 const std::vector<double>& s4_err = {}, double qxi_max = 1.0);
 
+// The paper's appendix: how much the fit range [0, q_m] matters. Both fits
+// repeated over q xi <= each of `qxi_max` (q_m follows xi), unweighted; NaN
+// where a range holds fewer than 3 shells. The spread of the finite values
+// says how well the data determine xi and chi0 beyond their statistical
+// error (exact OZ data: none; an (q xi)^4 term: the OZ xi drifts with the
+// range while the fit with A^2 stays).
+inline const std::vector<double> kOzRangeScan{0.5, 0.75, 1.0, 1.5, 2.0};
+struct OzRangeScan {
+  std::vector<double> qxi_max, xi, chi0, xi_a2, chi0_a2; // per range
+};
+OzRangeScan scan_oz_range(const std::vector<double>& q, const std::vector<double>& s4,
+                          const std::vector<double>& qxi_max = kOzRangeScan);
+// Half the range (max - min) / 2 of the finite values; NaN with fewer than 2.
+double half_range(const std::vector<double>& v);
+
 } // namespace dynhet::analysis
