@@ -119,6 +119,7 @@ private:
       n_modes_ = nx.size();
       flow_t_.assign(pairs * n_modes_, std::numeric_limits<double>::quiet_NaN());
       flow_l_ = flow_t_;
+      amp_.assign(static_cast<size_t>(m.n_origins) * n_modes_ * 4, std::numeric_limits<double>::quiet_NaN());
     }
     if (displacement_) displacement_->configure(spec_);
     if (want_msd_) d2_.resize(m.n_particles);
@@ -147,6 +148,11 @@ private:
                                                    pass_.msd_all);
       std::copy(w.transverse.begin(), w.transverse.end(), flow_t_.begin() + kj * n_modes_);
       std::copy(w.longitudinal.begin(), w.longitudinal.end(), flow_l_.begin() + kj * n_modes_);
+      if (j == info().n_lags - 1) // the amplitudes at the last lag, for the modes' lifetimes
+        for (size_t q = 0; q < n_modes_; ++q) {
+          double* a = &amp_[(static_cast<size_t>(k) * n_modes_ + q) * 4];
+          a[0] = w.t_re[q], a[1] = w.t_im[q], a[2] = w.l_re[q], a[3] = w.l_im[q];
+        }
     }
     if (displacement_) displacement_->add(k, j, pass_, pass_.n_small);
   }
@@ -214,32 +220,52 @@ private:
   // D_flow = sum over the modes of c = a quarter of the slope of the mode's
   // share of the MSD over D's fit range, and the spread of D_flow between
   // runs. A transverse mode is an Ornstein-Uhlenbeck velocity (linear
-  // fluctuating hydrodynamics: rate nu k^2) with a Gaussian amplitude: a
-  // mode frozen over the run gives an exponential c (variance = mean^2,
-  // E c^2 = 2 var); one that renews itself nu times in the run a Gamma
-  // (variance mean^2 / nu, E c^2 = (1 + 1/nu) mean^2). So var c = c^2 /
-  // (1 + nu), nu = 1 + T / tau, T the time the run's origins and lags
-  // span, tau the mode's time from its displacement's growth between the
-  // lag nearest t_max / 2 and t_max (ou_time_from_ratio: t^2 while
-  // frozen, t once renewed).
+  // fluctuating hydrodynamics: rate gamma = nu k^2) with a Gaussian
+  // amplitude: a mode frozen over the run gives an exponential c (variance
+  // = mean^2, E c^2 = 2 var); one that renews itself nu times in the run a
+  // Gamma (variance mean^2 / nu, E c^2 = (1 + 1/nu) mean^2). So var c =
+  // c^2 / (1 + nu), nu = 1 + gamma T, T the time the run's origins and
+  // lags span and gamma the mode's rate from the correlation of its
+  // amplitude at the last lag between origins whose windows do not overlap
+  // (ou_rate_from_correlation). Without two such origins: frozen (nu = 1).
   void flow_part(dynhet::msd_t& m) const {
     if (n_modes_ == 0) return;
-    const size_t nj = m.lag_time.size();
-    const int j2 = static_cast<int>(nj) - 1, j1 = an::nearest_lag(m.lag_time, m.lag_time.back() / 2);
-    const double span = (info().n_origins - 1) * dynhet::origin_spacing(info()) + m.lag_time.back();
+    const int no = info().n_origins;
+    const double t = m.lag_time.back();
+    const double span = (no - 1) * dynhet::origin_spacing(info()) + t;
+    std::vector<double> t0(no);
+    for (int k = 0; k < no; ++k) t0[k] = info().frame_time[info().origin_frame[k]];
     double sum = 0, var = 0;
     std::vector<double> mean, err;
     for (size_t q = 0; q < n_modes_; ++q)
-      for (const auto* table : {&flow_t_, &flow_l_}) {
-        std::vector<double> v(nj * info().n_origins);
-        for (size_t kj = 0; kj < v.size(); ++kj) v[kj] = (*table)[kj * n_modes_ + q];
+      for (int part = 0; part < 2; ++part) {
+        const std::vector<double>& table = part == 0 ? flow_t_ : flow_l_;
+        std::vector<double> v(m.lag_time.size() * no);
+        for (size_t kj = 0; kj < v.size(); ++kj) v[kj] = table[kj * n_modes_ + q];
         origin_mean(v, mean, err);
         const auto d = an::fit_diffusion(m.lag_time, mean, m.fit_t_min, m.fit_t_max);
         if (d.n < 3 || !std::isfinite(d.d)) return;
-        double tau = std::numeric_limits<double>::infinity(); // frozen unless the data say otherwise
-        if (j1 >= 0 && j1 < j2 && mean[j1] > 0 && mean[j2] > 0)
-          tau = an::ou_time_from_ratio(m.lag_time[j1], m.lag_time[j2], mean[j2] / mean[j1]);
-        const double nu = 1 + (tau > 0 ? span / tau : std::numeric_limits<double>::infinity());
+        // The amplitude's correlation between origins at least t apart.
+        double power = 0, cross = 0;
+        int n_power = 0, n_cross = 0;
+        std::vector<double> gaps;
+        for (int k = 0; k < no; ++k) {
+          const double* a = &amp_[(static_cast<size_t>(k) * n_modes_ + q) * 4 + 2 * part];
+          if (std::isnan(a[0])) continue;
+          power += a[0] * a[0] + a[1] * a[1], ++n_power;
+          for (int l = k + 1; l < no; ++l) {
+            const double* b = &amp_[(static_cast<size_t>(l) * n_modes_ + q) * 4 + 2 * part];
+            if (std::isnan(b[0]) || t0[l] - t0[k] < t * (1 - 1e-9)) continue;
+            cross += a[0] * b[0] + a[1] * b[1], ++n_cross; // Re(a conj b)
+            gaps.push_back(t0[l] - t0[k]);
+          }
+        }
+        double nu = 1; // frozen unless two origins far enough apart say otherwise
+        if (n_cross > 0 && power > 0) {
+          const double gamma = an::ou_rate_from_correlation(t, gaps, (cross / n_cross) / (power / n_power));
+          if (std::isfinite(gamma)) nu = 1 + gamma * span;
+          else if (gamma > 0) nu = std::numeric_limits<double>::infinity();
+        }
         sum += d.d;
         if (std::isfinite(nu)) var += d.d * d.d / (1 + nu);
       }
@@ -327,6 +353,7 @@ private:
   static constexpr int kFlowModes = 4;       // |n| <= 4: waves of L / 4 and longer
   size_t n_modes_ = 0;
   std::vector<double> flow_t_, flow_l_;      // per (origin, lag, mode): collective_modes
+  std::vector<double> amp_;                  // per (origin, mode): u_k . e at the last lag (t re, im, l re, im)
   std::vector<double> d2_, select_;          // |dr|^2 of the pair; the selection's buffer
   dynhet::Scene::Msd msd_spec_;
   std::unique_ptr<dynhet::DisplacementResults> displacement_;

@@ -583,6 +583,7 @@ WaveModes collective_modes(const double* pos0, const double* pos_t, long n, doub
     const double floor = msd / double(n) / (win * win);
     w.longitudinal[k] = 2 * (lr * lr + li * li) - floor;
     w.transverse[k] = 2 * (tr * tr + ti * ti) - floor;
+    w.t_re.push_back(tr), w.t_im.push_back(ti), w.l_re.push_back(lr), w.l_im.push_back(li);
   }
   return w;
 }

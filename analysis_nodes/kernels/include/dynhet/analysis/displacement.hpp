@@ -164,6 +164,7 @@ DisplacementDensity displacement_density(const DisplacementSpec& spec, const std
 struct WaveModes {
   std::vector<int> nx, ny; // the n of each mode
   std::vector<double> transverse, longitudinal; // 2 |u_k . e|^2 - MSD / N per mode
+  std::vector<double> t_re, t_im, l_re, l_im;    // u_k . e itself (transverse, longitudinal)
 };
 // The wave vectors of collective_modes, in its order.
 void wave_vectors(int n_max, std::vector<int>& nx, std::vector<int>& ny);
