@@ -1,3 +1,4 @@
+#include <algorithm>
 #include "run_recorder.hpp"
 
 #include "dynhet/disk.hpp"
@@ -156,7 +157,12 @@ bool RunRecorder::on_sim_status(const sim_status_t &m) {
   guarded("sim status", [&] { write_sim(m); });
   // The frames kept are counted at the end (finish), not at a "done": a
   // forged one must not close the recorder's frames while the sim goes on.
-  if (ended(m.phase) && m.frames_published > 0) frames_published_ = m.frames_published;
+  // Its count is untrusted too: at most the run's frames (a forged
+  // INT32_MAX would make every run incomplete), and never below a count
+  // already seen (a forged smaller one after the sim's would excuse lost
+  // frames); the safe direction is to expect more.
+  if (ended(m.phase) && m.frames_published > 0)
+    frames_published_ = std::max(frames_published_, std::min(m.frames_published, info_->n_frames));
   completion_.sim_phase(m.phase, m.message);
   return true;
 }
