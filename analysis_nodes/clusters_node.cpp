@@ -365,11 +365,14 @@ private:
     m.n_blocks = n_blocks_;
     m.kappa_n_min = static_cast<int32_t>(spec_.power_law_sizes[0]);
     m.kappa_n_max = static_cast<int32_t>(spec_.power_law_sizes[1]);
-    AtLag r = at_lag(c, j);
-    if (b.ok()) {
+    AtLag r;
+    if (b.ok()) { // j, the lag nearest tau_alpha, is b.lo or b.hi
       const AtLag lo = at_lag(c, b.lo), hi = at_lag(c, b.hi);
       const std::optional<AtLag> third = b.third >= 0 ? std::optional<AtLag>(at_lag(c, b.third)) : std::nullopt;
+      r = j == b.lo ? lo : j == b.hi ? hi : at_lag(c, j);
       interpolate(r, lo, hi, third ? &*third : nullptr, b);
+    } else {
+      r = at_lag(c, j);
     }
     const KindResult &slow = r.slow, &fast = r.fast;
     m.origins_at_lag = r.origins;
