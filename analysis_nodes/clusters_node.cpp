@@ -11,9 +11,14 @@
 //   t0 + t (eq. 10).
 // - The lag: Q(t) of each cutoff is the fraction of slow particles, so the
 //   node has its own tau_alpha (the overlap node's definition). Clusters are
-//   tallied at every scheduled lag; the results are those of the scheduled
-//   lag nearest tau_alpha in ln t, chosen anew at every publication (the
-//   final one uses the final tau_alpha), or nearest the scene's clusters.lag.
+//   tallied at every scheduled lag; the results are at t = tau_alpha,
+//   interpolated linearly in ln t between the results of the two scheduled
+//   lags that bracket it (errors as fully correlated, plus the interpolation
+//   error from a third lag), anew at every publication (the final one at the
+//   final tau_alpha). Integer results (largest, spanning, counts per bin,
+//   origins) are those of the lag nearest tau_alpha. Where tau_alpha is not
+//   bracketed by lags with clusters, the results are those of the scheduled
+//   lag nearest it, or nearest the scene's clusters.lag if it gives one.
 // - Errors: jackknife over blocks of consecutive origins (at most
 //   clusters.error_blocks blocks).
 // - Memory: the origin frames still needed (16 N bytes each, FrameNode) and
@@ -36,6 +41,7 @@
 #include "dynhet/model.hpp"
 #include "dynhet/analysis/clusters.hpp"
 #include "dynhet/analysis/fits.hpp"
+#include "dynhet/analysis/lag_interpolation.hpp"
 #include "dynhet/analysis/overlap.hpp"
 #include "dynhet/clusters_t.hpp"
 #include "dynhet/scene.hpp"
@@ -196,6 +202,13 @@ private:
     return best;
   }
 
+  // The scheduled lags with clusters that bracket tau_alpha (not ok(): not
+  // bracketed, or the scene gives the lag).
+  an::LagBracket bracket(int c, double tau_alpha) const {
+    if (spec_.lag > 0) return {};
+    return an::bracket_lag(info().lag_time, tau_alpha, [&](int j) { return tallies(c, j, kSlow).sets() > 0; });
+  }
+
   void publish_results(bool final) override {
     for (int c = 0; c < info().n_cutoffs; ++c) {
       dynhet::clusters_t m{};
@@ -206,14 +219,17 @@ private:
       m.tau_alpha = q.tau_alpha, m.tau_alpha_err = q.tau_alpha_err;
       fill_lags(c, m);
       m.lag_index = chosen_lag(c, q.tau_alpha);
-      m.lag = m.lag_index >= 0 ? info().lag_time[m.lag_index] : kNaN;
-      fill_at_lag(c, m.lag_index, m);
+      const an::LagBracket b = bracket(c, q.tau_alpha);
+      m.lag = b.ok() ? q.tau_alpha : m.lag_index >= 0 ? info().lag_time[m.lag_index] : kNaN;
+      m.lag_lo = b.ok() ? b.lo : -1, m.lag_hi = b.ok() ? b.hi : -1, m.lag_weight = b.ok() ? b.w : kNaN;
+      m.lag_third = b.ok() ? b.third : -1;
+      fill_at_lag(c, m.lag_index, b, m);
       out().publish(dynhet::cutoff_channel(dynhet::kChanClusters, m.cutoff_a), &m);
       if (final)
         std::fprintf(stderr,
-                     "clusters_node: a=%g tau_alpha=%.4g lag %.4g: slow <N_c>=%.4g d_f=%.3g kappa=%.3g; "
+                     "clusters_node: a=%g tau_alpha=%.4g lag %.4g (%s): slow <N_c>=%.4g d_f=%.3g kappa=%.3g; "
                      "fast <N_c>=%.4g d_f=%.3g N0=%.3g sigma=%.3g (%d pairs)\n",
-                     m.cutoff_a, m.tau_alpha, m.lag, m.slow_mean_size, m.slow_d_f, m.slow_kappa, m.fast_mean_size,
+                     m.cutoff_a, m.tau_alpha, m.lag, m.lag_lo >= 0 ? "interpolated" : "nearest", m.slow_mean_size, m.slow_d_f, m.slow_kappa, m.fast_mean_size,
                      m.fast_d_f, m.fast_n0, m.fast_sigma, pairs_done());
     }
   }
@@ -282,28 +298,89 @@ private:
     return r;
   }
 
-  void fill_at_lag(int c, int j, dynhet::clusters_t& m) const {
+  // Everything published at one lag (or interpolated to tau_alpha).
+  struct AtLag {
+    int32_t origins = 0;
+    KindResult slow, fast;
+    double kappa = kNaN, kappa_err = kNaN, n0 = kNaN, n0_err = kNaN, sigma = kNaN, sigma_err = kNaN;
+    double n_sigma = kNaN, p0 = kNaN;
+    std::vector<int32_t> size_lo, size_hi;
+    std::vector<double> size_centre;
+  };
+  AtLag at_lag(int c, int j) const {
+    AtLag r;
+    if (j < 0) return r;
+    const BlockTallies &ts = tallies(c, j, kSlow), &tf = tallies(c, j, kFast);
+    const BlockTallies::Pooled ps = ts.pool(), pf = tf.pool();
+    r.origins = static_cast<int32_t>(ps.total.sets);
+    const std::vector<long>& e = ps.total.edges;
+    const size_t n_bins = e.size() - 1; // every bin up to N, so that the arrays keep their length
+    r.slow = kind_result(ts, ps, n_bins), r.fast = kind_result(tf, pf, n_bins);
+    for (size_t b = 0; b < n_bins; ++b) {
+      r.size_lo.push_back(static_cast<int32_t>(e[b]));
+      r.size_hi.push_back(static_cast<int32_t>(e[b + 1] - 1));
+      r.size_centre.push_back(std::sqrt(double(r.size_lo.back()) * r.size_hi.back()));
+    }
+    fit_sizes(ps, pf, r);
+    return r;
+  }
+
+  // r (the nearest lag's, which keeps its integer fields) with every other
+  // result interpolated to t between the lags of b: values linear in ln t,
+  // errors (1 - w) e_lo + w e_hi (the lags share their origins) with
+  // |quadratic - linear| through the third lag in quadrature.
+  static void interpolate(AtLag& r, const AtLag& lo, const AtLag& hi, const AtLag* third, const an::LagBracket& b) {
+    auto v3 = [&](double AtLag::*f) { return third ? third->*f : kNaN; };
+    auto pair = [&](double AtLag::*v, double AtLag::*e) {
+      const an::ValueErr x = an::interpolate_correlated(b, {lo.*v, lo.*e}, {hi.*v, hi.*e}, v3(v));
+      r.*v = x.value, r.*e = x.err;
+    };
+    pair(&AtLag::kappa, &AtLag::kappa_err), pair(&AtLag::n0, &AtLag::n0_err), pair(&AtLag::sigma, &AtLag::sigma_err);
+    r.n_sigma = an::interpolate(b, lo.n_sigma, hi.n_sigma), r.p0 = an::interpolate(b, lo.p0, hi.p0);
+    for (auto kind : {&AtLag::slow, &AtLag::fast})
+      interpolate(r.*kind, lo.*kind, hi.*kind, third ? &(third->*kind) : nullptr, b);
+  }
+  static void interpolate(KindResult& r, const KindResult& lo, const KindResult& hi, const KindResult* third,
+                          const an::LagBracket& b) {
+    auto pair = [&](double& v, double& e, double v_lo, double e_lo, double v_hi, double e_hi, double v_3) {
+      const an::ValueErr x = an::interpolate_correlated(b, {v_lo, e_lo}, {v_hi, e_hi}, v_3);
+      v = x.value, e = x.err;
+    };
+    pair(r.mean_size, r.mean_size_err, lo.mean_size, lo.mean_size_err, hi.mean_size, hi.mean_size_err,
+         third ? third->mean_size : kNaN);
+    pair(r.d_f, r.d_f_err, lo.d_f, lo.d_f_err, hi.d_f, hi.d_f_err, third ? third->d_f : kNaN);
+    r.clusters = an::interpolate(b, lo.clusters, hi.clusters);
+    const size_t n = r.p.size();
+    if (lo.p.size() != n || hi.p.size() != n) return; // (every lag with clusters has every bin)
+    const bool has3 = third && third->p.size() == n;
+    for (size_t i = 0; i < n; ++i) {
+      pair(r.p[i], r.p_err[i], lo.p[i], lo.p_err[i], hi.p[i], hi.p_err[i], has3 ? third->p[i] : kNaN);
+      pair(r.rg[i], r.rg_err[i], lo.rg[i], lo.rg_err[i], hi.rg[i], hi.rg_err[i], has3 ? third->rg[i] : kNaN);
+      r.rg_size[i] = an::interpolate(b, lo.rg_size[i], hi.rg_size[i]);
+    }
+  }
+
+  // The results at lag j, or interpolated between the lags of b if b.ok().
+  void fill_at_lag(int c, int j, const an::LagBracket& b, dynhet::clusters_t& m) const {
     m.n_blocks = n_blocks_;
     m.kappa_n_min = static_cast<int32_t>(spec_.power_law_sizes[0]);
     m.kappa_n_max = static_cast<int32_t>(spec_.power_law_sizes[1]);
-    m.slow_kappa = m.slow_kappa_err = m.fast_n0 = m.fast_n0_err = m.fast_sigma = m.fast_sigma_err = kNaN;
-    m.fast_n_sigma = m.fast_p0 = kNaN;
-    KindResult slow, fast;
-    if (j >= 0) {
-      const BlockTallies &ts = tallies(c, j, kSlow), &tf = tallies(c, j, kFast);
-      const BlockTallies::Pooled ps = ts.pool(), pf = tf.pool();
-      m.origins_at_lag = static_cast<int32_t>(ps.total.sets);
-      const std::vector<long>& e = ps.total.edges;
-      const size_t n_bins = e.size() - 1; // every bin up to N, so that the arrays keep their length
-      slow = kind_result(ts, ps, n_bins), fast = kind_result(tf, pf, n_bins);
-      for (size_t b = 0; b < n_bins; ++b) {
-        m.size_lo.push_back(static_cast<int32_t>(e[b]));
-        m.size_hi.push_back(static_cast<int32_t>(e[b + 1] - 1));
-        m.size_centre.push_back(std::sqrt(double(m.size_lo.back()) * m.size_hi.back()));
-      }
-      fit_sizes(ps, pf, m);
+    AtLag r;
+    if (b.ok()) { // j, the lag nearest tau_alpha, is b.lo or b.hi
+      const AtLag lo = at_lag(c, b.lo), hi = at_lag(c, b.hi);
+      const std::optional<AtLag> third = b.third >= 0 ? std::optional<AtLag>(at_lag(c, b.third)) : std::nullopt;
+      r = j == b.lo ? lo : j == b.hi ? hi : at_lag(c, j);
+      interpolate(r, lo, hi, third ? &*third : nullptr, b);
+    } else {
+      r = at_lag(c, j);
     }
+    const KindResult &slow = r.slow, &fast = r.fast;
+    m.origins_at_lag = r.origins;
+    m.size_lo = r.size_lo, m.size_hi = r.size_hi, m.size_centre = r.size_centre;
     m.n_bins = static_cast<int32_t>(m.size_lo.size());
+    m.slow_kappa = r.kappa, m.slow_kappa_err = r.kappa_err;
+    m.fast_n0 = r.n0, m.fast_n0_err = r.n0_err, m.fast_sigma = r.sigma, m.fast_sigma_err = r.sigma_err;
+    m.fast_n_sigma = r.n_sigma, m.fast_p0 = r.p0;
     m.slow_clusters = slow.clusters, m.fast_clusters = fast.clusters;
     m.slow_mean_size = slow.mean_size, m.slow_mean_size_err = slow.mean_size_err;
     m.fast_mean_size = fast.mean_size, m.fast_mean_size_err = fast.mean_size_err;
@@ -318,21 +395,21 @@ private:
 
   // P(N_c) ~ N_c^-kappa for slow clusters (eq. 11, over power_law_sizes),
   // log-normal for fast ones (eqs. 12-13); jackknife errors over blocks.
-  void fit_sizes(const BlockTallies::Pooled& ps, const BlockTallies::Pooled& pf, dynhet::clusters_t& m) const {
+  void fit_sizes(const BlockTallies::Pooled& ps, const BlockTallies::Pooled& pf, AtLag& m) const {
     const long lo = spec_.power_law_sizes[0], hi = spec_.power_law_sizes[1], min_count = spec_.min_bin_count;
     const Estimate kappa = ps.estimate([&](const an::ClusterTally& x) {
       return x.clusters ? an::fit_power_law(x.histogram(), lo, hi, min_count).kappa : kNaN;
     });
-    m.slow_kappa = kappa.value, m.slow_kappa_err = kappa.err;
+    m.kappa = kappa.value, m.kappa_err = kappa.err;
     if (pf.total.clusters == 0) return;
     const an::LogNormalFit f = an::fit_log_normal(pf.total.histogram(), min_count);
-    m.fast_n0 = f.n0, m.fast_sigma = f.sigma, m.fast_n_sigma = f.n_sigma, m.fast_p0 = f.p0;
+    m.n0 = f.n0, m.sigma = f.sigma, m.n_sigma = f.n_sigma, m.p0 = f.p0;
     std::vector<double> n0, sigma;
     for (const auto& t : pf.loo) {
       const an::LogNormalFit g = t.clusters ? an::fit_log_normal(t.histogram(), min_count) : an::LogNormalFit{};
       n0.push_back(t.clusters ? g.n0 : kNaN), sigma.push_back(t.clusters ? g.sigma : kNaN);
     }
-    m.fast_n0_err = an::jackknife_error(n0), m.fast_sigma_err = an::jackknife_error(sigma);
+    m.n0_err = an::jackknife_error(n0), m.sigma_err = an::jackknife_error(sigma);
   }
 
   dynhet::Scene::Clusters spec_;

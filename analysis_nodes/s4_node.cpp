@@ -16,10 +16,13 @@
 // xi(t) come at every t), or the scheduled lags nearest the times in
 // s4.lags (to bound the cost at N = 10^5, ~70 ms per pair for six grids).
 // The fits with jackknife errors and the chi4 comparison are made, per
-// cutoff, at t_s4, the computed lag nearest that cutoff's running tau_alpha
-// of the node's own (Q(t) from the same weights, W(q = 0) of the whole box;
-// the paper evaluates S4 at tau_alpha); before Q(t) crosses 1/e, at the last
-// lag with data.
+// cutoff, at t_s4 = that cutoff's running tau_alpha of the node's own (Q(t)
+// from the same weights, W(q = 0) of the whole box; the paper evaluates S4
+// at tau_alpha): S4 per origin interpolated linearly in ln t between the two
+// computed lags that bracket tau_alpha, the interpolation error (quadratic
+// through a third lag minus linear) in quadrature with the jackknife's. At
+// the computed lag nearest tau_alpha where it is not bracketed or the scene
+// lists s4.lags; before Q(t) crosses 1/e, at the last lag with data.
 //
 // Memory: the origin frames some later used lag still needs, 16 N bytes
 // each: at most (largest used lag) / origin_spacing + 1 of them; the S4
@@ -37,6 +40,7 @@
 #include <string>
 
 #include "dynhet/analysis/displacement.hpp"
+#include "dynhet/analysis/lag_interpolation.hpp"
 #include "dynhet/analysis/overlap.hpp"
 #include "dynhet/analysis/s4.hpp"
 #include "dynhet/analysis/s4_average.hpp"
@@ -79,6 +83,7 @@ private:
     for (int j = 0; j < m.n_lags; ++j)
       if (scene.s4_lags.empty()) slot_[j] = 0;
     for (double t : scene.s4_lags) slot_[an::nearest_lag(m.lag_time, t)] = 0;
+    interpolate_ = scene.s4_lags.empty(); // listed lags: results at the one nearest tau_alpha
     for (int j = 0; j < m.n_lags; ++j)
       if (slot_[j] == 0) slot_[j] = static_cast<int>(lags_.size()), lags_.push_back(m.lag_time[j]);
     for (double a : m.cutoff_a) cuts_.push_back(Cutoff{a, {}, std::make_unique<an::OverlapAccumulator>(m.n_origins, m.lag_time)});
@@ -122,6 +127,17 @@ private:
     std::unique_ptr<an::OverlapAccumulator> q_acc; // Q(t;t0) of the whole box, for tau_alpha and chi4
   };
 
+  // The computed lags bracketing tau_alpha, both with data (not ok(): not
+  // bracketed, or the scene lists the lags).
+  an::LagBracket bracket(const Cutoff& c, double tau_alpha) const {
+    if (!interpolate_) return {};
+    return an::bracket_lag(lags_, tau_alpha, [&](int l) {
+      for (int k = 0; k < info().n_origins; ++k)
+        if (c.acc[0].has(k, l)) return true;
+      return false;
+    });
+  }
+
   // The computed lag nearest tau_alpha (in ln t), else the last one with data.
   int fit_slot(const Cutoff& c, double tau_alpha) const {
     if (std::isfinite(tau_alpha)) return an::nearest_lag(lags_, tau_alpha);
@@ -144,11 +160,13 @@ private:
     m.cutoff_a = c.a, m.q_max = q_max_, m.qxi_max = kQxiMax;
     m.tau_alpha = c.q_acc->result().tau_alpha;
     const int l = fit_slot(c, m.tau_alpha);
-    m.lag_index = l, m.t_s4 = lags_[l];
+    const an::LagBracket b = bracket(c, m.tau_alpha);
+    m.lag_index = l, m.t_s4 = b.ok() ? m.tau_alpha : lags_[l];
+    m.lag_lo = b.ok() ? b.lo : -1, m.lag_hi = b.ok() ? b.hi : -1, m.lag_weight = b.ok() ? b.w : kNaN;
+    m.lag_third = b.ok() ? b.third : -1;
     m.lag_time = lags_;
     std::vector<std::string> notes;
-    for (size_t g = 0; g < grids_.size(); ++g) add_grid(m, c, g, l, notes);
-    m.n_origins = c.acc.back().mean(l).n_origins;
+    for (size_t g = 0; g < grids_.size(); ++g) add_grid(m, c, g, l, b, notes);
     const size_t whole = grids_.size() - 1;
     m.xi = m.oz_xi[whole], m.xi_err = m.oz_xi_err[whole], m.chi0 = m.oz_chi0[whole], m.chi0_err = m.oz_chi0_err[whole];
     m.chi4_box = m.chi4[whole], m.chi4_box_err = m.chi4_err[whole];
@@ -168,16 +186,29 @@ private:
     if (out().publish(dynhet::cutoff_channel(dynhet::kChanS4, m.cutoff_a), &m) != 0)
       std::fprintf(stderr, "s4_node: could not publish S4 (%d bytes)\n", m.getEncodedSize());
     if (final)
-      std::fprintf(stderr, "s4_node: a=%g t_s4=%.4g (tau_alpha %.4g), whole box xi=%.4g +- %.2g chi0=%.4g +- %.2g, chi4=%.4g +- %.2g (%d origins)\n",
-                   m.cutoff_a, m.t_s4, m.tau_alpha, m.xi, m.xi_err, m.chi0, m.chi0_err, m.chi4_box, m.chi4_box_err, m.n_origins);
+      std::fprintf(stderr, "s4_node: a=%g t_s4=%.4g (tau_alpha %.4g; %s), whole box xi=%.4g +- %.2g chi0=%.4g +- %.2g, chi4=%.4g +- %.2g (%d origins)\n",
+                   m.cutoff_a, m.t_s4, m.tau_alpha,
+                   m.lag_lo >= 0 ? "interpolated between two lags" : "the lag nearest", m.xi, m.xi_err, m.chi0, m.chi0_err, m.chi4_box, m.chi4_box_err, m.n_origins);
     if (final)
       for (const auto& n : notes) std::fprintf(stderr, "s4_node: a=%g %s\n", m.cutoff_a, n.c_str());
   }
 
-  // Grid g's shells, fits and chi4 of cutoff c at computed lag l.
-  void add_grid(dynhet::s4_t& m, const Cutoff& c, size_t g, int l, std::vector<std::string>& notes) const {
+  // Q(t;t0) of cutoff c per origin at computed lag l.
+  std::vector<double> q_per_origin(const Cutoff& c, int l) const {
+    const int j = static_cast<int>(std::find(slot_.begin(), slot_.end(), l) - slot_.begin());
+    std::vector<double> q(info().n_origins);
+    for (int k = 0; k < info().n_origins; ++k) q[k] = c.q_acc->q(k, j);
+    return q;
+  }
+
+  // Grid g's shells, fits and chi4 of cutoff c at t_s4: interpolated
+  // between the lags of b if b.ok(), else at computed lag l.
+  void add_grid(dynhet::s4_t& m, const Cutoff& c, size_t g, int l, const an::LagBracket& b,
+                std::vector<std::string>& notes) const {
     const an::S4Accumulator& a = c.acc[g];
-    const an::S4Accumulator::Mean mean = a.mean(l);
+    const an::S4AtTime at = b.ok() ? an::fit_s4_at_time(a, b, kQxiMax) : an::S4AtTime{a.mean(l), an::fit_s4_at_lag(a, l, kQxiMax)};
+    const an::S4Accumulator::Mean& mean = at.mean;
+    if (g + 1 == grids_.size()) m.n_origins = mean.n_origins;
     m.subbox_particles.push_back(grids_[g].mean_particles);
     m.subbox_per_side.push_back(grids_[g].per_side);
     m.grid_spacing.push_back(fft_[g]->spacing());
@@ -187,7 +218,7 @@ private:
     m.shell_vectors.insert(m.shell_vectors.end(), a.n_vectors().begin(), a.n_vectors().end());
     m.s4.insert(m.s4.end(), mean.s4.begin(), mean.s4.end());
     m.s4_err.insert(m.s4_err.end(), mean.s4_err.begin(), mean.s4_err.end());
-    const an::S4FitAtLag f = an::fit_s4_at_lag(a, l, kQxiMax);
+    const an::S4FitAtLag& f = at.fit;
     for (const auto* o : {&f.oz, &f.oz_a2})
       if (!o->note.empty())
         notes.push_back("N_box " + std::to_string(static_cast<long>(grids_[g].mean_particles + 0.5)) + ": xi of the " +
@@ -199,20 +230,21 @@ private:
     m.a2_xi.push_back(f.oz_a2.xi), m.a2_xi_err.push_back(f.oz_a2.xi_err);
     m.a2_a.push_back(f.oz_a2.a), m.a2_a_err.push_back(f.oz_a2.a_err);
     m.a2_q_fit_max.push_back(f.oz_a2.q_fit_max), m.a2_n_fit.push_back(f.oz_a2.n);
-    // chi4 at the same lag: S4 at q = 0 is eq. (14) for sub-boxes (W_r(0) = Q_r);
+    // chi4 at the same t: S4 at q = 0 is eq. (14) for sub-boxes (W_r(0) = Q_r);
     // the whole box has no q = 0 shell: N_tot var(Q) over origins.
     if (grids_[g].per_side > 1) {
       m.chi4.push_back(mean.s4[0]), m.chi4_err.push_back(mean.s4_err[0]);
     } else {
-      const int j = static_cast<int>(std::find(slot_.begin(), slot_.end(), l) - slot_.begin());
-      std::vector<double> q(info().n_origins);
-      for (int k = 0; k < info().n_origins; ++k) q[k] = c.q_acc->q(k, j);
-      const an::ValueErr c = an::whole_box_chi4(q, info().n_particles);
-      m.chi4.push_back(c.value), m.chi4_err.push_back(c.err);
+      const double n = static_cast<double>(info().n_particles);
+      const an::ValueErr x = b.ok() ? an::whole_box_chi4_at_time(q_per_origin(c, b.lo), q_per_origin(c, b.hi),
+                                                                 b.third >= 0 ? q_per_origin(c, b.third) : std::vector<double>{}, b, n)
+                                    : an::whole_box_chi4(q_per_origin(c, l), n);
+      m.chi4.push_back(x.value), m.chi4_err.push_back(x.err);
     }
   }
 
   double q_max_ = 1;
+  bool interpolate_ = true;   // at tau_alpha between computed lags (false: the scene lists s4.lags)
   std::vector<int> slot_;     // per scheduled lag: index among the computed lags, or -1
   std::vector<double> lags_;  // the computed lags
   std::vector<an::SubboxGrid> grids_;

@@ -23,9 +23,11 @@ Conventions (docs/analysis.md, "Study analysis"):
   node's): chi4, S4, xi and chi0 are interpolated linearly in ln t between
   the two computed lags around it; the interpolation error (against a
   parabola through the three nearest lags) is recorded and added in
-  quadrature. Clusters and P(dx) are taken at the lag nearest tau_alpha
-  that the nodes used (the study schedules a lag at the pilot's tau_alpha);
-  its distance from tau_alpha is recorded.
+  quadrature. Clusters are the clusters node's at its own tau_alpha (the
+  node interpolates between the lags around it, or takes the nearest lag
+  where tau_alpha is not bracketed); P(dx) is taken at the lag nearest
+  tau_alpha that the node used (the study schedules a lag at the pilot's
+  tau_alpha); the ratio of the time used to tau_alpha is recorded.
 - chi4(tau_alpha) is the largest proper sub-box's (the paper's chi4 comes
   from sub-boxes; the whole box of fixed N lacks the number fluctuations);
   xi is the whole box's OZ xi (the finest q).
@@ -1176,7 +1178,7 @@ def appendix_results(A):
         ax[0].errorbar(x, arr[:, 0], arr[:, 1], fmt=m, label=lab, mfc="none")
     ax[0].set_yscale("log")
     ax[0].set_xlabel("φ")
-    ax[0].set_ylabel("χ at the s4 node's t_s4 (the lag nearest τ_α)")
+    ax[0].set_ylabel("χ at the s4 node's t_s4 (= its τ_α)")
     ax[0].legend(fontsize=8)
     ax[0].set_title("Fig. fitting")
     rat = np.array(rat)

@@ -354,8 +354,9 @@ bool RunRecorder::on_s4(const s4_t &m) {
 // per shell value q, shell_vectors (grid g's shells follow grid g-1's). Per
 // record: s4, s4_err (records, values) at t_s4; s4_lag (records, lags,
 // values); xi_lag, chi0_lag (records, lags, grids); oz_*, a2_*, chi4,
-// chi4_err (records, grids); scalars tau_alpha, t_s4, lag_index, n_origins,
-// xi, xi_err, chi0, chi0_err, chi4_box, chi4_box_err.
+// chi4_err (records, grids); scalars tau_alpha, t_s4, lag_index, lag_lo,
+// lag_hi, lag_weight, lag_third, n_origins, xi, xi_err, chi0, chi0_err,
+// chi4_box, chi4_box_err.
 void RunRecorder::write_s4(const s4_t &m) {
   const std::string label = cutoff_label(m.cutoff_a);
   const std::string base = "s4/" + label + "/";
@@ -404,9 +405,12 @@ void RunRecorder::write_s4(const s4_t &m) {
   writer_->append_observable(base + "a2_n_fit", at, m.a2_n_fit);
   const std::pair<const char *, double> scalars[] = {
       {"tau_alpha", m.tau_alpha}, {"t_s4", m.t_s4}, {"xi", m.xi}, {"xi_err", m.xi_err}, {"chi0", m.chi0},
-      {"chi0_err", m.chi0_err}, {"chi4_box", m.chi4_box}, {"chi4_box_err", m.chi4_box_err}};
+      {"chi0_err", m.chi0_err}, {"chi4_box", m.chi4_box}, {"chi4_box_err", m.chi4_box_err}, {"lag_weight", m.lag_weight}};
   for (const auto &[name, v] : scalars) writer_->append_scalar(base + name, at, v);
   writer_->append_scalar(base + "lag_index", at, m.lag_index);
+  writer_->append_scalar(base + "lag_lo", at, m.lag_lo);
+  writer_->append_scalar(base + "lag_hi", at, m.lag_hi);
+  writer_->append_scalar(base + "lag_third", at, m.lag_third);
   writer_->append_scalar(base + "n_origins", at, m.n_origins);
 }
 
@@ -448,6 +452,7 @@ void RunRecorder::write_clusters(const clusters_t &m) {
   }
   scalar("tau_alpha", m.tau_alpha), scalar("tau_alpha_err", m.tau_alpha_err);
   scalar("lag_index", m.lag_index), scalar("lag", m.lag);
+  scalar("lag_lo", m.lag_lo), scalar("lag_hi", m.lag_hi), scalar("lag_weight", m.lag_weight), scalar("lag_third", m.lag_third);
   array("n_origins", m.n_origins), array("n_slow", m.n_slow), array("n_fast", m.n_fast);
   array("mean_size_slow", m.mean_size_slow), array("mean_size_slow_err", m.mean_size_slow_err);
   array("mean_size_fast", m.mean_size_fast), array("mean_size_fast_err", m.mean_size_fast_err);

@@ -39,6 +39,30 @@ def crossing_time(t, q, level):
     return math.nan
 
 
+def bracket(t, tau):
+    """The node's bracket (lag_interpolation.hpp): adjacent lags lo, hi = lo + 1 with
+    t[lo] <= tau <= t[hi], w = ln(tau/t_lo)/ln(t_hi/t_lo), and the third lag (the
+    neighbour on tau's side, else the other); None outside the lags."""
+    n = len(t)
+    if not (math.isfinite(tau) and t[0] <= tau <= t[-1]) or n < 2:
+        return None
+    lo = 0
+    while lo + 2 < n and t[lo + 1] <= tau:
+        lo += 1
+    hi = lo + 1
+    w = math.log(tau / t[lo]) / math.log(t[hi] / t[lo])
+    below, above = (lo - 1 if lo > 0 else None), (hi + 1 if hi + 1 < n else None)
+    third = (below if below is not None else above) if w < 0.5 else (above if above is not None else below)
+    return lo, hi, w, third
+
+
+def quad_minus_lin(t, tau, lo, hi, third, v_lo, v_hi, v_3):
+    """The quadratic in ln t through the three lags minus the linear interpolation, at tau."""
+    x = np.log([t[lo], t[hi], t[third], tau])
+    c = np.polyfit(x[:3], np.array([v_lo, v_hi, v_3], dtype=float), 2)
+    return np.polyval(c, x[3]) - (v_lo + (x[3] - x[0]) / (x[1] - x[0]) * (v_hi - v_lo))
+
+
 def origin_mean(x):
     """Mean over origins (axis 0) and its standard error, as the node's BlockAverage."""
     return x.mean(axis=0), x.std(axis=0, ddof=1) / math.sqrt(x.shape[0])
@@ -378,23 +402,43 @@ def check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, sched_lag):
     tau = float(g["tau_alpha"]["value"][-1])
     tau_ov = float(f[f"observables/overlap/a{a:g}/tau_alpha"]["value"][-1])
     check(abs(tau - tau_ov) <= 1e-9 * tau_ov, f"s4 {name}: tau_alpha {tau:.6g} is the overlap node's")
+    # At tau_alpha: S4 interpolated in ln t between the computed lags that bracket it.
     t_s4 = float(g["t_s4"]["value"][-1])
-    check(t_s4 == lags[np.argmin(np.abs(np.log(lags / tau)))], f"s4 {name}: fits at t = {t_s4:.4g}, the lag nearest tau_alpha")
+    br = bracket(lags, tau)
+    check(br is not None, f"s4 {name}: tau_alpha {tau:.4g} lies within the computed lags")
+    lo, hi, w, third = br
+    rec = tuple(int(g[k]["value"][-1]) for k in ("lag_lo", "lag_hi", "lag_third"))
+    check(rec == (lo, hi, third if third is not None else -1), f"s4 {name}: bracketing lags {rec} (and the third)")
+    check(abs(t_s4 - tau) <= 1e-12 * tau, f"s4 {name}: t_s4 {t_s4:.15g} is tau_alpha {tau:.15g}")
+    check(abs(float(g["lag_weight"]["value"][-1]) - w) <= 1e-12, f"s4 {name}: weight w = {w:.6f}")
     li = int(g["lag_index"]["value"][-1])
-    check(np.array_equal(g["s4"]["value"][-1], s4_lag[li], equal_nan=True), f"s4 {name}: S4 at t_s4 is its row of s4_lag")
-    # chi4 at t_s4: S4 at q = 0 for sub-boxes (checked above, shell 0), N var(Q) for the whole box.
-    j = int(np.argmin(np.abs(np.log(sched_lag / t_s4))))
+    check(li == int(np.argmin(np.abs(np.log(lags / tau)))), f"s4 {name}: lag_index is the lag nearest tau_alpha")
+    s4_rec, s4_err = g["s4"]["value"][-1], g["s4_err"]["value"][-1]
+    s4_lin = (1 - w) * s4_lag[lo] + w * s4_lag[hi]
+    check(np.allclose(s4_rec, s4_lin, rtol=1e-12, atol=1e-14, equal_nan=True),
+          f"s4 {name}: S4 at t_s4 is (1 - w) S4(t_lo) + w S4(t_hi)")
+    if third is not None:
+        d = np.abs(quad_minus_lin(lags, tau, lo, hi, third, s4_lag[lo], s4_lag[hi], s4_lag[third]))
+        ok = np.isfinite(d)
+        check(np.all(s4_err[ok] >= d[ok] * (1 - 1e-9)),
+              f"s4 {name}: every S4 error holds the interpolation error (largest {np.max(d[ok] / s4_rec[ok]):.2g} of S4)")
+    # chi4 at t_s4: S4 at q = 0 for sub-boxes, N var(Q) interpolated for the whole box.
     chi4 = g["chi4"]["value"][-1]
     for gi, m in enumerate(sides):
         if m == 1:
-            q = [np.mean(np.hypot(*(unwrapped[pair_frame[k][j]] - unwrapped[of]).T) < a) for k, of in enumerate(origin_frame)]
-            bf = n * np.var(q, ddof=1)
-            check(abs(chi4[gi] - bf) <= 1e-9 * bf, f"s4 {name}: whole-box chi4 {chi4[gi]:.5g} = N var(Q) over origins")
+            bf = []
+            for l_ in (lo, hi):
+                j = int(np.argmin(np.abs(np.log(sched_lag / lags[l_]))))
+                q = [np.mean(np.hypot(*(unwrapped[pair_frame[k][j]] - unwrapped[of]).T) < a) for k, of in enumerate(origin_frame)]
+                bf.append(n * np.var(q, ddof=1))
+            bf_t = (1 - w) * bf[0] + w * bf[1]
+            check(abs(chi4[gi] - bf_t) <= 1e-9 * bf_t,
+                  f"s4 {name}: whole-box chi4 {chi4[gi]:.5g} = N var(Q) interpolated ({bf[0]:.5g} .. {bf[1]:.5g})")
         else:
-            check(chi4[gi] == s4_lag[li, start[gi]], f"s4 {name} m={m}: chi4 at t_s4 is S4 at q = 0")
+            check(chi4[gi] == s4_rec[start[gi]], f"s4 {name} m={m}: chi4 at t_s4 is S4 at q = 0")
     # OZ fit of the whole box: a least-squares minimum of the relative residuals over its range.
     gi = len(sides) - 1
-    q, s4 = q_rec[start[gi]:start[gi + 1]], s4_lag[li, start[gi]:start[gi + 1]]
+    q, s4 = q_rec[start[gi]:start[gi + 1]], s4_rec[start[gi]:start[gi + 1]]
     chi0, xi, qf = (float(g[k]["value"][-1][gi]) for k in ("oz_chi0", "oz_xi", "oz_q_fit_max"))
     if math.isfinite(xi):
         sel = (q > 0) & (q <= qf * (1 + 1e-12)) & np.isfinite(s4)
@@ -404,6 +448,12 @@ def check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, sched_lag):
         nudged = min(sse(chi0 * f1, xi * f2) for f1 in (0.999, 1, 1.001) for f2 in (0.999, 1, 1.001) if (f1, f2) != (1, 1))
         check(best <= nudged * (1 + 1e-9), f"s4 {name}: OZ fit xi={xi:.4g} chi0={chi0:.4g} over q <= {qf:.3g} is a least-squares minimum")
         check(float(g["xi"]["value"][-1]) == xi, f"s4 {name}: the xi summary is the whole box's")
+        # Between the bracketing lags' fits (xi_lag, chi0_lag: the same fit at each lag), within the error.
+        for k_, v, e in (("xi_lag", xi, float(g["oz_xi_err"]["value"][-1][gi])),
+                         ("chi0_lag", chi0, float(g["oz_chi0_err"]["value"][-1][gi]))):
+            at = g[k_]["value"][-1][[lo, hi], gi]
+            check(min(at) - e <= v <= max(at) + e,
+                  f"s4 {name}: whole-box {k_[:-4]} {v:.4g} +- {e:.2g} at t_s4 lies between its values at the lags {at}")
     else:
         check(False, f"s4 {name}: no OZ fit of the whole box")
 
@@ -514,15 +564,46 @@ def check_clusters(f, unwrapped, L, origin_frame, pair_frame, lag, scene):
             close = np.hypot(d[..., 0], d[..., 1]) < cut[species[:, None] + species[None, :]]
             np.fill_diagonal(close, False)
             neighbours.append([np.flatnonzero(row) for row in close])
+        # tau_alpha lies between two scheduled lags: the results there are interpolated in ln t.
+        br = bracket(lag, tau_bf)
+        check(br is not None and int(g["lag_lo"]["value"][-1]) == br[0] and int(g["lag_hi"]["value"][-1]) == br[1],
+              f"clusters {name}: interpolated between the lags that bracket tau_alpha")
+        lo_, hi_, w, third = br
+        check(int(g["lag_third"]["value"][-1]) == (third if third is not None else -1), f"clusters {name}: third lag {third}")
+        check(abs(float(g["lag"]["value"][-1]) - tau) <= 1e-12 * tau, f"clusters {name}: the results are at t = tau_alpha")
+        check(abs(float(g["lag_weight"]["value"][-1]) - w) <= 1e-12, f"clusters {name}: weight w = {w:.6f}")
+
+        def at_t(v_lo, v_hi, v_3, err=None):
+            """(value, smallest admissible error): the interpolated value, and the interpolation error."""
+            v = (1 - w) * v_lo + w * v_hi
+            d = np.abs(quad_minus_lin(lag, tau, lo_, hi_, third, v_lo, v_hi, v_3)) if third is not None else 0 * v
+            return v, np.where(np.isfinite(d), d, 0)
+
         mean_size = {"slow": [], "fast": []}
-        at_lag = {"slow": [], "fast": []}
+        clusters_at = {"slow": {}, "fast": {}}
         for jj in range(len(lag)):
             for kind, sel in (("slow", d2[:, jj] < a * a), ("fast", d2[:, jj] > 9 * a * a)):
                 cl = [c for k, of in enumerate(origin_frame)
                       for c in clusters_bf(unwrapped[of], unwrapped[pair_frame[k][jj]], neighbours[k], sel[k], L)]
                 mean_size[kind].append(sum(c[0] for c in cl) / len(cl) if cl else math.nan)
-                if jj == j:
-                    at_lag[kind] = cl
+                if jj in (j, lo_, hi_, third):
+                    clusters_at[kind][jj] = cl
+        lo, hi = g["size_lo"][()], g["size_hi"][()]
+
+        def results(cl):
+            """P(N_c), R_g per bin and d_f of one lag's clusters (brute force)."""
+            sizes = np.array([c[0] for c in cl])
+            count = np.array([np.sum((sizes >= l) & (sizes <= h)) for l, h in zip(lo, hi)])
+            used = [(c[0], c[1]) for c in cl if c[0] >= n_min and c[1] > 0]
+            ln_n, ln_rg = [], []
+            for l, h in zip(lo, hi):
+                inbin = [(math.log(s), math.log(rg)) for s, rg in used if l <= s <= h]
+                ln_n.append(np.mean([v[0] for v in inbin]) if inbin else math.nan)
+                ln_rg.append(np.mean([v[1] for v in inbin]) if inbin else math.nan)
+            ok = np.isfinite(ln_n)
+            d_f = 1 / np.polyfit(np.array(ln_n)[ok], np.array(ln_rg)[ok], 1)[0] if ok.sum() >= 3 else math.nan  # 3 bins (clusters.hpp)
+            return {"count": count, "p": count / (len(sizes) * (hi - lo + 1)), "rg": np.exp(ln_rg), "d_f": d_f}
+
         for kind in ("slow", "fast"):
             rec = g[f"mean_size_{kind}"]["value"][-1]
             same = np.allclose(rec, mean_size[kind], rtol=1e-12, atol=0, equal_nan=True)
@@ -530,31 +611,32 @@ def check_clusters(f, unwrapped, L, origin_frame, pair_frame, lag, scene):
             n_sel = g[f"n_{kind}"]["value"][-1]
             sel_bf = np.mean(d2 < a * a if kind == "slow" else d2 > 9 * a * a, axis=2).mean(axis=0) * n
             check(np.allclose(n_sel, sel_bf, rtol=1e-12), f"clusters {name}: {kind} particles per origin at every lag")
-            # At the chosen lag: the size histogram, R_g per bin, d_f.
-            lo, hi = g["size_lo"][()], g["size_hi"][()]
-            sizes = np.array([c[0] for c in at_lag[kind]])
-            count_bf = np.array([np.sum((sizes >= l) & (sizes <= h)) for l, h in zip(lo, hi)])
-            check(np.array_equal(g[f"count_{kind}"]["value"][-1], count_bf), f"clusters {name}: {kind} P(N_c) counts equal brute force")
-            p_bf = count_bf / (len(sizes) * (hi - lo + 1))
-            check(np.allclose(g[f"p_{kind}"]["value"][-1], p_bf, rtol=1e-12, atol=0), f"clusters {name}: {kind} P(N_c)")
-            spans = sum(math.isnan(c[1]) for c in at_lag[kind])
+            # <N_c> at tau_alpha: interpolated, its error (1 - w) e_lo + w e_hi with the interpolation's in quadrature.
+            e_lag = g[f"mean_size_{kind}_err"]["value"][-1]
+            v, d = at_t(rec[lo_], rec[hi_], rec[third] if third is not None else math.nan)
+            e = math.hypot((1 - w) * e_lag[lo_] + w * e_lag[hi_], d)
+            got, got_e = float(g[f"{kind}_mean_size"]["value"][-1]), float(g[f"{kind}_mean_size_err"]["value"][-1])
+            check(abs(got - v) <= 1e-12 * v and abs(got_e - e) <= 1e-9 * e,
+                  f"clusters {name}: {kind} <N_c> at tau_alpha {got:.4g} +- {got_e:.2g} (interpolation error {d:.2g})")
+            # The nearest lag: the size histogram's counts and the spanning clusters.
+            r = {jj: results(cl) for jj, cl in clusters_at[kind].items()}
+            check(np.array_equal(g[f"count_{kind}"]["value"][-1], r[j]["count"]),
+                  f"clusters {name}: {kind} P(N_c) counts at the nearest lag equal brute force")
+            spans = sum(math.isnan(c[1]) for c in clusters_at[kind][j])
             check(int(g[f"{kind}_spanning"]["value"][-1]) == spans, f"clusters {name}: {spans} spanning {kind} clusters")
-            used = [(c[0], c[1]) for c in at_lag[kind] if c[0] >= n_min and c[1] > 0]
-            ln_n, ln_rg = [], []
-            for l, h in zip(lo, hi):
-                inbin = [(math.log(s), math.log(rg)) for s, rg in used if l <= s <= h]
-                ln_n.append(np.mean([v[0] for v in inbin]) if inbin else math.nan)
-                ln_rg.append(np.mean([v[1] for v in inbin]) if inbin else math.nan)
-            rg_rec = g[f"rg_{kind}"]["value"][-1]
-            same = np.allclose(rg_rec, np.exp(ln_rg), rtol=1e-9, atol=0, equal_nan=True)
-            check(same, f"clusters {name}: {kind} R_g per N_c bin (R_g at t0 + t, periodic) equals brute force")
-            ok = np.isfinite(ln_n)
-            d_f = float(g[f"{kind}_d_f"]["value"][-1])
-            if ok.sum() >= 3:  # d_f needs 3 bins (clusters.hpp)
-                d_f_bf = 1 / np.polyfit(np.array(ln_n)[ok], np.array(ln_rg)[ok], 1)[0]
-                check(abs(d_f - d_f_bf) <= 1e-9 * abs(d_f_bf), f"clusters {name}: {kind} d_f = {d_f:.4g} (brute force {d_f_bf:.4g})")
-            else:
-                check(math.isnan(d_f), f"clusters {name}: {kind} d_f is NaN with {ok.sum()} R_g bins")
+            # Interpolated: P(N_c), R_g per bin, d_f; each error at least the interpolation error.
+            for key, tol, label in (("p", 1e-12, "P(N_c)"), ("rg", 1e-9, "R_g per N_c bin (R_g at t0 + t, periodic)"),
+                                    ("d_f", 1e-9, "d_f")):
+                rec_v = np.atleast_1d(g[f"{kind}_d_f" if key == "d_f" else f"{key}_{kind}"]["value"][-1])
+                rec_e = np.atleast_1d(g[f"{kind}_d_f_err" if key == "d_f" else f"{key}_{kind}_err"]["value"][-1])
+                v3 = r[third][key] if third is not None else np.nan * np.asarray(r[lo_][key])
+                v, d = at_t(np.asarray(r[lo_][key]), np.asarray(r[hi_][key]), np.asarray(v3))
+                v = np.atleast_1d(v)
+                same = np.allclose(rec_v, v, rtol=tol, atol=0, equal_nan=True)
+                check(same, f"clusters {name}: {kind} {label} at tau_alpha equals brute force interpolated")
+                fin = np.isfinite(rec_e)
+                check(np.all(rec_e[fin] >= np.atleast_1d(d)[fin] * (1 - 1e-9)),
+                      f"clusters {name}: {kind} {label} errors hold the interpolation error")
 
 
 def main(path, scene_path):

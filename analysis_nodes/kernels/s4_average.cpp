@@ -52,7 +52,11 @@ S4Accumulator::Mean S4Accumulator::mean(int j, int skip) const {
   return m;
 }
 
-S4FitAtLag fit_s4_at_lag(const S4Accumulator& acc, int j, double qxi_max) {
+namespace {
+
+// fit_s4_at_lag without the notes: the fits to the origin mean at lag j,
+// their errors the jackknife over origins.
+S4FitAtLag jackknife_fits(const S4Accumulator& acc, int j, double qxi_max) {
   const S4Accumulator::Mean all = acc.mean(j);
   S4FitAtLag out{fit_oz(acc.q(), all.s4, {}, qxi_max), fit_oz_a2(acc.q(), all.s4, {}, qxi_max), all.n_origins};
   // Leave-one-out fits: chi0, xi (both forms) and A.
@@ -67,7 +71,11 @@ S4FitAtLag fit_s4_at_lag(const S4Accumulator& acc, int j, double qxi_max) {
   out.oz.chi0_err = jackknife_error_3(chi0), out.oz.xi_err = jackknife_error_3(xi);
   out.oz_a2.chi0_err = jackknife_error_3(chi0_a2), out.oz_a2.xi_err = jackknife_error_3(xi_a2);
   out.oz_a2.a_err = jackknife_error_3(a);
-  // Where xi is not determined, say so instead of printing a number.
+  return out;
+}
+
+// Where xi is not determined, say so instead of printing a number.
+void flag_undetermined(S4FitAtLag& out, double qxi_max) {
   for (OzFit* f : {&out.oz, &out.oz_a2}) {
     if (!std::isfinite(f->xi)) continue;
     char buf[200];
@@ -82,6 +90,54 @@ S4FitAtLag fit_s4_at_lag(const S4Accumulator& acc, int j, double qxi_max) {
       f->note = buf, f->xi = f->xi_err = kNaN;
     }
   }
+}
+
+// err and |a - b| in quadrature; err unchanged where a or b is not finite.
+double with_difference(double err, double a, double b) {
+  return std::isfinite(a) && std::isfinite(b) ? std::hypot(err, a - b) : err;
+}
+
+} // namespace
+
+S4FitAtLag fit_s4_at_lag(const S4Accumulator& acc, int j, double qxi_max) {
+  S4FitAtLag out = jackknife_fits(acc, j, qxi_max);
+  flag_undetermined(out, qxi_max);
+  return out;
+}
+
+S4Accumulator interpolate_s4(const S4Accumulator& acc, const LagBracket& b) {
+  if (!b.ok()) throw std::invalid_argument("interpolate_s4: the time is not between two lags");
+  S4Accumulator out(acc.n_origins(), 1, acc.q(), acc.n_vectors());
+  S4Shells s;
+  for (int k = 0; k < acc.n_origins(); ++k) {
+    if (!acc.has(k, b.lo) || !acc.has(k, b.hi)) continue;
+    const double *lo = acc.at(k, b.lo), *hi = acc.at(k, b.hi);
+    s.s4.resize(acc.q().size());
+    for (size_t v = 0; v < s.s4.size(); ++v) s.s4[v] = interpolate(b, lo[v], hi[v]);
+    out.add(k, 0, s);
+  }
+  return out;
+}
+
+S4AtTime fit_s4_at_time(const S4Accumulator& acc, const LagBracket& b, double qxi_max) {
+  const S4Accumulator at = interpolate_s4(acc, b);
+  S4AtTime out{at.mean(0), jackknife_fits(at, 0, qxi_max)};
+  // The quadratic through the origin means at the three lags, per shell.
+  const S4Accumulator::Mean lo = acc.mean(b.lo), hi = acc.mean(b.hi);
+  const S4Accumulator::Mean third = b.third >= 0 ? acc.mean(b.third) : S4Accumulator::Mean{};
+  std::vector<double> quad = out.mean.s4;
+  for (size_t v = 0; v < quad.size(); ++v) {
+    const double d = quadratic_minus_linear(b, lo.s4[v], hi.s4[v], b.third >= 0 ? third.s4[v] : kNaN);
+    quad[v] += d;
+    out.mean.s4_err[v] = std::hypot(out.mean.s4_err[v], d);
+  }
+  // The fits' interpolation error: linear against quadratic S4.
+  const OzFit f = fit_oz(acc.q(), quad, {}, qxi_max), g = fit_oz_a2(acc.q(), quad, {}, qxi_max);
+  OzFit &oz = out.fit.oz, &a2 = out.fit.oz_a2;
+  oz.chi0_err = with_difference(oz.chi0_err, oz.chi0, f.chi0), oz.xi_err = with_difference(oz.xi_err, oz.xi, f.xi);
+  a2.chi0_err = with_difference(a2.chi0_err, a2.chi0, g.chi0), a2.xi_err = with_difference(a2.xi_err, a2.xi, g.xi);
+  a2.a_err = with_difference(a2.a_err, a2.a, g.a);
+  flag_undetermined(out.fit, qxi_max);
   return out;
 }
 
@@ -100,6 +156,33 @@ ValueErr whole_box_chi4(const std::vector<double>& q_per_origin, double n_total)
   std::vector<double> loo;
   for (size_t k = 0; k < q.size(); ++k) loo.push_back(chi4(k));
   return {chi4(q.size()), jackknife_error_3(loo)};
+}
+
+} // namespace dynhet::analysis
+
+namespace dynhet::analysis {
+
+ValueErr whole_box_chi4_at_time(const std::vector<double>& q_lo, const std::vector<double>& q_hi,
+                                const std::vector<double>& q_third, const LagBracket& b, double n_total) {
+  // The origins with Q at both lags.
+  std::vector<double> lo, hi;
+  for (size_t k = 0; k < q_lo.size() && k < q_hi.size(); ++k)
+    if (!std::isnan(q_lo[k]) && !std::isnan(q_hi[k])) lo.push_back(q_lo[k]), hi.push_back(q_hi[k]);
+  // N_tot times the sample variance of the values other than `skip`, interpolated.
+  auto chi4 = [&](size_t skip) {
+    double s_lo = 0, s2_lo = 0, s_hi = 0, s2_hi = 0;
+    size_t n = 0;
+    for (size_t k = 0; k < lo.size(); ++k)
+      if (k != skip) s_lo += lo[k], s2_lo += lo[k] * lo[k], s_hi += hi[k], s2_hi += hi[k] * hi[k], ++n;
+    if (n < 2) return kNaN;
+    return interpolate(b, n_total * (s2_lo - s_lo * s_lo / n) / (n - 1), n_total * (s2_hi - s_hi * s_hi / n) / (n - 1));
+  };
+  std::vector<double> loo;
+  for (size_t k = 0; k < lo.size(); ++k) loo.push_back(chi4(k));
+  const double value = chi4(lo.size());
+  const double v_lo = whole_box_chi4(lo, n_total).value, v_hi = whole_box_chi4(hi, n_total).value;
+  const double d = b.third >= 0 ? quadratic_minus_linear(b, v_lo, v_hi, whole_box_chi4(q_third, n_total).value) : 0.0;
+  return {value, std::hypot(jackknife_error_3(loo), d)};
 }
 
 } // namespace dynhet::analysis

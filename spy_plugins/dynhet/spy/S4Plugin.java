@@ -6,7 +6,7 @@ import javax.swing.JDesktopPane;
 import lcm.spy.ChannelData;
 import lcm.spy.SpyPlugin;
 
-/** lcm-spy view of s4_t (DYNHET_S4_<a>): S4(q) at the lag t_s4 on every sub-box grid, log-log. */
+/** lcm-spy view of s4_t (DYNHET_S4_<a>): S4(q) at t_s4 (= tau_alpha, between lags) on every sub-box grid, log-log. */
 public final class S4Plugin implements SpyPlugin {
   public boolean canHandle(long fingerprint) { return fingerprint == s4_t.LCM_FINGERPRINT; }
 

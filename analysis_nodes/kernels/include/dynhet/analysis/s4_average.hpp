@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "dynhet/analysis/fits.hpp"
+#include "dynhet/analysis/lag_interpolation.hpp"
 #include "dynhet/analysis/s4.hpp"
 
 namespace dynhet::analysis {
@@ -31,9 +32,10 @@ public:
   const std::vector<double>& q() const { return q_; }
   const std::vector<int>& n_vectors() const { return n_vectors_; }
   int n_origins() const { return n_origins_; }
+  // Origin k's S4 per shell at lag j (meaningful where has(k, j)).
+  const double* at(int k, int j) const { return s4_.data() + (static_cast<size_t>(k) * n_lags_ + j) * q_.size(); }
 
 private:
-  const double* at(int k, int j) const { return s4_.data() + (static_cast<size_t>(k) * n_lags_ + j) * q_.size(); }
   int n_origins_, n_lags_;
   std::vector<double> q_;
   std::vector<int> n_vectors_;
@@ -61,9 +63,35 @@ S4FitAtLag fit_s4_at_lag(const S4Accumulator& acc, int j, double qxi_max = 1.0);
 // chi4 of the whole box at one lag, where the sub-box average of eq. (14)
 // has one term: N_tot times the variance over origins of Q(t;t0) (n/(n-1)
 // corrected), with its jackknife error. NaN below 2 (error 3) origins.
-struct ValueErr {
-  double value, err;
-};
 ValueErr whole_box_chi4(const std::vector<double>& q_per_origin, double n_total);
+
+// At a time t between two computed lags (b from bracket_lag over the
+// accumulator's lags): S4 per origin measured at both lags, (1 - w) S4(lo)
+// + w S4(hi), linear in ln t, as the one lag of a new accumulator; so the
+// mean, its standard error and the jackknife of the fits run over origins
+// exactly as at a lag, and the correlation of the two lags (they share
+// their origins) is kept.
+S4Accumulator interpolate_s4(const S4Accumulator& acc, const LagBracket& b);
+
+// The origin mean of S4 and the fits at t: fit_s4_at_lag on interpolate_s4,
+// each error with the interpolation's own in quadrature: per shell
+// |quadratic - linear| in ln t through the origin means at lo, hi and the
+// third lag (quadratic_minus_linear), and for chi0, xi, A the difference of
+// the fits to the linearly and to the quadratically interpolated mean
+// (where the latter fit gives no number, none is added). xi's notes
+// (fit_s4_at_lag) judge the total error.
+struct S4AtTime {
+  S4Accumulator::Mean mean; // s4_err: the standard error over origins and the interpolation error
+  S4FitAtLag fit;
+};
+S4AtTime fit_s4_at_time(const S4Accumulator& acc, const LagBracket& b, double qxi_max = 1.0);
+
+// whole_box_chi4 at t: (1 - w) chi4(lo) + w chi4(hi) over the origins with
+// Q at both lags (chi4 is a variance over origins: Q is not interpolated per
+// origin, which would lower it by w (1 - w) N var(Q_hi - Q_lo)); the
+// jackknife over those origins of the interpolated value, and the
+// interpolation error from chi4 at the third lag in quadrature.
+ValueErr whole_box_chi4_at_time(const std::vector<double>& q_lo, const std::vector<double>& q_hi,
+                                const std::vector<double>& q_third, const LagBracket& b, double n_total);
 
 } // namespace dynhet::analysis
