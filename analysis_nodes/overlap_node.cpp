@@ -216,20 +216,44 @@ private:
       }
     }
     out().publish(dynhet::kChanMsd, &m);
+    if (final && std::isfinite(m.diffusion_flow)) {
+      // How often the longest waves' phases renewed themselves in the run,
+      // per |n| (a diagnostic: the flows' error counts each wave's energy
+      // once per run whatever the phases do).
+      std::vector<int> nx, ny;
+      an::wave_vectors(kFlowModes, nx, ny);
+      std::string shells;
+      for (int r = 1; r <= kFlowModes; ++r) {
+        std::vector<double> g;
+        for (size_t q = 0; q < n_modes_; ++q)
+          if (nx[q] * nx[q] + ny[q] * ny[q] <= r * r && nx[q] * nx[q] + ny[q] * ny[q] > (r - 1) * (r - 1))
+            g.push_back(renewals_[q]);
+        std::sort(g.begin(), g.end());
+        if (!g.empty()) shells += " " + std::to_string(r) + ":" + std::to_string(g[g.size() / 2]).substr(0, 6);
+      }
+      std::fprintf(stderr,
+                   "overlap_node: D=%.5g +- %.2g over t in [%.4g, %.4g]; D_flow=%.4g +- %.2g (waves |n| <= %d); "
+                   "median phase renewals of the transverse waves in the run by |n|:%s\n",
+                   m.diffusion, m.diffusion_err, m.fit_t_min, m.fit_t_max, m.diffusion_flow, m.diffusion_flow_err,
+                   kFlowModes, shells.c_str());
+    }
   }
   // D_flow = sum over the modes of c = a quarter of the slope of the mode's
   // share of the MSD over D's fit range, and the spread of D_flow between
-  // runs. A transverse mode is an Ornstein-Uhlenbeck velocity (linear
-  // fluctuating hydrodynamics: rate gamma = nu k^2) with a Gaussian
-  // amplitude: a mode frozen over the run gives an exponential c (variance
-  // = mean^2, E c^2 = 2 var); one that renews itself nu times in the run a
-  // Gamma (variance mean^2 / nu, E c^2 = (1 + 1/nu) mean^2). So var c =
-  // c^2 / (1 + nu), nu = 1 + gamma T, T the time the run's origins and
-  // lags span and gamma the mode's rate from the correlation of its
-  // amplitude at the last lag between origins whose windows do not overlap
-  // (ou_rate_from_correlation). Without two such origins: frozen (nu = 1).
+  // runs. A wave's amplitude is Gaussian, so the energy a run samples is
+  // exponential: var c = mean^2 = E c^2 / 2, estimated by c^2 / 2, if each
+  // wave's energy is sampled once per run. That is what the seeds say:
+  // D_flow varies between runs far more than between blocks of origins of
+  // one run (docs/analysis.md) although the waves' phases renew within a
+  // run (their correlation between origins whose windows do not overlap,
+  // ou_rate_from_correlation, is printed per |n| as the renewals gamma T;
+  // mostly "inf": none left); the energy in the longest waves is what
+  // persists, and one run cannot sample its spread. Counting the phase
+  // renewals as independent samples (var c^2 / (2 + gamma T)) gave errors
+  // 1.6-1.8 times too small in the seed study.
   void flow_part(dynhet::msd_t& m) const {
     if (n_modes_ == 0) return;
+    renewals_.assign(n_modes_, std::numeric_limits<double>::quiet_NaN());
     const int no = info().n_origins;
     const double t = m.lag_time.back();
     const double span = (no - 1) * dynhet::origin_spacing(info()) + t;
@@ -260,14 +284,15 @@ private:
             gaps.push_back(t0[l] - t0[k]);
           }
         }
-        double nu = 1; // frozen unless two origins far enough apart say otherwise
+        double nu = 1; // phases frozen unless two origins far enough apart say otherwise
         if (n_cross > 0 && power > 0) {
           const double gamma = an::ou_rate_from_correlation(t, gaps, (cross / n_cross) / (power / n_power));
           if (std::isfinite(gamma)) nu = 1 + gamma * span;
           else if (gamma > 0) nu = std::numeric_limits<double>::infinity();
         }
         sum += d.d;
-        if (std::isfinite(nu)) var += d.d * d.d / (1 + nu);
+        var += d.d * d.d / 2;
+        if (part == 0) renewals_[q] = nu - 1;
       }
     m.diffusion_flow = sum, m.diffusion_flow_err = std::sqrt(var);
   }
@@ -354,6 +379,7 @@ private:
   size_t n_modes_ = 0;
   std::vector<double> flow_t_, flow_l_;      // per (origin, lag, mode): collective_modes
   std::vector<double> amp_;                  // per (origin, mode): u_k . e at the last lag (t re, im, l re, im)
+  mutable std::vector<double> renewals_;     // per mode: gamma T of the transverse part (flow_part), for the log
   std::vector<double> d2_, select_;          // |dr|^2 of the pair; the selection's buffer
   dynhet::Scene::Msd msd_spec_;
   std::unique_ptr<dynhet::DisplacementResults> displacement_;
