@@ -179,6 +179,9 @@ private:
         m.xi_lag.push_back(f.xi), m.chi0_lag.push_back(f.chi0);
       }
     m.n_grids = static_cast<int32_t>(grids_.size());
+    m.scan_qxi_max = an::kOzRangeScan;
+    m.n_scan = static_cast<int32_t>(m.scan_qxi_max.size());
+    m.n_scan_values = static_cast<int32_t>(m.scan_oz_xi.size());
     m.n_values = static_cast<int32_t>(m.q.size());
     m.n_lags = static_cast<int32_t>(lags_.size());
     m.n_lag_values = static_cast<int32_t>(m.s4_lag.size());
@@ -191,6 +194,18 @@ private:
                    m.lag_lo >= 0 ? "interpolated between two lags" : "the lag nearest", m.xi, m.xi_err, m.chi0, m.chi0_err, m.chi4_box, m.chi4_box_err, m.n_origins);
     if (final)
       for (const auto& n : notes) std::fprintf(stderr, "s4_node: a=%g %s\n", m.cutoff_a, n.c_str());
+    if (final) {
+      // The whole box's xi against the fit range (q xi <= 0.5 .. 2).
+      std::string xs;
+      for (int r = 0; r < m.n_scan; ++r) {
+        char buf[48];
+        std::snprintf(buf, sizeof buf, " %g:%.4g", m.scan_qxi_max[r], m.scan_oz_xi[whole * m.n_scan + r]);
+        xs += buf;
+      }
+      const std::vector<double> v(m.scan_oz_xi.begin() + whole * m.n_scan, m.scan_oz_xi.begin() + (whole + 1) * m.n_scan);
+      std::fprintf(stderr, "s4_node: a=%g whole box OZ xi by fit range (q xi <=):%s; half their range %.2g against the error %.2g\n",
+                   m.cutoff_a, xs.c_str(), an::half_range(v), m.xi_err);
+    }
   }
 
   // Q(t;t0) of cutoff c per origin at computed lag l.
@@ -223,6 +238,11 @@ private:
       if (!o->note.empty())
         notes.push_back("N_box " + std::to_string(static_cast<long>(grids_[g].mean_particles + 0.5)) + ": xi of the " +
                         (o == &f.oz ? "OZ" : "OZ + A^2") + " fit not determined (" + o->note + ")");
+    const an::OzRangeScan scan = an::scan_oz_range(a.q(), mean.s4);
+    m.scan_oz_xi.insert(m.scan_oz_xi.end(), scan.xi.begin(), scan.xi.end());
+    m.scan_oz_chi0.insert(m.scan_oz_chi0.end(), scan.chi0.begin(), scan.chi0.end());
+    m.scan_a2_xi.insert(m.scan_a2_xi.end(), scan.xi_a2.begin(), scan.xi_a2.end());
+    m.scan_a2_chi0.insert(m.scan_a2_chi0.end(), scan.chi0_a2.begin(), scan.chi0_a2.end());
     m.oz_chi0.push_back(f.oz.chi0), m.oz_chi0_err.push_back(f.oz.chi0_err);
     m.oz_xi.push_back(f.oz.xi), m.oz_xi_err.push_back(f.oz.xi_err);
     m.oz_q_fit_max.push_back(f.oz.q_fit_max), m.oz_n_fit.push_back(f.oz.n);

@@ -343,6 +343,8 @@ bool RunRecorder::on_s4(const s4_t &m) {
   if (bad.empty() && m.n_values > 0) bad = size_problem("s4_lag", m.n_lag_values, m.n_lags, m.n_values);
   if (bad.empty() && m.n_values > 0)
     bad = size_problem("xi_lag, chi0_lag", m.n_lag_fits, m.n_lags, m.n_grids);
+  if (bad.empty() && m.n_values > 0)
+    bad = size_problem("scan_oz_xi, scan_oz_chi0, scan_a2_xi, scan_a2_chi0", m.n_scan_values, m.n_grids, m.n_scan);
   if (!bad.empty()) return rejected(cutoff_channel(kChanS4, m.cutoff_a), bad);
   guarded("s4", [&] { write_s4(m); });
   if (m.is_final) completion_.final_result("s4", m.cutoff_a);
@@ -353,7 +355,8 @@ bool RunRecorder::on_s4(const s4_t &m) {
 // subbox_particles, subbox_per_side, grid_spacing, grid_points, n_shells;
 // per shell value q, shell_vectors (grid g's shells follow grid g-1's). Per
 // record: s4, s4_err (records, values) at t_s4; s4_lag (records, lags,
-// values); xi_lag, chi0_lag (records, lags, grids); oz_*, a2_*, chi4,
+// values); xi_lag, chi0_lag (records, lags, grids); scan_qxi_max
+// (records, ranges), scan_{oz,a2}_{xi,chi0} (records, grids, ranges); oz_*, a2_*, chi4,
 // chi4_err (records, grids); scalars tau_alpha, t_s4, lag_index, lag_lo,
 // lag_hi, lag_weight, lag_third, n_origins, xi, xi_err, chi0, chi0_err,
 // chi4_box, chi4_box_err.
@@ -402,6 +405,12 @@ void RunRecorder::write_s4(const s4_t &m) {
   writer_->append_observable(base + "xi_lag", at, m.xi_lag.data(), {dim(m.n_lags), dim(m.n_grids)});
   writer_->append_observable(base + "chi0_lag", at, m.chi0_lag.data(), {dim(m.n_lags), dim(m.n_grids)});
   writer_->append_observable(base + "oz_n_fit", at, m.oz_n_fit);
+  writer_->append_observable(base + "scan_qxi_max", at, m.scan_qxi_max);
+  for (const auto &[name, v] : {std::pair<const char *, const std::vector<double> *>{"scan_oz_xi", &m.scan_oz_xi},
+                                {"scan_oz_chi0", &m.scan_oz_chi0},
+                                {"scan_a2_xi", &m.scan_a2_xi},
+                                {"scan_a2_chi0", &m.scan_a2_chi0}})
+    writer_->append_observable(base + name, at, v->data(), {dim(m.n_grids), dim(m.n_scan)});
   writer_->append_observable(base + "a2_n_fit", at, m.a2_n_fit);
   const std::pair<const char *, double> scalars[] = {
       {"tau_alpha", m.tau_alpha}, {"t_s4", m.t_s4}, {"xi", m.xi}, {"xi_err", m.xi_err}, {"chi0", m.chi0},
