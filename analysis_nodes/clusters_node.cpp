@@ -13,8 +13,8 @@
 //   node has its own tau_alpha (the overlap node's definition). Clusters are
 //   tallied at every scheduled lag; the results are at t = tau_alpha,
 //   interpolated linearly in ln t between the results of the two scheduled
-//   lags that bracket it (errors as fully correlated, plus the interpolation
-//   error from a third lag), anew at every publication (the final one at the
+//   lags that bracket it (errors as fully correlated; no curvature error
+//   from a third lag, which measured the fits' noise), anew at every publication (the final one at the
 //   final tau_alpha). Integer results (largest, spanning, counts per bin,
 //   origins) are those of the lag nearest tau_alpha. Where tau_alpha is not
 //   bracketed by lags with clusters, the results are those of the scheduled
@@ -222,7 +222,7 @@ private:
       const an::LagBracket b = bracket(c, q.tau_alpha);
       m.lag = b.ok() ? q.tau_alpha : m.lag_index >= 0 ? info().lag_time[m.lag_index] : kNaN;
       m.lag_lo = b.ok() ? b.lo : -1, m.lag_hi = b.ok() ? b.hi : -1, m.lag_weight = b.ok() ? b.w : kNaN;
-      m.lag_third = b.ok() ? b.third : -1;
+      m.lag_third = -1; // no interpolation error from a third lag (interpolate, below)
       fill_at_lag(c, m.lag_index, b, m);
       out().publish(dynhet::cutoff_channel(dynhet::kChanClusters, m.cutoff_a), &m);
       if (final)
@@ -327,8 +327,9 @@ private:
 
   // r (the nearest lag's, which keeps its integer fields) with every other
   // result interpolated to t between the lags of b: values linear in ln t,
-  // errors (1 - w) e_lo + w e_hi (the lags share their origins) with
-  // |quadratic - linear| through the third lag in quadrature.
+  // errors (1 - w) e_lo + w e_hi (the lags share their origins); with a
+  // third lag, |quadratic - linear| through it in quadrature (not used:
+  // fill_at_lag).
   static void interpolate(AtLag& r, const AtLag& lo, const AtLag& hi, const AtLag* third, const an::LagBracket& b) {
     auto v3 = [&](double AtLag::*f) { return third ? third->*f : kNaN; };
     auto pair = [&](double AtLag::*v, double AtLag::*e) {
@@ -368,7 +369,11 @@ private:
     AtLag r;
     if (b.ok()) { // j, the lag nearest tau_alpha, is b.lo or b.hi
       const AtLag lo = at_lag(c, b.lo), hi = at_lag(c, b.hi);
-      const std::optional<AtLag> third = b.third >= 0 ? std::optional<AtLag>(at_lag(c, b.third)) : std::nullopt;
+      // No third lag: the quadratic's difference from the linear
+      // interpolation measured the noise of three fits rather than the
+      // curvature (d_f's error grew 5-10 fold, and the seed study put it at
+      // 0.39 of the seeds' spread, kappa 0.49; docs/analysis.md).
+      const std::optional<AtLag> third = std::nullopt;
       r = j == b.lo ? lo : j == b.hi ? hi : at_lag(c, j);
       interpolate(r, lo, hi, third ? &*third : nullptr, b);
     } else {

@@ -88,6 +88,7 @@ def main():
     ap.add_argument("study_dir")
     ap.add_argument("--cutoff", default="0.6")
     ap.add_argument("--points", action="store_true")
+    ap.add_argument("--markdown", action="store_true", help="the table as markdown (for docs/analysis.md)")
     args = ap.parse_args()
     with open(os.path.join(args.study_dir, "index.toml"), "rb") as f:
         runs = tomllib.load(f)["runs"]
@@ -120,7 +121,7 @@ def main():
           f"{sum(len(v) for v in points.values())} runs (seeds per point: "
           f"{sorted(set(len(v) for v in points.values()))})")
     print(f"{'quantity':44s} {'points':>6s} {'dof':>5s} {'spread/error':>13s} {'+-':>6s} {'no error':>8s}")
-    rows = []
+    rows, md = [], []
     for n in names:
         num, dof, nan, used = 0.0, 0, 0, 0
         for key, runs_ in points.items():
@@ -144,6 +145,10 @@ def main():
         rows.append((n, r))
         flag = "" if 0.7 <= r <= 1.5 else "  <- outside 0.7-1.5"
         print(f"{n:44s} {used:6d} {dof:5d} {r:13.2f} {r / math.sqrt(2 * dof):6.2f} {nan:8d}{flag}")
+        md.append(f"| {n} | {dof} | {r:.2f} +- {r / math.sqrt(2 * dof):.2f} | {nan} |")
+    if args.markdown:
+        print("\n| quantity | dof | spread / mean error | runs without an error |\n|---|---|---|---|")
+        print("\n".join(md))
     flow_report(points)
 
 

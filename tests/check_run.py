@@ -568,8 +568,11 @@ def check_clusters(f, unwrapped, L, origin_frame, pair_frame, lag, scene):
         br = bracket(lag, tau_bf)
         check(br is not None and int(g["lag_lo"]["value"][-1]) == br[0] and int(g["lag_hi"]["value"][-1]) == br[1],
               f"clusters {name}: interpolated between the lags that bracket tau_alpha")
-        lo_, hi_, w, third = br
-        check(int(g["lag_third"]["value"][-1]) == (third if third is not None else -1), f"clusters {name}: third lag {third}")
+        lo_, hi_, w, _ = br
+        # The clusters node adds no interpolation error from a third lag (its
+        # fits' noise swamped the curvature; docs/analysis.md).
+        third = None
+        check(int(g["lag_third"]["value"][-1]) == -1, f"clusters {name}: no third lag")
         check(abs(float(g["lag"]["value"][-1]) - tau) <= 1e-12 * tau, f"clusters {name}: the results are at t = tau_alpha")
         check(abs(float(g["lag_weight"]["value"][-1]) - w) <= 1e-12, f"clusters {name}: weight w = {w:.6f}")
 
