@@ -144,7 +144,7 @@ def main():
         r = math.sqrt(num / dof)
         rows.append((n, r))
         flag = "" if 0.7 <= r <= 1.5 else "  <- outside 0.7-1.5"
-        print(f"{n:44s} {used:6d} {dof:5d} {r:13.2f} {r / math.sqrt(2 * dof):6.2f} {nan:8d}{flag}")
+        print(f"{n:44s} {used:6d} {dof:5d} {r:13.3f} {r / math.sqrt(2 * dof):6.2f} {nan:8d}{flag}")
         md.append(f"| {n} | {dof} | {r:.2f} +- {r / math.sqrt(2 * dof):.2f} | {nan} |")
     if args.markdown:
         print("\n| quantity | dof | spread / mean error | runs without an error |\n|---|---|---|---|")
