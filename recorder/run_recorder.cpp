@@ -405,12 +405,14 @@ void RunRecorder::write_s4(const s4_t &m) {
   writer_->append_observable(base + "xi_lag", at, m.xi_lag.data(), {dim(m.n_lags), dim(m.n_grids)});
   writer_->append_observable(base + "chi0_lag", at, m.chi0_lag.data(), {dim(m.n_lags), dim(m.n_grids)});
   writer_->append_observable(base + "oz_n_fit", at, m.oz_n_fit);
-  writer_->append_observable(base + "scan_qxi_max", at, m.scan_qxi_max);
-  for (const auto &[name, v] : {std::pair<const char *, const std::vector<double> *>{"scan_oz_xi", &m.scan_oz_xi},
-                                {"scan_oz_chi0", &m.scan_oz_chi0},
-                                {"scan_a2_xi", &m.scan_a2_xi},
-                                {"scan_a2_chi0", &m.scan_a2_chi0}})
-    writer_->append_observable(base + name, at, v->data(), {dim(m.n_grids), dim(m.n_scan)});
+  if (m.n_scan > 0) { // a sender without the range scan (n_scan 0) still has its S4 recorded
+    writer_->append_observable(base + "scan_qxi_max", at, m.scan_qxi_max);
+    for (const auto &[name, v] : {std::pair<const char *, const std::vector<double> *>{"scan_oz_xi", &m.scan_oz_xi},
+                                  {"scan_oz_chi0", &m.scan_oz_chi0},
+                                  {"scan_a2_xi", &m.scan_a2_xi},
+                                  {"scan_a2_chi0", &m.scan_a2_chi0}})
+      writer_->append_observable(base + name, at, v->data(), {dim(m.n_grids), dim(m.n_scan)});
+  }
   writer_->append_observable(base + "a2_n_fit", at, m.a2_n_fit);
   const std::pair<const char *, double> scalars[] = {
       {"tau_alpha", m.tau_alpha}, {"t_s4", m.t_s4}, {"xi", m.xi}, {"xi_err", m.xi_err}, {"chi0", m.chi0},
