@@ -292,7 +292,8 @@ private:
         }
         sum += d.d;
         var += d.d * d.d / 2;
-        if (part == 0) renewals_[q] = nu - 1;
+        if (part == 0) // NaN: no two origins t apart
+          renewals_[q] = n_cross > 0 && power > 0 ? nu - 1 : std::numeric_limits<double>::quiet_NaN();
       }
     m.diffusion_flow = sum, m.diffusion_flow_err = std::sqrt(var);
   }
