@@ -195,38 +195,6 @@ TEST(Fits, OriginJackknifeWithBlocksAsLongAsTheCorrelationMatchesTheSpread) {
   EXPECT_NEAR(e1 / sd, 0.5, 0.06);
 }
 
-TEST(Fits, OrnsteinUhlenbeckRateFromWindowCorrelations) {
-  // Brute force: an OU velocity (rate gamma) sampled finely; displacements
-  // over windows of t = 4 starting every 1; the mean correlation of windows
-  // 4 to 12 apart, and the rate it gives back.
-  const double gamma = 0.08, t = 4.0, dt = 0.01;
-  std::mt19937_64 rng(3);
-  std::normal_distribution<double> g;
-  const long steps = 4000000; // 4e4 time units: 3200 relaxation times
-  std::vector<double> x(steps + 1, 0.0);
-  double v = g(rng);
-  const double a = std::exp(-gamma * dt), b = std::sqrt(1 - a * a);
-  for (long i = 0; i < steps; ++i) x[i + 1] = x[i] + v * dt, v = a * v + b * g(rng);
-  const long w = std::lround(t / dt), s = std::lround(1.0 / dt);
-  std::vector<double> disp;
-  for (long i = 0; i + w <= steps; i += s) disp.push_back(x[i + w] - x[i]);
-  double var = 0;
-  for (double u : disp) var += u * u / disp.size();
-  std::vector<double> d;
-  double c = 0;
-  int n = 0;
-  for (int m = 4; m <= 12; ++m) {
-    double cov = 0;
-    for (size_t i = 0; i + m < disp.size(); ++i) cov += disp[i] * disp[i + m] / (disp.size() - m);
-    c += cov / var, ++n, d.push_back(m);
-    EXPECT_NEAR(cov / var, ou_window_correlation(t, m, gamma), 0.03) << m;
-  }
-  EXPECT_NEAR(ou_rate_from_correlation(t, d, c / n) / gamma, 1.0, 0.15);
-  EXPECT_EQ(ou_rate_from_correlation(t, d, 1.2), 0.0);
-  EXPECT_TRUE(std::isinf(ou_rate_from_correlation(t, d, -0.1)));
-  EXPECT_TRUE(std::isnan(ou_rate_from_correlation(t, {2.0}, 0.5)));
-}
-
 TEST(Fits, OzRangeScanIsFlatOnOzDataAndDriftsWithAQuarticTerm) {
   std::vector<double> q, s, s2;
   for (int k = 1; k <= 80; ++k) {

@@ -119,35 +119,6 @@ std::vector<double> origin_jackknife(const std::vector<double>& table, int n_ori
   return err;
 }
 
-double ou_window_correlation(double t, double d, double gamma) {
-  const double x = gamma * t;
-  if (x < 1e-8) return 1.0;
-  const double p = x + std::expm1(-x); // x - 1 + e^-x
-  const double e = -std::expm1(-x);    // 1 - e^-x
-  return std::exp(-gamma * (d - t)) * e * e / (2 * p);
-}
-
-double ou_rate_from_correlation(double t, const std::vector<double>& d, double c) {
-  if (!(t > 0) || d.empty() || !std::isfinite(c)) return kNaN;
-  for (double x : d)
-    if (!(x >= t * (1 - 1e-12))) return kNaN;
-  if (c >= 1) return 0.0;
-  if (c <= 0) return std::numeric_limits<double>::infinity();
-  auto mean_c = [&](double g) {
-    double s = 0;
-    for (double x : d) s += ou_window_correlation(t, x, g);
-    return s / double(d.size());
-  };
-  double lo = std::log(1e-8 / t), hi = std::log(1e4 / t); // gamma t from 1e-8 to 1e4
-  if (mean_c(std::exp(lo)) <= c) return 0.0;
-  if (mean_c(std::exp(hi)) >= c) return std::numeric_limits<double>::infinity();
-  for (int i = 0; i < 100; ++i) {
-    const double mid = 0.5 * (lo + hi);
-    (mean_c(std::exp(mid)) > c ? lo : hi) = mid;
-  }
-  return std::exp(0.5 * (lo + hi));
-}
-
 int origin_block(double longest_lag, double origin_spacing, int n_origins) {
   if (!(origin_spacing > 0) || !std::isfinite(longest_lag) || !(longest_lag > 0)) return 1;
   const int span = static_cast<int>(std::ceil(longest_lag / origin_spacing - 1e-9));

@@ -103,16 +103,6 @@ DiffusionFit fit_diffusion(const std::vector<double>& t, const std::vector<doubl
 double diffusive_onset(const std::vector<double>& t, const std::vector<double>& msd, double tol = 0.05);
 
 
-// The rate gamma = 1/tau of an Ornstein-Uhlenbeck velocity (a transverse
-// hydrodynamic mode: gamma = nu k^2) from the correlation of its
-// displacement over windows of length t that start d >= t apart (no
-// overlap): C(d) = exp(-gamma (d - t)) (1 - exp(-gamma t))^2 /
-// (2 (gamma t - 1 + exp(-gamma t))), 1 for a frozen velocity. `d` lists the
-// separations of the pairs measured, `c` their mean correlation: gamma
-// such that the mean of C over d equals c. 0 if c >= 1 (frozen), infinity
-// if c <= 0, NaN for bad input (a d < t).
-double ou_rate_from_correlation(double t, const std::vector<double>& d, double c);
-double ou_window_correlation(double t, double d, double gamma);
 
 // Gaussian P_g(dx,t) = exp(-dx^2/(4Dt)) / sqrt(4 pi D t) with D free, fitted
 // to ln P over the non-empty bins, each weighted by its count (Poisson).
