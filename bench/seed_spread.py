@@ -15,7 +15,7 @@ chi-square with dof = sum (K - 1) degrees of freedom), more where the
 quoted errors scatter. Values without an
 error (NaN) are counted, not pooled.
 
-Usage: bench/seed_spread.py STUDY_DIR [--cutoff 0.6] [--points]
+Usage: bench/seed_spread.py STUDY_DIR [STUDY_DIR ...] [--cutoff 0.6] [--points] [--markdown]
 (--points: also one line per point and quantity).
 """
 import argparse
@@ -85,19 +85,24 @@ def quantities(path, a):
 
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("study_dir")
+    ap.add_argument("study_dir", nargs="+", help="one or more studies; runs of the same point in several studies "
+                    "pool (their seeds must differ)")
     ap.add_argument("--cutoff", default="0.6")
     ap.add_argument("--points", action="store_true")
     ap.add_argument("--markdown", action="store_true", help="the table as markdown (for docs/analysis.md)")
     args = ap.parse_args()
-    with open(os.path.join(args.study_dir, "index.toml"), "rb") as f:
-        runs = tomllib.load(f)["runs"]
-    points = {}
-    for name, r in runs.items():
-        if r.get("state") != "complete":
-            continue
-        key = tuple(r.get(k) for k in AXES_BUT_SEED)
-        points.setdefault(key, []).append(quantities(os.path.join(args.study_dir, r["path"], "run.h5"), args.cutoff))
+    points, seen = {}, set()
+    for study in args.study_dir:
+        with open(os.path.join(study, "index.toml"), "rb") as f:
+            runs = tomllib.load(f)["runs"]
+        for name, r in runs.items():
+            if r.get("state") != "complete":
+                continue
+            key = tuple(r.get(k) for k in AXES_BUT_SEED)
+            if (key, r.get("seed")) in seen:
+                sys.exit(f"seed_spread: seed {r.get('seed')} of {key} is in two studies; pool studies of different seeds")
+            seen.add((key, r.get("seed")))
+            points.setdefault(key, []).append(quantities(os.path.join(study, r["path"], "run.h5"), args.cutoff))
     points = {k: v for k, v in points.items() if len(v) >= 2}
     if not points:
         sys.exit("seed_spread: no point with two or more complete seeds")
@@ -117,7 +122,7 @@ def main():
             for n in q:
                 if not n.startswith("_") and n not in names:
                     names.append(n)
-    print(f"study {os.path.abspath(args.study_dir)}: {len(points)} points, "
+    print(f"studies {', '.join(os.path.abspath(d) for d in args.study_dir)}: {len(points)} points, "
           f"{sum(len(v) for v in points.values())} runs (seeds per point: "
           f"{sorted(set(len(v) for v in points.values()))})")
     print(f"{'quantity':44s} {'points':>6s} {'dof':>5s} {'spread/error':>13s} {'+-':>6s} {'no error':>8s}")
