@@ -169,6 +169,7 @@ private:
     }
   }
   void publish_msd(bool final) {
+    std::vector<double> frozen; // the waves' frozen shares (flow_part), for the final log line
     dynhet::msd_t m{};
     stamp(m, final);
     m.lag_time = info().lag_time;
@@ -203,7 +204,7 @@ private:
       // Without the modes (no waves measured), the jackknife of the MSD.
       const int block = an::origin_block(m.fit_t_max, dynhet::origin_spacing(info()), info().n_origins);
       const int nl = static_cast<int>(m.lag_time.size());
-      flow_part(m);
+      frozen = flow_part(m);
       if (std::isfinite(m.diffusion_flow_err)) {
         std::vector<double> local(msd_all_);
         for (size_t kj = 0; kj < local.size(); ++kj)
@@ -226,7 +227,9 @@ private:
         std::vector<double> g;
         for (size_t q = 0; q < n_modes_; ++q)
           if (nx[q] * nx[q] + ny[q] * ny[q] <= r * r && nx[q] * nx[q] + ny[q] * ny[q] > (r - 1) * (r - 1))
-            g.push_back(frozen_[q]);
+            g.push_back(frozen[q]);
+        // NaN (no two origins far enough apart) for one wave is NaN for all
+        if (std::any_of(g.begin(), g.end(), [](double x) { return std::isnan(x); })) g.assign(1, NAN);
         std::sort(g.begin(), g.end());
         if (!g.empty()) shells += " " + std::to_string(r) + ":" + std::to_string(g[g.size() / 2]).substr(0, 6);
       }
@@ -249,9 +252,11 @@ private:
   // run: exponential energy, variance (f c)^2 / 2 estimated; the renewing
   // part a Gamma over the T / t windows of the run: ((1 - f) c)^2 /
   // (1 + T / t).
-  void flow_part(dynhet::msd_t& m) const {
-    if (n_modes_ == 0) return;
-    frozen_.assign(n_modes_, std::numeric_limits<double>::quiet_NaN());
+  // Returns the frozen share f of each wave's transverse part (NaN where
+  // not measured), for the log.
+  std::vector<double> flow_part(dynhet::msd_t& m) const {
+    std::vector<double> frozen(n_modes_, std::numeric_limits<double>::quiet_NaN());
+    if (n_modes_ == 0) return frozen;
     const int no = info().n_origins;
     const double t = m.lag_time.back();
     const double span = (no - 1) * dynhet::origin_spacing(info()) + t;
@@ -266,7 +271,7 @@ private:
         for (size_t kj = 0; kj < v.size(); ++kj) v[kj] = table[kj * n_modes_ + q];
         origin_mean(v, mean, err);
         const auto d = an::fit_diffusion(m.lag_time, mean, m.fit_t_min, m.fit_t_max);
-        if (d.n < 3 || !std::isfinite(d.d)) return;
+        if (d.n < 3 || !std::isfinite(d.d)) return frozen;
         // The amplitude's correlation between origins at least t apart.
         double power = 0, cross = 0;
         int n_power = 0, n_cross = 0;
@@ -284,9 +289,10 @@ private:
         const double f = measured ? std::clamp((cross / n_cross) / (power / n_power), 0.0, 1.0) : 1.0;
         sum += d.d;
         var += std::pow(f * d.d, 2) / 2 + std::pow((1 - f) * d.d, 2) / (1 + span / t);
-        if (part == 0) frozen_[q] = measured ? f : std::numeric_limits<double>::quiet_NaN();
+        if (part == 0 && measured) frozen[q] = f;
       }
     m.diffusion_flow = sum, m.diffusion_flow_err = std::sqrt(var);
+    return frozen;
   }
 
   void publish_chi4(bool final) {
@@ -371,7 +377,6 @@ private:
   size_t n_modes_ = 0;
   std::vector<double> flow_t_, flow_l_;      // per (origin, lag, mode): collective_modes
   std::vector<double> amp_;                  // per (origin, mode): u_k . e at the last lag (t re, im, l re, im)
-  mutable std::vector<double> frozen_;       // per mode: the transverse part's frozen share f (flow_part), for the log
   std::vector<double> d2_, select_;          // |dr|^2 of the pair; the selection's buffer
   dynhet::Scene::Msd msd_spec_;
   std::unique_ptr<dynhet::DisplacementResults> displacement_;
