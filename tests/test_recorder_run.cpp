@@ -430,3 +430,35 @@ TEST(RunRecorder, ANodeThatLostFramesMakesTheFileIncomplete) {
 }
 
 } // namespace
+
+// The fit-range scan of an S4 message is [grid][range]: recorded with that
+// shape, and a message whose scan does not fill n_grids x n_scan (a hostile
+// or broken sender) is rejected and counted, not written.
+TEST(RunRecorder, S4RangeScanKeepsItsShapeAndAMismatchIsRejected) {
+  const std::string path = temp_file("s4scan");
+  dynhet::RunRecorder rec(path, "test");
+  auto info = run_info();
+  info.observables = {"s4"};
+  info.keep_frames = false;
+  ASSERT_TRUE(rec.on_run(info));
+  auto m = s4(0.6, false, 1);
+  m.n_scan = 3, m.scan_qxi_max = {0.5, 1, 2};
+  m.n_scan_values = 6; // 2 grids x 3 ranges
+  for (auto *v : {&m.scan_oz_xi, &m.scan_oz_chi0, &m.scan_a2_xi, &m.scan_a2_chi0}) *v = {0, 1, 2, 10, 11, 12};
+  EXPECT_TRUE(rec.on_s4(m));
+  auto wrong = m;
+  wrong.n_scan_values = 4; // 4 values are not 2 x 3
+  for (auto *v : {&wrong.scan_oz_xi, &wrong.scan_oz_chi0, &wrong.scan_a2_xi, &wrong.scan_a2_chi0}) v->resize(4);
+  wrong.frame_index = 2;
+  EXPECT_FALSE(rec.on_s4(wrong));
+  EXPECT_EQ(rec.messages_rejected(), 1);
+  rec.finish("test over");
+
+  h5read::File f(path);
+  const std::string g = "/observables/s4/a0.6";
+  EXPECT_EQ(h5read::shape(f, g + "/scan_oz_xi/value"), (Shape{1, 2, 3})); // [record][grid][range]
+  EXPECT_EQ(h5read::read<double>(f, g + "/scan_a2_chi0/value"), (std::vector<double>{0, 1, 2, 10, 11, 12}));
+  EXPECT_EQ(h5read::read<double>(f, g + "/scan_qxi_max/value"), (std::vector<double>{0.5, 1, 2}));
+  EXPECT_EQ(h5read::read<int64_t>(f, g + "/xi/step"), std::vector<int64_t>{1}); // the mismatch wrote nothing
+  std::remove(path.c_str());
+}
