@@ -264,10 +264,14 @@ def check_chi4(f, unwrapped, L, origin_frame, pair_frame):
                 chi = per_origin[:, :, 1].mean(axis=0)
             err = np.max(np.abs(chi - rec[gi]) / np.maximum(np.abs(chi), 1e-12))
             check(err < 1e-9, f"chi4 {name} m={m}: equals brute force (max rel diff {err:.2g})")
-            # chi4^P, tau4: the vertex of the parabola in ln t through the
-            # largest point and its neighbours; their errors the larger
-            # jackknife over blocks of 1 and 2 origins (2 only if >= 4 blocks).
+            # chi4^P, tau4: the vertex of the parabola in ln t fitted to the
+            # peak above half its maximum, weights (y/y_max - 1/2)/(1/2), kept
+            # within those lags; fewer than three: the parabola through the
+            # largest point and its neighbours. Their errors: a jackknife over
+            # blocks of origins spanning the last lag the fit reads (at most
+            # a quarter of the origins; the whole box needs 3 blocks).
             lag = g["lag_time"][()]
+            spacing = float(f["parameters/schedule"].attrs["origin_spacing"])
 
             def curve(keep):
                 po = per_origin[keep]
@@ -275,31 +279,41 @@ def check_chi4(f, unwrapped, L, origin_frame, pair_frame):
 
             def peak(y):
                 b = int(np.nanargmax(y))
+                lo = hi = b
+                while lo > 0 and y[lo - 1] > y[b] / 2:
+                    lo -= 1
+                while hi < len(y) - 1 and y[hi + 1] > y[b] / 2:
+                    hi += 1
+                if y[b] > 0 and hi - lo >= 2:
+                    u = np.log(lag[lo:hi + 1]) - math.log(lag[b])
+                    w = (y[lo:hi + 1] / y[b] - 0.5) / 0.5
+                    c2, c1, c0 = np.polyfit(u, y[lo:hi + 1], 2, w=np.sqrt(w))
+                    fit = lambda v: c0 + c1 * v + c2 * v * v
+                    v = min(max(-c1 / (2 * c2), u[0]), u[-1]) if c2 < 0 else (u[0] if fit(u[0]) >= fit(u[-1]) else u[-1])
+                    return fit(v), lag[b] * math.exp(v), hi
                 if b == 0 or b == len(y) - 1:
-                    return y[b], lag[b]
+                    return y[b], lag[b], b
                 x = np.log(lag[b - 1:b + 2])
                 c2, c1, c0 = np.polyfit(x, y[b - 1:b + 2], 2)
                 if not c2 < 0:
-                    return y[b], lag[b]
+                    return y[b], lag[b], b + 1
                 xv = -c1 / (2 * c2)
-                return c0 + c1 * xv + c2 * xv * xv, math.exp(xv)
+                return c0 + c1 * xv + c2 * xv * xv, math.exp(xv), b + 1
             pk = peak(chi)
             rp = (g["chi4_peak"]["value"][-1][gi], g["tau4"]["value"][-1][gi])
-            check(all(abs(u - v) <= 1e-8 * abs(v) for u, v in zip(rp, pk)),
+            check(all(abs(u - v) <= 1e-8 * abs(v) for u, v in zip(rp, pk[:2])),
                   f"chi4 {name} m={m}: peak {rp[0]:.5g} at tau4 {rp[1]:.4g} equals brute force")
             ko = len(origin_frame)
-            errs = None
-            for bsz in (1, 2):
-                nb_ = -(-ko // bsz)
-                if nb_ < ((3 if m == 1 else 2) if bsz == 1 else 4):
-                    continue
-                reps = np.array([peak(curve([i for i in range(ko) if i // bsz != blk])) for blk in range(nb_)])
-                jk = np.sqrt((nb_ - 1) / nb_ * ((reps - reps.mean(axis=0)) ** 2).sum(axis=0))
-                errs = jk if errs is None else np.maximum(errs, jk)
-            if errs is not None:
+            bsz = min(max(math.ceil(lag[pk[2]] / spacing - 1e-9), 1), max(1, ko // 4))
+            bsz = min(max(bsz, 1), max(1, ko // 2))
+            nb_ = -(-ko // bsz)
+            if nb_ >= (3 if m == 1 else 2):
+                reps = np.array([peak(curve([i for i in range(ko) if i // bsz != blk]))[:2] for blk in range(nb_)])
+                errs = np.sqrt((nb_ - 1) / nb_ * ((reps - reps.mean(axis=0)) ** 2).sum(axis=0))
                 re = (g["chi4_peak_err"]["value"][-1][gi], g["tau4_err"]["value"][-1][gi])
                 check(all(abs(u - v) <= 1e-6 * abs(v) + 1e-12 for u, v in zip(re, errs)),
-                      f"chi4 {name} m={m}: peak errors +- {re[0]:.3g}, +- {re[1]:.3g} equal a brute-force block jackknife")
+                      f"chi4 {name} m={m}: peak errors +- {re[0]:.3g}, +- {re[1]:.3g} equal a brute-force "
+                      f"jackknife over {nb_} blocks of {bsz} origins")
             if m == 1 and len(origin_frame) >= 3:  # jackknife over origins of N var(Q)
                 q = per_origin[:, :, 0]
                 k = len(q)

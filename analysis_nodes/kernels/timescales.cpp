@@ -1,5 +1,6 @@
 #include "dynhet/analysis/timescales.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -20,22 +21,61 @@ std::vector<double> tau_alpha_per_origin(const OverlapAccumulator& acc, const st
   return tau;
 }
 
-Peak find_peak(const std::vector<double>& t, const std::vector<double>& y) { return peak_at(t, y, peak_index(y)); }
-
-Peak peak_at(const std::vector<double>& t, const std::vector<double>& y, int best) {
+namespace {
+// The parabola in ln t through the largest point and its neighbours.
+Peak three_point_peak(const std::vector<double>& t, const std::vector<double>& y, int best) {
   const int n = static_cast<int>(y.size());
-  if (best < 0 || best >= n || !std::isfinite(y[best])) return {kNaN, kNaN, false};
   if (best == 0 || best == n - 1 || !std::isfinite(y[best - 1]) || !std::isfinite(y[best + 1]))
-    return {t[best], y[best], false};
-  // Parabola through (ln t, y) at the three lags; its vertex.
+    return {t[best], y[best], best != 0 && best != n - 1, best, best};
   const double x0 = std::log(t[best - 1]), x1 = std::log(t[best]), x2 = std::log(t[best + 1]);
   const double y0 = y[best - 1], y1 = y[best], y2 = y[best + 1];
   const double d01 = (y1 - y0) / (x1 - x0), d12 = (y2 - y1) / (x2 - x1), c = (d12 - d01) / (x2 - x0);
-  if (!(c < 0)) return {t[best], y1, true};
+  if (!(c < 0)) return {t[best], y1, true, best - 1, best + 1};
   const double b = d01 - c * (x0 + x1); // y = y0 + d01 (x - x0) + c (x - x0)(x - x1)
   const double xv = -b / (2 * c);
-  const double yv = y0 + d01 * (xv - x0) + c * (xv - x0) * (xv - x1);
-  return {std::exp(xv), yv, true};
+  return {std::exp(xv), y0 + d01 * (xv - x0) + c * (xv - x0) * (xv - x1), true, best - 1, best + 1};
+}
+} // namespace
+
+Peak find_peak(const std::vector<double>& t, const std::vector<double>& y) {
+  const int best = peak_index(y);
+  if (best < 0) return {kNaN, kNaN, false};
+  const int n = static_cast<int>(y.size());
+  const double top = y[best], half = 0.5 * top;
+  int lo = best, hi = best;
+  while (lo > 0 && std::isfinite(y[lo - 1]) && y[lo - 1] > half) --lo;
+  while (hi < n - 1 && std::isfinite(y[hi + 1]) && y[hi + 1] > half) ++hi;
+  if (!(top > 0) || hi - lo < 2) return three_point_peak(t, y, best);
+  // Weighted least squares for y = a + b u + c u^2, u = ln t - ln t[best].
+  const double x_best = std::log(t[best]);
+  double m[3][4] = {}; // normal equations, augmented
+  for (int j = lo; j <= hi; ++j) {
+    const double u = std::log(t[j]) - x_best, w = (y[j] / top - 0.5) / 0.5;
+    const double p[3] = {1.0, u, u * u};
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) m[r][c] += w * p[r] * p[c];
+      m[r][3] += w * p[r] * y[j];
+    }
+  }
+  for (int col = 0; col < 3; ++col) { // Gaussian elimination with partial pivoting
+    int piv = col;
+    for (int r = col + 1; r < 3; ++r)
+      if (std::abs(m[r][col]) > std::abs(m[piv][col])) piv = r;
+    if (!(std::abs(m[piv][col]) > 0)) return three_point_peak(t, y, best);
+    for (int c = 0; c < 4; ++c) std::swap(m[col][c], m[piv][c]);
+    for (int r = 0; r < 3; ++r) {
+      if (r == col) continue;
+      const double f = m[r][col] / m[col][col];
+      for (int c = col; c < 4; ++c) m[r][c] -= f * m[col][c];
+    }
+  }
+  const double a = m[0][3] / m[0][0], b = m[1][3] / m[1][1], c = m[2][3] / m[2][2];
+  const double u_lo = std::log(t[lo]) - x_best, u_hi = std::log(t[hi]) - x_best;
+  const auto fit = [&](double u) { return a + b * u + c * u * u; };
+  // The vertex, kept within the fitted lags; no maximum (c >= 0): the
+  // higher end, the limit of the vertex as c -> 0 from below.
+  const double u = c < 0 ? std::clamp(-b / (2 * c), u_lo, u_hi) : (fit(u_lo) >= fit(u_hi) ? u_lo : u_hi);
+  return {std::exp(x_best + u), fit(u), best != 0 && best != n - 1, lo, hi};
 }
 
 int peak_index(const std::vector<double>& y) {

@@ -15,17 +15,24 @@ namespace dynhet::analysis {
 std::vector<double> tau_alpha_per_origin(const OverlapAccumulator& acc, const std::vector<double>& lag_time,
                                          int n_origins);
 
-// Maximum of y(t) over the finite values, refined by the parabola in ln t
-// through the three lags around it (if the maximum is not at an end).
+// The peak of y(t), such as chi4^P at tau4: the vertex of the parabola in
+// ln t fitted by weighted least squares to the peak above its half maximum
+// (the lags around the largest point where y > y_max / 2, each weighted by
+// its height above half the maximum, (y / y_max - 1/2) / (1/2)); the vertex
+// is kept within those lags. Fewer than three such lags: the parabola
+// through the largest point and its two neighbours.
+// Why not the largest point and its neighbours alone: on a broad top the
+// largest point moves between lags from run to run, so that estimate jumps,
+// is biased up by the noise it selects (chi4^P by up to one seed-to-seed
+// standard deviation), and its jackknife error varied 50-fold between seeds
+// of one scene (docs/analysis.md, "Seed benchmark"). The weights go to zero
+// at half maximum, so this estimate is continuous in the data.
 struct Peak {
   double t, y;
-  bool interior; // false: at the first or last lag, so only a bound
+  bool interior; // false: the largest point at the first or last lag, so only a bound
+  int first = -1, last = -1; // the lags the estimate reads
 };
 Peak find_peak(const std::vector<double>& t, const std::vector<double>& y);
-
-// The same with the three lags centred on lag `best` (the vertex of the
-// parabola through them), whatever y's largest point.
-Peak peak_at(const std::vector<double>& t, const std::vector<double>& y, int best);
 
 // Index of the largest finite y (-1 if none).
 int peak_index(const std::vector<double>& y);
