@@ -342,7 +342,7 @@ private:
   void loop() {
     auto last = FrameNode::Clock::now();
     while (!stop_) {
-      const int r = in_.handleTimeout(100);
+      const int r = handle_timeout(in_, 100);
       const auto now = FrameNode::Clock::now();
       inbox_.receive_turn(std::chrono::duration<double>(now - last).count());
       last = now;
@@ -415,6 +415,7 @@ int node_main(const std::string& program, const std::string& description, NodeFa
     if (const std::optional<Inbox::Message> m = inbox.pop(std::chrono::milliseconds(200))) {
       node->handle(*m);
     } else if (inbox.ended()) { // a replayed log has ended, every message of it handled
+      if (!replay && bus_lost(in)) std::fprintf(stderr, "%s: %s\n", program.c_str(), kBusLost);
       node->input_ended();
       break;
     }

@@ -239,9 +239,9 @@ int Session::run() {
     if (log_ && !log_done_ && fatal_.empty()) {
       log_done_ = !read_log(1000);
       if (log_done_) last_progress_ = Clock::now(); // the wait for results starts now
-      lcm_.handleTimeout(0);
-    } else if (lcm_.handleTimeout(100) < 0 && !g_signal) {
-      return finish("LCM: receive failed");
+      dynhet::handle_timeout(lcm_, 0);
+    } else if (dynhet::handle_timeout(lcm_, 100) < 0 && !g_signal) {
+      return finish(dynhet::bus_lost(lcm_) ? dynhet::kBusLost : "LCM: receive failed");
     }
     const int code = step();
     if (code >= 0) return code;

@@ -339,7 +339,7 @@ public:
   template <class Idle> void before_frame(int f, Idle&& idle) {
     if (nodes_.empty()) return;
     for (;;) {
-      lcm_.handleTimeout(0);
+      if (dynhet::handle_timeout(lcm_, 0) < 0 && dynhet::bus_lost(lcm_)) throw std::runtime_error(dynhet::kBusLost);
       const auto now = Clock::now();
       bool wait = false;
       for (auto& [name, n] : nodes_) {
@@ -364,7 +364,7 @@ public:
       }
       if (!wait) return;
       idle();
-      lcm_.handleTimeout(20);
+      dynhet::handle_timeout(lcm_, 20);
     }
   }
 
@@ -498,6 +498,7 @@ int main(int argc, char** argv) {
   if (run_id == 0) run_id = static_cast<int64_t>(std::random_device{}() & 0x7fffffff) << 20 ^ getpid();
 
   lcm::LCM lcm(dynhet::resolve_lcm_url(url));
+  const bool tcpq = dynhet::is_tcpq_url(dynhet::resolve_lcm_url(url));
   if (dynhet::bus_unreachable(lcm, dynhet::resolve_lcm_url(url))) {
     std::fprintf(stderr, "sim_node: cannot open LCM at %s\n", dynhet::resolve_lcm_url(url).c_str());
     return 3;
@@ -593,6 +594,7 @@ int main(int argc, char** argv) {
         const double target = std::min(t, slot);
         while (!eng.run_until(target, slice_events)) {
           rep.update(eng, t_end - eng.time());
+          if (tcpq && dynhet::bus_lost(lcm)) throw std::runtime_error(dynhet::kBusLost);
           if (seconds_since(last_info) > 2.0) publish_info();
           if (g_signal && checkpoint_path.empty())
             throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
@@ -653,6 +655,7 @@ int main(int argc, char** argv) {
         if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
       });
       wait_seconds += seconds_since(t_wait);
+      if (tcpq && dynhet::bus_lost(lcm)) throw std::runtime_error(dynhet::kBusLost);
       const auto t_publish = Clock::now();
       eng.unwrapped_positions(xy);
 #ifndef NDEBUG

@@ -157,3 +157,10 @@ set_tests_properties(tcpq_runs_complete PROPERTIES LABELS process TIMEOUT 180)
 add_test(NAME logplayer_full_log
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/logplayer_full.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(logplayer_full_log PROPERTIES LABELS process TIMEOUT 120)
+
+# tcpq: the hub killed mid-run (tests/tcpq_hub_death.sh): no process aborts
+# on LCM's closed socket (dynhet::handle_timeout); each says the connection
+# is gone and exits 1; run.h5 is closed, incomplete, with the reason.
+add_test(NAME tcpq_hub_death_ends_every_process_cleanly
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/tcpq_hub_death.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(tcpq_hub_death_ends_every_process_cleanly PROPERTIES LABELS process TIMEOUT 120)

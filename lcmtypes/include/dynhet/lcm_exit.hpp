@@ -52,6 +52,18 @@ inline bool bus_unreachable(lcm::LCM &lcm, const std::string &url) {
   return !lcm.good() || (is_tcpq_url(url) && lcm.getFileno() < 0);
 }
 
+// The same provider closes its socket when the hub goes away (killed,
+// restarted, its host down) and then reports file number -1, on which
+// lcm_handle_timeout's select aborts the process ("bit out of range 0 -
+// FD_SETSIZE on fd_set"). bus_lost says so; handle_timeout is
+// LCM::handleTimeout that returns -1 then instead of aborting.
+inline bool bus_lost(lcm::LCM &lcm) { return lcm.getFileno() < 0; }
+inline int handle_timeout(lcm::LCM &lcm, int timeout_ms) {
+  return bus_lost(lcm) ? -1 : lcm.handleTimeout(timeout_ms);
+}
+inline constexpr const char *kBusLost =
+    "the LCM connection is gone (the tcpq hub closed it: stopped, killed or restarted)";
+
 namespace detail {
 // Reads and discards until the peer closes (true) or the deadline passes.
 inline std::string drain_until_closed(int fd, double timeout_s) {
