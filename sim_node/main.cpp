@@ -497,10 +497,11 @@ int main(int argc, char** argv) {
   }
   if (run_id == 0) run_id = static_cast<int64_t>(std::random_device{}() & 0x7fffffff) << 20 ^ getpid();
 
-  lcm::LCM lcm(dynhet::resolve_lcm_url(url));
-  const bool tcpq = dynhet::is_tcpq_url(dynhet::resolve_lcm_url(url));
-  if (dynhet::bus_unreachable(lcm, dynhet::resolve_lcm_url(url))) {
-    std::fprintf(stderr, "sim_node: cannot open LCM at %s\n", dynhet::resolve_lcm_url(url).c_str());
+  const std::string bus_url = dynhet::resolve_lcm_url(url);
+  lcm::LCM lcm(bus_url);
+  const bool tcpq = dynhet::is_tcpq_url(bus_url);
+  if (dynhet::bus_unreachable(lcm, bus_url)) {
+    std::fprintf(stderr, "sim_node: cannot open LCM at %s\n", bus_url.c_str());
     return 3;
   }
   std::signal(SIGINT, on_signal);
@@ -731,7 +732,7 @@ int main(int argc, char** argv) {
   }
   // The last frames and the "done" (or "failed") reach the bus before the
   // process ends (tcpq: dynhet/lcm_exit.hpp).
-  if (const std::string why = dynhet::deliver_before_exit(lcm, dynhet::resolve_lcm_url(url)); !why.empty())
+  if (const std::string why = dynhet::deliver_before_exit(lcm, bus_url); !why.empty())
     std::fprintf(stderr, "sim_node: %s\n", why.c_str());
   return code;
 }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <Eigen/Dense>
+
 namespace dynhet::analysis {
 
 namespace {
@@ -48,28 +50,18 @@ Peak find_peak(const std::vector<double>& t, const std::vector<double>& y) {
   if (!(top > 0) || hi - lo < 2) return three_point_peak(t, y, best);
   // Weighted least squares for y = a + b u + c u^2, u = ln t - ln t[best].
   const double x_best = std::log(t[best]);
-  double m[3][4] = {}; // normal equations, augmented
+  Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
+  Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
   for (int j = lo; j <= hi; ++j) {
     const double u = std::log(t[j]) - x_best, w = (y[j] / top - 0.5) / 0.5;
-    const double p[3] = {1.0, u, u * u};
-    for (int r = 0; r < 3; ++r) {
-      for (int c = 0; c < 3; ++c) m[r][c] += w * p[r] * p[c];
-      m[r][3] += w * p[r] * y[j];
-    }
+    const Eigen::Vector3d p(1.0, u, u * u);
+    normal += w * p * p.transpose();
+    rhs += w * y[j] * p;
   }
-  for (int col = 0; col < 3; ++col) { // Gaussian elimination with partial pivoting
-    int piv = col;
-    for (int r = col + 1; r < 3; ++r)
-      if (std::abs(m[r][col]) > std::abs(m[piv][col])) piv = r;
-    if (!(std::abs(m[piv][col]) > 0)) return three_point_peak(t, y, best);
-    for (int c = 0; c < 4; ++c) std::swap(m[col][c], m[piv][c]);
-    for (int r = 0; r < 3; ++r) {
-      if (r == col) continue;
-      const double f = m[r][col] / m[col][col];
-      for (int c = col; c < 4; ++c) m[r][c] -= f * m[col][c];
-    }
-  }
-  const double a = m[0][3] / m[0][0], b = m[1][3] / m[1][1], c = m[2][3] / m[2][2];
+  const Eigen::ColPivHouseholderQR<Eigen::Matrix3d> qr(normal);
+  if (qr.rank() < 3) return three_point_peak(t, y, best);
+  const Eigen::Vector3d abc = qr.solve(rhs);
+  const double a = abc[0], b = abc[1], c = abc[2];
   const double u_lo = std::log(t[lo]) - x_best, u_hi = std::log(t[hi]) - x_best;
   const auto fit = [&](double u) { return a + b * u + c * u * u; };
   // The vertex, kept within the fitted lags; no maximum (c >= 0): the
