@@ -89,6 +89,7 @@ struct BlockTallies {
       return {f(total), an::jackknife_error(x)};
     }
   };
+  template <class Ar> void state(Ar& ar) { ar(empty, block); } // checkpoints
   Pooled pool() const {
     Pooled p{empty, {}};
     for (const auto& t : block) p.total.add(t);
@@ -166,6 +167,16 @@ private:
 
   void on_origin(int k, const std::vector<double>& pos0) override { add_origin(k, pos0); }
   void on_origin_dropped(int k) override { graphs_.erase(k); }
+
+  // Checkpoints: g_ab's sums, the cutoffs once fixed, Q(t;t0) and the
+  // tallies; the neighbour graphs of the held origins are rebuilt.
+  template <class Ar> void io(Ar& ar) { ar(g_sum_, g_frames_, cut_, q_, tallies_); }
+  void save_state(dynhet::StateOut& out) override { io(out); }
+  void load_state(dynhet::StateIn& in) override {
+    io(in);
+    if (cut_)
+      for (const auto& [k, pos] : held_origins()) build_graph(k, pos);
+  }
 
   // One (origin, lag): Q for tau_alpha, then slow and fast clusters for every cutoff.
   void on_pair(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) override {

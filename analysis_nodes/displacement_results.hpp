@@ -26,6 +26,7 @@ public:
   void add(int origin, int lag, const analysis::DisplacementResult& pass, long n_small);
   // The message at the lags nearest the targets, given the running tau_alpha.
   displacement_t message(double tau_alpha, double cutoff_a) const;
+  template <class Ar> void state(Ar& ar) { ar(tally_); } // what a checkpoint keeps
 
 private:
   const run_info_t& run_;

@@ -1,5 +1,6 @@
 #include "frame_node.hpp"
 
+#include "dynhet/cut.hpp"
 #include "dynhet/flow_control.hpp"
 #include "dynhet/lcm_exit.hpp"
 #include "dynhet/lcm_guard.hpp"
@@ -7,7 +8,9 @@
 
 #include <algorithm>
 #include <atomic>
+#include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <thread>
 
 #include <CLI/CLI.hpp>
@@ -127,12 +130,17 @@ void FrameNode::on_sim_status_raw(const lcm::ReceiveBuffer* rb, const std::strin
   guarded<sim_status_t>(*this, rb, ch, [&](const sim_status_t& m) { on_sim_status(m); });
 }
 
+void FrameNode::on_checkpoint_raw(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+  guarded<checkpoint_t>(*this, rb, ch, [&](const checkpoint_t& m) { on_checkpoint(m); });
+}
+
 void FrameNode::handle(const Inbox::Message& m) {
   lcm::ReceiveBuffer rb{const_cast<uint8_t*>(m.data.data()), static_cast<uint32_t>(m.data.size()), m.recv_utime};
   const auto t0 = Clock::now();
   if (m.channel == kChanFrame) on_chunk_raw(&rb, m.channel);
   else if (m.channel == kChanRun) on_run_raw(&rb, m.channel);
   else if (m.channel == kChanSimStatus) on_sim_status_raw(&rb, m.channel);
+  else if (m.channel == kChanCheckpoint) on_checkpoint_raw(&rb, m.channel);
   longest_handler_ = std::max(longest_handler_, std::chrono::duration<double>(Clock::now() - t0).count());
 }
 
@@ -180,6 +188,7 @@ void FrameNode::on_run(const run_info_t& mm) {
       last_use_[k] = std::max(last_use_[k], f);
     }
   }
+  if (resume_cut_ >= 0) load_cut();
 }
 
 void FrameNode::on_chunk(const frame_chunk_t& mm) {
@@ -191,6 +200,11 @@ void FrameNode::on_chunk(const frame_chunk_t& mm) {
   }
   const ChunkHeader h{m->frame_index, m->time,           m->n_particles, m->chunk_index,
                       m->chunk_count, m->first_particle, m->count};
+  // A cut after an earlier frame is taken before any later chunk counts.
+  if (!pending_cuts_.empty() && m->frame_index > pending_cuts_.begin()->second.frame) {
+    try_cut(m->frame_index);
+    if (finished_) return;
+  }
   const int64_t bad = assembler_.chunks_malformed();
   auto frame = assembler_.add(h, m->position.data());
   if (assembler_.chunks_malformed() > bad) {
@@ -209,6 +223,12 @@ void FrameNode::on_sim_status(const sim_status_t& mm) {
   if (!info_ || m->run_id != info_->run_id || finished_) return;
   last_sim_news_ = Clock::now();
   sim_interrupted_ = m->phase == "interrupted"; // checkpointed: wait for --resume
+  if (sim_interrupted_ && checkpointing()) {
+    // The pipeline resumes as a whole from its last whole cut.
+    return stop_resumable("the sim stopped resumably" +
+                          (saved_cut_ >= 0 ? "; this node's last saved cut is " + std::to_string(saved_cut_)
+                                           : std::string("; this node saved no cut")));
+  }
   // Chunks of a frame the sim has sent stopped coming: the rest are lost
   // (the sim, pacing on this node, would otherwise wait for it).
   if (m->frames_published > 0 && std::chrono::duration<double>(Clock::now() - last_chunk_).count() > kChunkGrace) {
@@ -267,6 +287,116 @@ void FrameNode::on_frame(const Frame& f) {
   // Right away, not at the next second: the sim paces its frames on it
   // (flow control, sim_node --pace-nodes).
   publish_status();
+  try_cut();
+}
+
+// ---- Checkpoint cuts (dynhet/cut.hpp) ----
+
+void FrameNode::on_checkpoint(const checkpoint_t& m) {
+  if (!info_ || !started_ || finished_ || !checkpointing() || m.run_id != info_->run_id) return;
+  if (const std::string bad = checkpoint_problem(m, info_->n_frames); !bad.empty())
+    return reject(kChanCheckpoint, "checkpoint: " + bad);
+  if (m.process == "sim" && m.state == "whole") return; // news of a cut: nothing to do here
+  if (m.process != "sim" || m.state != "save") return reject(kChanCheckpoint, "checkpoint: not a request of the sim");
+  if (m.cut == saved_cut_) return answer_cut(saved_cut_, "saved", saved_bytes_, saved_seconds_, ""); // asked again
+  if (m.cut < saved_cut_ || pending_cuts_.count(m.cut)) return;
+  if (pending_cuts_.size() >= 64) pending_cuts_.erase(pending_cuts_.begin()); // a flood: the oldest go
+  pending_cuts_[m.cut] = m;
+  try_cut();
+}
+
+// The cuts asked for, in order: each is saved when this node stands at its
+// boundary, and refused when it is past it.
+void FrameNode::try_cut(int next_chunk_frame) {
+  while (!pending_cuts_.empty() && !finished_) {
+    const checkpoint_t c = pending_cuts_.begin()->second;
+    if (last_frame_ > c.frame) {
+      // Past the boundary already (a request that came late): this cut
+      // cannot have this node's part, so it will not be whole.
+      pending_cuts_.erase(pending_cuts_.begin());
+      answer_cut(c.cut, "failed", 0, 0, "frame " + std::to_string(last_frame_) +
+                                           " already folded in, past the cut's " + std::to_string(c.frame));
+      continue;
+    }
+    if (!(last_frame_ == c.frame || next_chunk_frame > c.frame)) return;
+    pending_cuts_.erase(pending_cuts_.begin());
+    save_cut(c);
+  }
+}
+
+void FrameNode::save_cut(const checkpoint_t& c) {
+  const auto t0 = Clock::now();
+  try {
+    assembler_.give_up_before(c.frame + 1); // frames up to the cut are settled
+    StateOut out;
+    base_state(out);
+    save_state(out);
+    std::filesystem::create_directories(cut_dir(cut_dir_, c.cut));
+    PartHeader h;
+    h.process = name_, h.run_id = info_->run_id, h.cut = c.cut, h.frame = c.frame;
+    h.scene_hash = scene_hash(info_->scene_toml);
+    write_part(part_path(cut_dir_, c.cut, name_), h, out.bytes());
+    saved_cut_ = c.cut;
+    saved_bytes_ = static_cast<int64_t>(out.bytes().size());
+    saved_seconds_ = std::chrono::duration<double>(Clock::now() - t0).count();
+    std::fprintf(stderr, "%s_node: checkpoint: cut %d after frame %d saved (%.1f MB in %.2f s)\n", name_.c_str(),
+                 c.cut, c.frame, saved_bytes_ / 1e6, saved_seconds_);
+    answer_cut(c.cut, "saved", saved_bytes_, saved_seconds_, "");
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s_node: checkpoint: cut %d NOT saved: %s\n", name_.c_str(), c.cut, e.what());
+    answer_cut(c.cut, "failed", 0, 0, e.what());
+    if (!signal_) return;
+  }
+  // After a signal: stop with the sim's last cut (its request says "stop").
+  if (signal_ && c.message == "stop")
+    stop_resumable("signal " + std::to_string(signal_) + ": stopped after cut " + std::to_string(c.cut));
+}
+
+void FrameNode::answer_cut(int cut, const std::string& state, int64_t bytes, double seconds,
+                           const std::string& message) {
+  checkpoint_t a{};
+  a.utime = utime_now();
+  a.run_id = info_->run_id;
+  a.cut = cut;
+  a.frame = last_frame_;
+  a.sim_time = last_time_;
+  a.process = name_;
+  a.state = state;
+  a.bytes = bytes;
+  a.write_seconds = seconds;
+  a.message = message.substr(0, 400);
+  out_.publish(checkpoint_answer_channel(name_), &a);
+}
+
+void FrameNode::load_cut() {
+  const std::string path = part_path(cut_dir_, resume_cut_, name_);
+  try {
+    PartHeader h;
+    const std::vector<uint8_t> bytes =
+        read_part(path, name_, info_->run_id, scene_hash(info_->scene_toml), &h);
+    StateIn in(bytes.data(), bytes.size(), path);
+    base_state(in);
+    load_state(in);
+    if (!in.at_end()) throw BadPart(path + ": " + std::to_string(bytes.size() - in.offset()) + " bytes left over");
+    saved_cut_ = resume_cut_;
+    std::fprintf(stderr, "%s_node: resumed from cut %d after frame %d (t = %.10g): %d frames whole, %d lost, %d "
+                 "pairs done, %zu origins held\n", name_.c_str(), h.cut, h.frame, last_time_,
+                 assembler_.frames_whole(), assembler_.frames_lost(), pairs_done_, origins_.size());
+  } catch (const std::exception& e) {
+    finish(1, std::string("cannot resume: ") + e.what());
+  }
+  resume_cut_ = -1;
+}
+
+// Stopped with nothing final: the results stay open, to be resumed.
+void FrameNode::stop_resumable(const std::string& why) {
+  if (finished_) return;
+  status_.state = "interrupted";
+  status_.message = why;
+  publish_status();
+  std::fprintf(stderr, "%s_node: interrupted, resumable: %s\n", name_.c_str(), why.c_str());
+  finished_ = true;
+  exit_code_ = kInterrupted;
 }
 
 void FrameNode::publish_status() {
@@ -282,6 +412,9 @@ void FrameNode::publish_status() {
 
 void FrameNode::tick() {
   watch_inbox();
+  if (signal_ && !finished_ && std::chrono::duration<double>(Clock::now() - signalled_at_).count() > kSignalWait)
+    stop_resumable("signal " + std::to_string(signal_) + ", and no last cut from the sim within " +
+                   std::to_string(static_cast<int>(kSignalWait)) + " s");
   if (info_) maybe_done();
   if (finished_) return;
   if (std::chrono::duration<double>(Clock::now() - last_status_).count() >= 1.0) publish_status();
@@ -311,6 +444,9 @@ void FrameNode::finish(int code, const std::string& why) {
 
 namespace {
 
+std::atomic<int> g_node_signal{0};
+void on_node_signal(int sig) { g_node_signal = sig; }
+
 // The receive thread: LCM's handle loop on the input bus, copying each
 // message into the inbox and nothing else (no decoding, no checks: the
 // compute thread does those), so that the socket is drained however long a
@@ -327,6 +463,7 @@ public:
     // this thread empties it at once.
     in_.subscribe(kChanFrame, &Receiver::on_message, this)->setQueueCapacity(100000);
     in_.subscribe(kChanSimStatus, &Receiver::on_message, this);
+    in_.subscribe(kChanCheckpoint, &Receiver::on_message, this);
     thread_ = std::thread([this] { loop(); });
   }
   ~Receiver() { stop(); }
@@ -387,7 +524,17 @@ int node_main(const std::string& program, const std::string& description, NodeFa
   double frame_delay = 0;
   app.add_option("--test-frame-delay", frame_delay,
                  "tests only: sleep this many seconds on every frame, a stand-in for heavy computation");
+  std::string checkpoint_dir;
+  int resume_cut = -1;
+  app.add_option("--checkpoint-dir", checkpoint_dir,
+                 "save this node's part of each checkpoint cut the sim asks for here (docs/checkpoints.md); "
+                 "SIGTERM/SIGINT then stop the node after the next cut");
+  app.add_option("--resume-cut", resume_cut, "resume from this cut of --checkpoint-dir");
   CLI11_PARSE(app, argc, argv);
+  if (resume_cut >= 0 && checkpoint_dir.empty()) {
+    std::fprintf(stderr, "%s: --resume-cut needs --checkpoint-dir\n", program.c_str());
+    return 2;
+  }
 
   const std::string in_url = resolve_lcm_url(url);
   const bool replay = in_url.rfind("file://", 0) == 0;
@@ -406,6 +553,11 @@ int node_main(const std::string& program, const std::string& description, NodeFa
   inbox.set_bound(kQueueMin); // until the run info sizes it (frames come only after it)
   node->attach_inbox(&inbox);
   node->set_frame_delay(frame_delay);
+  if (!checkpoint_dir.empty()) {
+    node->set_checkpointing(checkpoint_dir, resume_cut);
+    std::signal(SIGINT, on_node_signal);
+    std::signal(SIGTERM, on_node_signal);
+  }
   Receiver receiver(in, inbox, replay); // stopped and joined before inbox, node and buses go
 
   std::fprintf(stderr, "%s: ready, reading %s\n", program.c_str(), in_url.c_str());
@@ -418,6 +570,10 @@ int node_main(const std::string& program, const std::string& description, NodeFa
       if (!replay && bus_lost(in)) std::fprintf(stderr, "%s: %s\n", program.c_str(), kBusLost);
       node->input_ended();
       break;
+    }
+    if (const int sig = g_node_signal.exchange(0)) {
+      std::fprintf(stderr, "%s: signal %d: stopping after the sim's next checkpoint cut\n", program.c_str(), sig);
+      node->signal_received(sig);
     }
     node->tick();
     if (!replay) node->check_sim_alive(sim_timeout);

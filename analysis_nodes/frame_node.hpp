@@ -28,8 +28,10 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "dynhet/checkpoint_t.hpp"
 #include "dynhet/chunking.hpp"
 #include "dynhet/frame_chunk_t.hpp"
+#include "dynhet/state_archive.hpp"
 #include "dynhet/lcm_url.hpp"
 #include "dynhet/node_status_t.hpp"
 #include "dynhet/run_info_t.hpp"
@@ -79,7 +81,26 @@ public:
   void on_run_raw(const lcm::ReceiveBuffer* rb, const std::string& ch);
   void on_chunk_raw(const lcm::ReceiveBuffer* rb, const std::string& ch);
   void on_sim_status_raw(const lcm::ReceiveBuffer* rb, const std::string& ch);
+  void on_checkpoint_raw(const lcm::ReceiveBuffer* rb, const std::string& ch);
   void reject(const std::string& channel, const std::string& why);
+
+  // Checkpoint cuts (dynhet/cut.hpp, docs/checkpoints.md): parts are saved
+  // under `dir` when the sim asks; resume_cut >= 0 loads this node's part
+  // of that cut once the run info is here.
+  void set_checkpointing(const std::string& dir, int resume_cut) { cut_dir_ = dir, resume_cut_ = resume_cut; }
+  bool checkpointing() const { return !cut_dir_.empty(); }
+  // SIGTERM or SIGINT: save the next cut the sim asks for, then stop
+  // (resumable); the sim's "interrupted" also stops it.
+  void signal_received(int sig) {
+    signal_ = sig;
+    signalled_at_ = Clock::now();
+  }
+  // A node signalled alone (the sim not) stops after this long without the
+  // sim's "stop" cut.
+  static constexpr double kSignalWait = 300;
+  // Exit status of a node that stopped with its state saved in a cut (or
+  // whose sim stopped so), to be resumed.
+  static constexpr int kInterrupted = 2;
 
 protected:
   // The run has started: set up. Throwing fails the node with the message
@@ -97,6 +118,12 @@ protected:
   virtual void on_pair(int k, int j, const std::vector<double>& pos0, const Frame& f) = 0;
   // After a frame that completed at least one pair, and at the end (final).
   virtual void publish_results(bool final) = 0;
+  // The node's own state in a checkpoint part (after the base's): every
+  // accumulator, so that a resumed node goes on bit for bit. load_state
+  // comes after start(), with held_origins() restored: rebuild there what
+  // derives from them.
+  virtual void save_state(StateOut& out) = 0;
+  virtual void load_state(StateIn& in) = 0;
 
   // The fields every result message shares: when, which run, which frame.
   template <class Msg> void stamp(Msg& m, bool final) const {
@@ -133,6 +160,28 @@ private:
   static constexpr double kChunkGrace = 2.0;
   void publish_status();
   void finish(int code, const std::string& why);
+
+  // Checkpoint cuts.
+  void on_checkpoint(const checkpoint_t& m);
+  // Saves the pending cut if this node is at its frame boundary: frame
+  // `frame` folded in and nothing later (next_chunk_frame: the frame of a
+  // chunk about to be added, -1 none).
+  void try_cut(int next_chunk_frame = -1);
+  void save_cut(const checkpoint_t& c);
+  void answer_cut(int cut, const std::string& state, int64_t bytes, double seconds, const std::string& message);
+  void load_cut();
+  void stop_resumable(const std::string& why);
+  template <class Ar> void base_state(Ar& ar) {
+    ar(origins_, last_frame_, last_time_, pairs_done_, assembler_, status_.messages_rejected, status_.chunks_rejected,
+       status_.last_rejection);
+  }
+  std::string cut_dir_;
+  int resume_cut_ = -1, signal_ = 0;
+  Clock::time_point signalled_at_;
+  std::map<int, checkpoint_t> pending_cuts_; // asked for, not yet saved: cut -> request
+  int saved_cut_ = -1;                      // the last cut saved
+  int64_t saved_bytes_ = 0;
+  double saved_seconds_ = 0;
 
   lcm::LCM& out_;
   int64_t run_filter_;

@@ -69,6 +69,19 @@ private:
   }
   void on_origin_dropped(int k) override { chi4_index_.erase(k); }
 
+  // Checkpoints: every accumulator; the sub-box index of each held origin
+  // is rebuilt from its positions.
+  template <class Ar> void io(Ar& ar) {
+    ar(acc_, msd_all_, msd_small_, msd_extreme_, flow_t_, flow_l_, amp_, chi4_acc_);
+    if (displacement_) ar(*displacement_);
+  }
+  void save_state(dynhet::StateOut& out) override { io(out); }
+  void load_state(dynhet::StateIn& in) override {
+    io(in);
+    if (pass_on_)
+      for (const auto& [k, pos0] : held_origins()) on_origin(k, pos0);
+  }
+
   void on_pair(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) override {
     an::overlap_subboxes(pos0.data(), f.position.data(), info().n_particles, grid_, info().cutoff_a, qr_);
     const int nb = grid_.per_side * grid_.per_side;

@@ -104,6 +104,14 @@ private:
 
   bool uses_lag(int j) const override { return slot_[j] >= 0; }
 
+  // Checkpoints: S4 per (origin, lag) on every grid and Q(t;t0), per cutoff.
+  void save_state(dynhet::StateOut& out) override {
+    for (Cutoff& c : cuts_) out(c.acc, *c.q_acc);
+  }
+  void load_state(dynhet::StateIn& in) override {
+    for (Cutoff& c : cuts_) in(c.acc, *c.q_acc);
+  }
+
   void on_pair(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) override {
     const long n = info().n_particles;
     d2_.resize(n);

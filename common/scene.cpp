@@ -284,6 +284,7 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
       {"equilibration_time", non_negative(s.equilibration_time)},
       {"production_time", positive(s.production_time)},
       {"checkpoint_interval", positive(s.checkpoint_interval)},
+      {"checkpoint_wall_interval", non_negative(s.checkpoint_wall_interval)},
   };
   schema["schedule"] = {
       {"origins", int_in(s.schedule.origins, 1, 1000000)},

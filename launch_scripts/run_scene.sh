@@ -1,9 +1,17 @@
 #!/usr/bin/env bash
 # Runs a scene end to end: the sim, the analysis nodes the scene needs and
-# the recorder, then plots. Exits non-zero if any process failed.
+# the recorder, then plots. The whole pipeline checkpoints as it goes
+# (DIR/checkpoints, docs/checkpoints.md): the same command on the same
+# --out DIR resumes an interrupted run from its last whole cut, bit for bit.
+# Exit: 0 complete; 75 interrupted and resumable (SIGTERM/SIGINT, or a
+# process died: run the same command again); 1 failed; 2 bad arguments or
+# a scene that differs from the interrupted run's.
 #
 # Usage: launch_scripts/run_scene.sh SCENE.toml [options]
-#   --out DIR       where run.h5, plots and logs go (default runs/<scene>-<time>)
+#   --out DIR       where run.h5, plots and logs go (default runs/<scene>-<time>);
+#                   a DIR that holds an interrupted run of the same scene is
+#                   resumed from its last whole checkpoint cut
+#   --fresh         start over in DIR (its checkpoints and run.h5 go)
 #   --bus private   (default) a private network namespace: no packet leaves
 #                   the machine, nothing else on the host sees the run
 #   --bus host      this host's LCM bus ($LCM_DEFAULT_URL, else
@@ -46,9 +54,12 @@ build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
 scene="" out="" bus=private url="" record="" build_first=1 plots=1 resume="" run_id="" role=all author="" author_email=""
+fresh=0 test_node_delay=""
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
+  --fresh) fresh=1; shift ;;
+  --test-node-delay) test_node_delay=$2; shift 2 ;; # tests: seconds of sleep per frame in every node
   --bus) bus=$2; shift 2 ;;
   --url) url=$2; shift 2 ;;
   --record) record=$2; shift 2 ;;
@@ -105,12 +116,65 @@ if [[ ($bus == private || $bus == tcpq) && -z ${DYNHET_IN_NETNS:-} ]]; then
   [[ -z $run_id ]] || args+=(--run-id "$run_id")
   [[ -z $author ]] || args+=(--author "$author")
   [[ -z $author_email ]] || args+=(--author-email "$author_email")
+  ((fresh == 0)) || args+=(--fresh)
+  [[ -z $test_node_delay ]] || args+=(--test-node-delay "$test_node_delay")
   exec "$root/launch_scripts/netns.sh" "$0" ${scene:+"$scene"} "${args[@]}"
 fi
-pids=() names=()
+
+# Checkpoint cuts of the whole pipeline (one host, a scene given): a run
+# interrupted in DIR resumes from its last whole cut.
+cuts="" cut_args=() resume_cut=()
+if [[ $role == all && -z $resume ]]; then
+  cuts=$out/checkpoints
+  if ((fresh)); then
+    rm -rf "$cuts" "$out/run.h5" "$out/scene.toml"
+  fi
+  if [[ -f $out/scene.toml ]] && ! cmp -s "$scene" "$out/scene.toml"; then
+    # The run in DIR was of another scene: name the keys that differ.
+    /usr/bin/python3 "$root/launch_scripts/scene_diff.py" "$out/scene.toml" "$scene" >&2 || true
+    echo "run_scene: $out holds a run of another scene (above); use another --out, or --fresh to start over" >&2
+    exit 2
+  fi
+  if [[ -f $out/run.h5 ]] && /usr/bin/python3 -c "import h5py, sys; sys.exit(0 if int(h5py.File(sys.argv[1], 'r').attrs.get('complete', 0)) == 1 else 1)" "$out/run.h5" 2>/dev/null && [[ -f $out/scene.toml ]]; then
+    echo "run_scene: $out/run.h5 is complete: nothing to resume (--fresh starts over)" >&2
+    exit 0
+  fi
+  cp "$scene" "$out/scene.toml.tmp" && mv "$out/scene.toml.tmp" "$out/scene.toml"
+  cut_args=(--checkpoint-dir "$cuts")
+  if [[ -d $cuts ]]; then
+    set +e
+    found=$("$bin/sim_node" "$scene" --checkpoint-dir "$cuts" --find-cut 2>"$out/find_cut.log")
+    set -e
+    sed 's/^sim_node: /run_scene: /' "$out/find_cut.log" >&2
+    if [[ $found =~ ^cut\ ([0-9]+)\ frame\ (-?[0-9]+)\ time\ ([^ ]+)\ run_id\ ([0-9]+) ]]; then
+      cut=${BASH_REMATCH[1]}
+      [[ -z $run_id || $run_id == "${BASH_REMATCH[4]}" ]] || { echo "run_scene: --run-id $run_id, but $out holds run ${BASH_REMATCH[4]}" >&2; exit 2; }
+      run_id=${BASH_REMATCH[4]}
+      resume_cut=(--resume-cut "$cut")
+      # Cuts after it were refused or never whole: they go.
+      for d in "$cuts"/cut-*; do
+        n=$((10#${d##*cut-}))
+        ((n > cut)) && rm -rf "$d"
+      done
+      echo "run_scene: resuming run $run_id from checkpoint cut $cut: frames up to ${BASH_REMATCH[2]} done, t = ${BASH_REMATCH[3]}; what came after it is computed again" >&2
+    else
+      echo "run_scene: no whole checkpoint cut in $cuts: starting the run from the beginning" >&2
+      rm -rf "$cuts"
+    fi
+  fi
+fi
+pids=() names=() reaped=()
 cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
 trap cleanup EXIT
-trap 'echo "run_scene: interrupted" >&2; exit 130' INT TERM
+if [[ -n $cuts ]]; then
+  # SIGTERM/SIGINT: every process takes its part of one more cut and stops;
+  # this script waits for them (below) and exits 75.
+  stop_signal=""
+  trap 'stop_signal=TERM; for p in "${pids[@]}" ${sim_pid:-}; do kill -TERM "$p" 2>/dev/null || true; done' TERM
+  trap 'stop_signal=INT; for p in "${pids[@]}" ${sim_pid:-}; do kill -INT "$p" 2>/dev/null || true; done' INT
+else
+  trap 'echo "run_scene: interrupted" >&2; exit 130' INT TERM
+fi
 
 if [[ $bus == tcpq ]]; then
   # LCM's TCP hub on a free loopback port of this (private) namespace; it
@@ -149,7 +213,8 @@ fi
 
 start() { # name, then the command; waits for its "ready" line
   local n=$1; shift
-  "$@" 2>"$out/$n.log" &
+  if ((${#resume_cut[@]})); then echo "---- resumed from cut ${resume_cut[1]}" >>"$out/$n.log"; else : >"$out/$n.log"; fi
+  "$@" 2>>"$out/$n.log" &
   pids+=($!) names+=("$n")
   for _ in $(seq 100); do
     grep -q "ready" "$out/$n.log" 2>/dev/null && return 0
@@ -176,8 +241,10 @@ fi
 wait_run=(); [[ $role == analysis ]] && wait_run=(--wait-run 900)
 authorship=(); [[ -z $author ]] || authorship+=(--author "$author")
 [[ -z $author_email ]] || authorship+=(--author-email "$author_email")
-start recorder "$bin/recorder" --out "$out/run.h5" --run-id "$run_id" "${wait_run[@]}" "${authorship[@]}"
-for n in $nodes; do start "$n" "$bin/$n" --run-id "$run_id" "${wait_run[@]}"; done
+start recorder "$bin/recorder" --out "$out/run.h5" --run-id "$run_id" "${wait_run[@]}" "${authorship[@]}" \
+  "${cut_args[@]}" "${resume_cut[@]}"
+node_delay=(); [[ -z $test_node_delay ]] || node_delay=(--test-frame-delay "$test_node_delay")
+for n in $nodes; do start "$n" "$bin/$n" --run-id "$run_id" "${wait_run[@]}" "${cut_args[@]}" "${resume_cut[@]}" "${node_delay[@]}"; done
 if [[ -n $record ]]; then
   # lcm-logger says nothing when it is ready. The nodes publish their status
   # every second from the start: once the log holds anything (it is flushed
@@ -194,6 +261,39 @@ set +e
 if [[ $role == analysis ]]; then
   echo "run_scene: waiting for run $run_id's sim on the bus (start it with --role sim --run-id $run_id)" >&2
   sim_rc=0
+elif [[ -n $cuts ]]; then
+  # In the background, watched with the others: a process that dies takes
+  # the run down at once (killed: the last whole cut is the restart point).
+  if ((${#resume_cut[@]})); then echo "---- resumed from cut ${resume_cut[1]}" >>"$out/sim_node.log"; else : >"$out/sim_node.log"; fi
+  "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" --pace-nodes --checkpoint "$out/checkpoint.h5" \
+    --checkpoint-before-frames "$out/checkpoint_before_frames.h5" "${cut_args[@]}" "${resume_cut[@]}" \
+    2> >(trap '' TERM INT; exec tee -a "$out/sim_node.log" >&2) &
+  sim_pid=$!
+  died=""
+  while kill -0 "$sim_pid" 2>/dev/null; do
+    for i in "${!pids[@]}"; do
+      if [[ -z ${reaped[$i]:-} ]] && ! kill -0 "${pids[$i]}" 2>/dev/null; then
+        wait "${pids[$i]}"; rc=$?
+        reaped[$i]=$rc
+        if [[ $rc -ne 0 && -z $stop_signal ]]; then died="${names[$i]} (exit $rc)"; break 2; fi
+      fi
+    done
+    sleep 0.2
+  done
+  if [[ -n $died ]]; then
+    echo "run_scene: $died died: stopping the run (it resumes from its last whole checkpoint cut)" >&2
+    kill -KILL "$sim_pid" "${pids[@]}" 2>/dev/null || true
+    wait "$sim_pid" 2>/dev/null
+    sim_rc=137
+  else
+    wait "$sim_pid"; sim_rc=$?
+    # A signal arrives during wait: wait again for the sim's own exit.
+    while kill -0 "$sim_pid" 2>/dev/null; do wait "$sim_pid"; sim_rc=$?; done
+    if [[ $sim_rc -ne 0 && -z $stop_signal ]]; then # killed, or failed: the rest cannot go on
+      echo "run_scene: sim_node died (exit $sim_rc): stopping the run" >&2
+      kill -KILL "${pids[@]}" 2>/dev/null || true
+    fi
+  fi
 else
   "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" --pace-nodes --checkpoint "$out/checkpoint.h5" \
     --checkpoint-before-frames "$out/checkpoint_before_frames.h5" 2> >(tee ${resume:+-a} "$out/sim_node.log" >&2)
@@ -214,8 +314,7 @@ fi
 status=$sim_rc
 for i in "${!pids[@]}"; do
   set +e
-  wait "${pids[$i]}"
-  rc=$?
+  if [[ -n ${reaped[$i]:-} ]]; then rc=${reaped[$i]}; else wait "${pids[$i]}"; rc=$?; fi
   set -e
   if [[ $rc -ne 0 ]]; then
     echo "run_scene: ${names[$i]} failed (exit $rc); its log: $out/${names[$i]}.log" >&2
@@ -238,6 +337,13 @@ if ((plots)) && [[ -f $out/run.h5 ]]; then
   done
   /usr/bin/python3 "$root/launch_scripts/plot_overlap.py" "$out/run.h5" "$out/overlap.png" ||
     { echo "run_scene: plotting failed" >&2; status=1; }
+fi
+if [[ -n $cuts && $status -ne 0 ]]; then
+  last=$(ls -d "$cuts"/cut-*/WHOLE 2>/dev/null | tail -1)
+  if [[ -n $last ]]; then
+    echo "run_scene: interrupted${stop_signal:+ by SIG$stop_signal}; resumable from $(dirname "$last"): run the same command again (exit 75)" >&2
+    status=75
+  fi
 fi
 echo "run_scene: results in $out (exit $status)" >&2
 exit $status

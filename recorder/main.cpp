@@ -16,15 +16,22 @@
 //
 // Exit: 0 complete; 1 incomplete (sim failed, results missing after
 // --timeout, no run info within --wait-run); 2 interrupted (SIGINT or
-// SIGTERM; the file is closed cleanly); 3 could not start (bus, log or
-// output file).
+// SIGTERM; the file is closed cleanly; with --checkpoint-dir, after its part
+// of the next checkpoint cut, or because the sim stopped resumably); 3
+// could not start (bus, log, output file or the cut to resume).
+//
+// With --checkpoint-dir it journals every message it takes and saves its
+// part of each checkpoint cut (recorder_cuts.hpp); --resume-cut N rebuilds
+// run.h5 from the journal up to cut N and goes on.
 #include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <climits>
 #include <csignal>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -36,6 +43,9 @@
 #include "dynhet/lcm_exit.hpp"
 #include "dynhet/lcm_guard.hpp"
 #include "dynhet/message_checks.hpp"
+#include "dynhet/cut.hpp"
+#include "dynhet/state_archive.hpp"
+#include "recorder_cuts.hpp"
 #include "run_recorder.hpp"
 
 namespace {
@@ -50,6 +60,9 @@ struct Options {
   std::string url, out, from_log, author, author_email;
   double timeout = 60, wait_run = 120;
   int64_t run_id = 0; // 0: the first run seen
+  std::string checkpoint_dir;
+  int resume_cut = -1;
+  double cut_wait = 300; // after a signal: how long to wait for the next cut
 };
 
 // The one channel each message may come on (lcm_url.hpp: one channel per
@@ -76,7 +89,9 @@ std::string channel_of(const dynhet::displacement_t &) { return dynhet::kChanDis
 class Session {
 public:
   Session(lcm::LCM &lcm, const Options &o)
-      : lcm_(lcm), opt_(o), rec_(o.out, DYNHET_VERSION, o.author, o.author_email), start_(Clock::now()) {}
+      : lcm_(lcm), opt_(o), rec_(o.out, DYNHET_VERSION, o.author, o.author_email), start_(Clock::now()) {
+    if (!o.checkpoint_dir.empty()) cuts_ = std::make_unique<dynhet::RecorderCuts>(lcm, o.checkpoint_dir);
+  }
 
   int run();
 
@@ -90,6 +105,17 @@ private:
   Clock::time_point start_, last_sim_, last_progress_, last_own_status_;
   std::string fatal_, early_failure_;
   dynhet::node_status_t own_{}; // the recorder's own status (kept frames only)
+  // Checkpoint cuts (--checkpoint-dir): the journal and the cuts' bookkeeping.
+  std::unique_ptr<dynhet::RecorderCuts> cuts_;
+  bool replaying_ = false, sim_interrupted_ = false;
+  std::string resumable() const {
+    return cuts_->saved_cut() >= 0 ? "resumable: this recorder's last saved cut is " + std::to_string(cuts_->saved_cut())
+                                   : "this recorder saved no cut";
+  }
+  std::optional<Clock::time_point> signalled_;
+  bool start_cuts(); // the journal, new or resumed; false: fatal_ says why
+  void dispatch(const std::string &ch, const void *data, int size);
+  void take_checkpoint(const lcm::ReceiveBuffer *rb, const std::string &ch);
 
   void subscribe();
   bool read_log(int max_events);
@@ -122,6 +148,7 @@ private:
   }
   template <class Msg, void (Session::*Take)(const Msg &)>
   void take_bytes(const void *data, int size, const std::string &ch) {
+    if (cuts_ && !replaying_) cuts_->journal().append(ch, data, static_cast<uint32_t>(size));
     Msg m;
     std::string why;
     if (!dynhet::guard::safe_decode(data, size, m, why)) return reject(ch, why);
@@ -195,6 +222,7 @@ void Session::take_run(const dynhet::run_info_t &m) {
     return reject(dynhet::kChanRun, "run info: " + bad);
   try {
     if (!rec_.on_run(m)) return;
+    if (cuts_) cuts_->set_run(m);
   } catch (const std::exception &e) {
     fatal_ = e.what(); // the file cannot be written
     return;
@@ -213,6 +241,7 @@ void Session::take_run(const dynhet::run_info_t &m) {
 void Session::take_sim(const dynhet::sim_status_t &m) {
   if (!rec_.has_run() && m.phase == "failed") early_failure_ = m.message;
   if (!rec_.on_sim_status(m)) return;
+  if (m.phase == "interrupted" && !replaying_) sim_interrupted_ = true;
   last_sim_ = Clock::now();
   if (rec_.completion().sim_ended()) last_progress_ = Clock::now();
 }
@@ -233,7 +262,78 @@ bool Session::read_log(int max_events) {
   return true;
 }
 
+// Where a journaled message goes: the handler of its channel's family.
+void Session::dispatch(const std::string &ch, const void *d, int n) {
+  using R = dynhet::RunRecorder;
+  namespace dh = dynhet;
+  auto in = [&](const char *family) { return ch.rfind(family, 0) == 0; };
+  if (ch == dh::kChanRun) take_bytes<dh::run_info_t, &Session::take_run>(d, n, ch);
+  else if (ch == dh::kChanSimStatus) take_bytes<dh::sim_status_t, &Session::take_sim>(d, n, ch);
+  else if (ch == dh::kChanFrame) take_bytes<dh::frame_chunk_t, &Session::take_frame>(d, n, ch);
+  else if (in(dh::kChanNodeStatus)) take_bytes<dh::node_status_t, &Session::take_node>(d, n, ch);
+  else if (in(dh::kChanOverlap)) take_bytes<dh::overlap_t, &Session::take_result<dh::overlap_t, &R::on_overlap>>(d, n, ch);
+  else if (in(dh::kChanChi4)) take_bytes<dh::chi4_t, &Session::take_result<dh::chi4_t, &R::on_chi4>>(d, n, ch);
+  else if (in(dh::kChanMsd)) take_bytes<dh::msd_t, &Session::take_result<dh::msd_t, &R::on_msd>>(d, n, ch);
+  else if (in(dh::kChanS4)) take_bytes<dh::s4_t, &Session::take_result<dh::s4_t, &R::on_s4>>(d, n, ch);
+  else if (in(dh::kChanClusters))
+    take_bytes<dh::clusters_t, &Session::take_result<dh::clusters_t, &R::on_clusters>>(d, n, ch);
+  else if (in(dh::kChanDisplacement))
+    take_bytes<dh::displacement_t, &Session::take_result<dh::displacement_t, &R::on_displacement>>(d, n, ch);
+}
+
+bool Session::start_cuts() {
+  if (!cuts_) return true;
+  try {
+    std::filesystem::create_directories(cuts_->dir());
+    if (opt_.resume_cut < 0) {
+      cuts_->journal().create(cuts_->journal_path());
+      return true;
+    }
+    std::remove(opt_.out.c_str()); // rebuilt from the journal
+    replaying_ = true;
+    const auto r = cuts_->resume(opt_.resume_cut, [&](const std::string &ch, const uint8_t *d, uint32_t n) {
+      dispatch(ch, d, static_cast<int>(n));
+    });
+    replaying_ = false;
+    if (!fatal_.empty()) return false;
+    if (!rec_.has_run() || rec_.run_id() != r.run_id)
+      throw dynhet::BadPart(dynhet::part_path(cuts_->dir(), opt_.resume_cut, "recorder") +
+                            ": its journal holds no run info of run " + std::to_string(r.run_id));
+    if (dynhet::scene_hash(rec_.run_info()->scene_toml) != r.scene_hash)
+      throw dynhet::BadPart(dynhet::part_path(cuts_->dir(), opt_.resume_cut, "recorder") + ": of another scene");
+    std::fprintf(stderr, "recorder: resumed from cut %d after frame %d: %llu bytes of journal replayed into %s\n",
+                 opt_.resume_cut, r.frame, static_cast<unsigned long long>(r.journal_bytes), opt_.out.c_str());
+    return true;
+  } catch (const std::exception &e) {
+    replaying_ = false;
+    fatal_ = std::string("cannot resume: ") + e.what();
+    return false;
+  }
+}
+
+void Session::take_checkpoint(const lcm::ReceiveBuffer *rb, const std::string &ch) {
+  if (!cuts_ || !rec_.has_run()) return;
+  dynhet::checkpoint_t m;
+  std::string why;
+  if (!dynhet::guard::safe_decode(rb->data, static_cast<int>(rb->data_size), m, why)) return reject(ch, why);
+  if (m.run_id != rec_.run_id()) return;
+  if (const std::string bad = dynhet::checkpoint_problem(m, rec_.n_frames()); !bad.empty())
+    return reject(ch, "checkpoint: " + bad);
+  if (const std::string bad = cuts_->on_message(m, ch); !bad.empty()) return reject(ch, "checkpoint: " + bad);
+  for (int c : cuts_->save_ready()) {
+    std::fprintf(stderr, "recorder: checkpoint: cut %d saved (journal %.1f MB)\n", c,
+                 cuts_->journal().length() / 1e6);
+  }
+}
+
 int Session::run() {
+  if (!start_cuts()) {
+    std::fprintf(stderr, "recorder: %s\n", fatal_.c_str());
+    return 3;
+  }
+  if (cuts_)
+    lcm_.subscribe(dynhet::channel_family(dynhet::kChanCheckpoint), &Session::take_checkpoint, this)
+        ->setQueueCapacity(1000);
   subscribe();
   for (;;) {
     if (log_ && !log_done_ && fatal_.empty()) {
@@ -258,7 +358,20 @@ int Session::step() {
     std::fprintf(stderr, "recorder: interrupted before any run info; no file written\n");
     return 2;
   }
+  if (g_signal && cuts_) {
+    // Stop after this recorder's part of the next cut (the sim takes one on
+    // its signal), or once the sim has stopped, or after --cut-wait.
+    if (!signalled_) {
+      signalled_ = Clock::now();
+      std::fprintf(stderr, "recorder: signal %d: stopping after the sim's next checkpoint cut\n", g_signal.load());
+    }
+    if (cuts_->stop_cut_saved() || sim_interrupted_ || rec_.completion().sim_ended() ||
+        since(*signalled_) > opt_.cut_wait)
+      return finish("interrupted by signal " + std::to_string(g_signal.load()) + "; " + resumable());
+    return -1;
+  }
   if (g_signal) return finish("interrupted by signal " + std::to_string(g_signal.load()));
+  if (cuts_ && sim_interrupted_) return finish("interrupted: the sim stopped; " + resumable());
   if (!rec_.has_run()) {
     if (!early_failure_.empty() || log_done_ || since(start_) > opt_.wait_run) {
       std::fprintf(stderr, "recorder: no run info %s; no file written\n",
@@ -358,6 +471,12 @@ int main(int argc, char **argv) {
   app.add_option("--author", o.author,
                  "the file's h5md/author name (default: $DYNHET_AUTHOR, else $USER, else \"unknown\")");
   app.add_option("--author-email", o.author_email, "the file's h5md/author email (default: none)");
+  app.add_option("--checkpoint-dir", o.checkpoint_dir,
+                 "journal every message here and save the recorder's part of each checkpoint cut "
+                 "(docs/checkpoints.md); SIGTERM/SIGINT then stop it after the next cut");
+  app.add_option("--resume-cut", o.resume_cut, "rebuild the file from the journal up to this cut and go on");
+  app.add_option("--cut-wait", o.cut_wait, "after SIGTERM/SIGINT, wait at most this long (s) for the next cut")
+      ->capture_default_str();
   app.add_option("--list-nodes", list_log,
                  "print the analysis nodes the run in this lcm-logger log needs, and exit");
   CLI11_PARSE(app, argc, argv);

@@ -86,6 +86,7 @@ public:
   int64_t messages_rejected() const { return rejected_; }
 
   bool has_run() const { return info_ != nullptr; }
+  const run_info_t *run_info() const { return info_.get(); }
   int64_t run_id() const { return info_ ? info_->run_id : 0; }
   bool keep_frames() const { return info_ && info_->keep_frames; }
   int n_frames() const { return info_ ? info_->n_frames : 0; }

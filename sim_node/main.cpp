@@ -21,6 +21,9 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "checkpoint.hpp"
+#include "cut_coordinator.hpp"
+#include "dynhet/cut.hpp"
+#include "dynhet/state_archive.hpp"
 #include "dynhet/chunking.hpp"
 #include "dynhet/engine/engine.hpp"
 #include "dynhet/flow_control.hpp"
@@ -137,6 +140,9 @@ public:
   }
   // Fine blocks of the pressure and frequency in this phase.
   long blocks() const { return pressure_.blocks(); }
+  // What a checkpoint cut keeps: the blocks and the last sample, so that a
+  // resumed run's Z and collision frequency equal the uninterrupted run's.
+  template <class Ar> void state(Ar& ar) { ar(pressure_, frequency_, s_time_, s_virial_, s_ke_, s_coll_); }
   // A new phase of this length in simulation time: rates and block
   // averages start afresh, with 256 fine blocks over the phase.
   void reset_rates(const dynhet::engine::Engine& e, double phase_length) {
@@ -435,6 +441,20 @@ int main(int argc, char** argv) {
                "buffer's worth of frames (run_scene.sh sets it)");
   bool check = false;
   app.add_flag("--check", check, "validate the scene, print what it needs (nodes, frames) and exit");
+  std::string cut_root;
+  int resume_cut = -1;
+  bool find_cut = false;
+  double cut_wait = 300;
+  app.add_option("--checkpoint-dir", cut_root,
+                 "take checkpoint cuts of the whole pipeline in this folder (docs/checkpoints.md): at every "
+                 "run.checkpoint_interval (or run.checkpoint_wall_interval), and on SIGTERM/SIGINT before exiting");
+  app.add_option("--resume-cut", resume_cut, "resume the run from this whole cut of --checkpoint-dir (the scene's)");
+  app.add_flag("--find-cut", find_cut,
+               "print the newest whole cut of --checkpoint-dir that every part of reads back for this scene "
+               "(\"cut N frame K time T run_id R\"), each cut refused and why on stderr, and exit (1: none)");
+  app.add_option("--cut-wait", cut_wait,
+                 "on SIGTERM/SIGINT, wait at most this many seconds for every process to save its part of the last cut")
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
 
   if (scene_path.empty() == resume_path.empty()) {
@@ -460,6 +480,36 @@ int main(int argc, char** argv) {
   } catch (const std::exception& e) {
     std::fprintf(stderr, "sim_node: %s\n", e.what());
     return 2;
+  }
+  if (find_cut) {
+    if (cut_root.empty()) {
+      std::fprintf(stderr, "sim_node: --find-cut needs --checkpoint-dir\n");
+      return 2;
+    }
+    std::vector<std::string> refused;
+    const auto c = dynhet::latest_whole_cut(cut_root, dynhet::scene_hash(scene.text), refused);
+    for (const std::string& r : refused) std::fprintf(stderr, "sim_node: %s\n", r.c_str());
+    if (!c) return 1;
+    std::printf("cut %d frame %d time %.17g run_id %lld\n", c->cut, c->frame, c->sim_time,
+                static_cast<long long>(c->run_id));
+    return 0;
+  }
+  // A cut's sim part: the run id comes from it.
+  std::vector<uint8_t> cut_part;
+  if (resume_cut >= 0) {
+    try {
+      if (cut_root.empty()) throw std::runtime_error("--resume-cut needs --checkpoint-dir");
+      dynhet::PartHeader h;
+      cut_part = dynhet::read_part(dynhet::part_path(cut_root, resume_cut, "sim"), "sim", 0,
+                                   dynhet::scene_hash(scene.text), &h);
+      if (run_id != 0 && run_id != h.run_id)
+        throw std::runtime_error("cut " + std::to_string(resume_cut) + " is of run " + std::to_string(h.run_id) +
+                                 ", not --run-id " + std::to_string(run_id));
+      run_id = h.run_id;
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "sim_node: cannot resume: %s\n", e.what());
+      return 2;
+    }
   }
   if (check) {
     // The engine's own refusals (a box too small for its cells, ...) are
@@ -545,7 +595,19 @@ int main(int argc, char** argv) {
     rep.msg().frames_total = info.n_frames;
 
     const auto t_wall = Clock::now();
-    if (!resume_path.empty()) {
+    // A cut's sim part: next frame, the reporter's phase, the engine state,
+    // then the reporter's blocks (applied after that phase's reset below).
+    std::string cut_phase;
+    size_t cut_reporter_at = 0;
+    if (!cut_part.empty()) {
+      dynhet::StateIn in(cut_part.data(), cut_part.size(), dynhet::part_path(cut_root, resume_cut, "sim"));
+      dynhet::engine::State st;
+      in(resumed.next_frame, cut_phase, st);
+      cut_reporter_at = in.offset();
+      eng.restore(st);
+      std::fprintf(stderr, "sim_node: resumed from checkpoint cut %d at t=%.10g, next frame %d (%s)\n", resume_cut,
+                   eng.time(), resumed.next_frame, dynhet::cut_dir(cut_root, resume_cut).c_str());
+    } else if (!resume_path.empty()) {
       eng.restore(resumed.state);
       std::fprintf(stderr, "sim_node: resumed at t=%.10g, frame %d, from %s\n", eng.time(),
                    resumed.next_frame, resume_path.c_str());
@@ -581,6 +643,42 @@ int main(int argc, char** argv) {
       checkpoint_written = true;
     };
     bool announced = false;
+    // After a phase's reset: a resumed run's blocks, if its cut was taken in
+    // this phase (a cut at the end of equilibration belongs to it: the
+    // production starts afresh, as in the uninterrupted run).
+    auto apply_cut_reporter = [&] {
+      if (cut_part.empty()) return;
+      if (cut_phase == rep.msg().phase) {
+        dynhet::StateIn in(cut_part.data() + cut_reporter_at, cut_part.size() - cut_reporter_at, "the sim part");
+        in(rep);
+      }
+      cut_part.clear();
+    };
+    // Checkpoint cuts of the whole pipeline: the sim, each node, the recorder.
+    std::unique_ptr<dynhet::CutCoordinator> cuts;
+    if (!cut_root.empty()) {
+      std::vector<std::string> parts{"sim"};
+      for (const auto& n : dynhet::nodes_for(scene.observables)) parts.push_back(n.substr(0, n.size() - 5));
+      parts.push_back(dynhet::kRecorderNode);
+      cuts = std::make_unique<dynhet::CutCoordinator>(lcm, cut_root, run_id, scene.text, parts);
+    }
+    // At a synchronised time: a cut after the last frame published.
+    auto take_cut = [&](bool stop) {
+      const auto t0 = Clock::now();
+      dynhet::StateOut out;
+      std::string phase = rep.msg().phase;
+      dynhet::engine::State st = eng.state();
+      out(next_frame, phase, st, rep);
+      const int c = cuts->take(next_frame - 1, eng.time(), out.bytes(), stop);
+      if (g_signal)
+        std::fprintf(stderr, "\nsim_node: checkpoint cut %d after frame %d at t=%.10g (sim part %.1f MB in %.2f s)\n",
+                     c, next_frame - 1, eng.time(), out.bytes().size() / 1e6, seconds_since(t0));
+      return c;
+    };
+    auto cut_due = [&] {
+      return cuts && (g_signal || scene.checkpoint_wall_interval <= 0 ||
+                      cuts->seconds_since_take() >= scene.checkpoint_wall_interval);
+    };
 
     // Advance to time t in slices, so that status and run info go out and
     // signals are seen at least once a second; synchronise (and checkpoint)
@@ -597,7 +695,8 @@ int main(int argc, char** argv) {
           rep.update(eng, t_end - eng.time());
           if (tcpq && dynhet::bus_lost(lcm)) throw std::runtime_error(dynhet::kBusLost);
           if (seconds_since(last_info) > 2.0) publish_info();
-          if (g_signal && checkpoint_path.empty())
+          if (cuts) cuts->poll();
+          if (g_signal && checkpoint_path.empty() && !cuts)
             throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
           if (g_signal && !announced) {
             std::fprintf(stderr, "\nsim_node: signal %d: running on to t=%g to write a checkpoint\n",
@@ -609,6 +708,26 @@ int main(int argc, char** argv) {
           eng.synchronize();
           ++next_slot;
           if (!checkpoint_path.empty()) checkpoint();
+          if (cut_due()) {
+            int c = -1;
+            try {
+              c = take_cut(g_signal != 0);
+            } catch (const std::exception& e) { // a full disk, say: the last whole cut stays the restart point
+              std::fprintf(stderr, "\nsim_node: checkpoint cut not taken: %s\n", e.what());
+            }
+            if (g_signal) {
+              checkpoint_written = true;
+              const int before = cuts->last_whole();
+              if (c >= 0 && cuts->wait_whole(c, cut_wait))
+                throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
+                                         "; checkpoint cut " + std::to_string(c) + " after frame " +
+                                         std::to_string(next_frame - 1) + " (t=" + std::to_string(eng.time()) +
+                                         ") is whole: the same command resumes the run");
+              throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
+                                       "; the last cut was not whole within " + std::to_string(cut_wait) +
+                                       " s: the run resumes from cut " + std::to_string(before));
+            }
+          }
           if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
                                                  (checkpoint_path.empty() ? "" : "; checkpoint at t=" +
                                                   std::to_string(eng.time()) + " in " + checkpoint_path +
@@ -623,12 +742,14 @@ int main(int argc, char** argv) {
       rep.msg().phase = "equilibrate";
       rep.msg().phase_end_time = scene.equilibration_time;
       rep.reset_rates(eng, scene.equilibration_time - eng.time());
+      apply_cut_reporter();
       advance(scene.equilibration_time);
     }
 
     rep.msg().phase = "production";
     rep.msg().phase_end_time = t_end;
     rep.reset_rates(eng, t_end - eng.time());
+    apply_cut_reporter();
     const auto ranges = dynhet::chunk_ranges(static_cast<int>(eng.size()), scene.chunk_particles);
     std::vector<double> xy;
     dynhet::frame_chunk_t chunk{};
@@ -652,6 +773,7 @@ int main(int argc, char** argv) {
       const auto t_wait = Clock::now();
       pacer.before_frame(f, [&] {
         if (seconds_since(last_info) > 2.0) publish_info();
+        if (cuts) cuts->poll();
         rep.update(eng, t_end - eng.time());
         if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
       });
@@ -691,6 +813,18 @@ int main(int argc, char** argv) {
       rep.msg().frames_published = next_frame = f + 1;
     }
     advance(t_end);
+    // The cuts still open are whole once the nodes have caught up: a run
+    // that dies after the sim ends then loses nothing the sim did.
+    if (cuts && cuts->newest_open() >= 0 &&
+        !cuts->wait_whole(cuts->newest_open(), cut_wait, [] { return g_signal != 0; })) {
+      if (g_signal) {
+        checkpoint_written = true;
+        throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
+                                 " after the last frame; the run resumes from cut " +
+                                 std::to_string(cuts->last_whole()));
+      }
+      std::fprintf(stderr, "\nsim_node: the last checkpoint cut was not whole within %g s (--cut-wait)\n", cut_wait);
+    }
     const double production_seconds = seconds_since(t_production);
     if (!checkpoint_path.empty()) {
       eng.synchronize();

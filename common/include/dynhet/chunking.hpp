@@ -68,6 +68,15 @@ public:
   int64_t chunks_received() const { return chunks_; }
   int64_t chunks_malformed() const { return malformed_; }
 
+  // A checkpoint (state_archive.hpp): which frames are settled and the
+  // counts. Taken at a frame boundary (give_up_before first), so nothing
+  // up to it is pending.
+  template <class Ar> void state(Ar& ar) {
+    std::vector<uint8_t> done(done_.begin(), done_.end());
+    ar(done, whole_, lost_, chunks_, malformed_);
+    done_.assign(done.begin(), done.end());
+  }
+
 private:
   struct Pending {
     Frame frame;

@@ -48,6 +48,12 @@ inline constexpr const char* kChanMsd = "DYNHET_MSD";
 inline constexpr const char* kChanS4 = "DYNHET_S4";                   // + "_<a>"
 inline constexpr const char* kChanClusters = "DYNHET_CLUSTERS";       // + "_<a>"
 inline constexpr const char* kChanDisplacement = "DYNHET_DISPLACEMENT";
+// Checkpoint cuts (dynhet/cut.hpp): the sim's requests, and each process's
+// answer on DYNHET_CHECKPOINT_<process>.
+inline constexpr const char* kChanCheckpoint = "DYNHET_CHECKPOINT";
+inline std::string checkpoint_answer_channel(const std::string& process) {
+  return std::string(kChanCheckpoint) + "_" + process;
+}
 
 // "a0.6": how a cutoff names its results in channels and in run.h5 (six
 // significant digits; a scene's cutoffs must differ in their labels).

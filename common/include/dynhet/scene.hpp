@@ -70,6 +70,11 @@ struct Scene {
   // writes a checkpoint there when asked), so that a resumed run goes on
   // bit for bit like the uninterrupted one.
   double checkpoint_interval = 10.0;
+  // Wall-clock seconds between checkpoint cuts (docs/checkpoints.md): 0
+  // takes one at every checkpoint_interval; else at the first synchronised
+  // time after this many seconds since the last (cuts are only ever taken
+  // at those times, so keep checkpoint_interval short in wall time).
+  double checkpoint_wall_interval = 0;
 
   ScheduleSpec schedule;
 

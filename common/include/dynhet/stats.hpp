@@ -94,6 +94,8 @@ public:
     return worst;
   }
 
+  template <class Ar> void state(Ar& ar) { ar(fine_, num_, den_, cur_num_, cur_den_, cur_dt_); } // checkpoints
+
 private:
   double fine_ = 0;
   std::vector<double> num_, den_;

@@ -4,10 +4,12 @@
 // guard::safe_decode (lcm_guard.hpp, generated).
 #pragma once
 
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <string>
 
+#include "dynhet/checkpoint_t.hpp"
 #include "dynhet/run_info_t.hpp"
 
 namespace dynhet {
@@ -49,6 +51,21 @@ inline std::string run_info_problem(const run_info_t& m) {
   for (int g = 0; g < m.n_chi4_sizes; ++g)
     if (m.chi4_subbox_particles[g] < 1) return "chi4_subbox_particles < 1";
   if (m.chunk_particles < 1) return "chunk_particles < 1";
+  return "";
+}
+
+// "" if a checkpoint request or answer is sane for a run of n_frames frames:
+// a cut number, a frame of the run (or -1), a finite time, a process name
+// that can be a file name (letters, digits, '_'), a known state.
+inline std::string checkpoint_problem(const checkpoint_t& m, int32_t n_frames) {
+  if (m.cut < 0) return "cut " + std::to_string(m.cut);
+  if (m.frame < -1 || m.frame >= n_frames) return "frame " + std::to_string(m.frame) + " not one of the run's";
+  if (!std::isfinite(m.sim_time) || m.sim_time < 0) return "sim_time not finite and >= 0";
+  if (m.process.empty() || m.process.size() > 32) return "process name of " + std::to_string(m.process.size()) + " characters";
+  for (char c : m.process)
+    if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) return "process name not [A-Za-z0-9_]";
+  if (m.state != "save" && m.state != "saved" && m.state != "failed" && m.state != "whole")
+    return "state \"" + m.state.substr(0, 16) + "\"";
   return "";
 }
 

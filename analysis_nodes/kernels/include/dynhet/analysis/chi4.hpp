@@ -39,6 +39,7 @@ public:
     double chi4_peak, tau4, chi4_peak_err, tau4_err;
   };
   Result result() const;
+  template <class Ar> void state(Ar& ar) { ar(s1_, s2_); } // what a checkpoint keeps
 
 private:
   std::size_t index(int k, int j) const { return static_cast<std::size_t>(k) * lag_.size() + j; }

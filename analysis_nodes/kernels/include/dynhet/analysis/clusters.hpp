@@ -40,6 +40,7 @@ struct PairDistribution {
   double dr;
   std::vector<double> r;                // bin centres
   std::array<std::vector<double>, 3> g; // by species_pair
+  template <class Ar> void state(Ar& ar) { ar(dr, r, g); }
 };
 PairDistribution pair_distribution(const double* pos, const std::uint8_t* species, long n, double box,
                                    double r_max, double dr);
@@ -52,6 +53,7 @@ double first_minimum(const std::vector<double>& r, const std::vector<double>& g,
 struct NeighbourCutoffs {
   std::array<double, 3> r; // by species_pair
   double max() const { return std::max(r[0], std::max(r[1], r[2])); }
+  template <class Ar> void state(Ar& ar) { ar(r); }
 };
 NeighbourCutoffs neighbour_cutoffs(const PairDistribution& g, double smooth);
 
@@ -160,6 +162,9 @@ struct ClusterTally {
   std::vector<long> count;                // clusters per bin, spanning ones included
   std::vector<long> rg_count;             // clusters in the R_g sums, per bin
   std::vector<double> sum_ln_n, sum_ln_rg; // sum of ln N_c and ln R_g, per bin
+  template <class Ar> void state(Ar& ar) {
+    ar(edges, rg_min_size, sets, particles, clusters, spanning, largest, count, rg_count, sum_ln_n, sum_ln_rg);
+  }
 };
 
 // d_f from R_g ~ N_c^(1/d_f): a straight line through the mean ln R_g against

@@ -57,11 +57,13 @@ public:
   DistributionEstimate estimate(const DisplacementSpec& spec, int lag, int set, double t,
                                 const DistributionFitSpec& fit) const;
   long pairs(int lag) const; // pairs added at this lag (set 0)
+  template <class Ar> void state(Ar& ar) { ar(cell_); } // what a checkpoint keeps
 
 private:
   struct Cell {
     std::vector<long> count;
     long samples = 0, pairs = 0;
+    template <class Ar> void state(Ar& ar) { ar(count, samples, pairs); }
   };
   int blocks_, lags_, sets_, bins_;
   std::vector<Cell> cell_; // [(block * lags + lag) * sets + set]

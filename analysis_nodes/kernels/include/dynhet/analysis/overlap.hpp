@@ -54,6 +54,8 @@ public:
   const std::vector<double>& table() const { return q_; }
   int n_origins() const { return n_origins_; }
   double origin_spacing() const { return spacing_; }
+  // What a checkpoint keeps (the sizes are the run's, set by the constructor).
+  template <class Ar> void state(Ar& ar) { ar(q_, var_); }
 
 private:
   std::size_t index(int k, int j) const { return static_cast<size_t>(k) * lag_.size() + j; }

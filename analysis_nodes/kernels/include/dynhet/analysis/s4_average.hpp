@@ -34,6 +34,7 @@ public:
   int n_origins() const { return n_origins_; }
   // Origin k's S4 per shell at lag j (meaningful where has(k, j)).
   const double* at(int k, int j) const { return s4_.data() + (static_cast<size_t>(k) * n_lags_ + j) * q_.size(); }
+  template <class Ar> void state(Ar& ar) { ar(s4_, filled_); } // what a checkpoint keeps
 
 private:
   int n_origins_, n_lags_;

@@ -108,6 +108,7 @@ struct Counters {
   // kMaxKickDraws draws and took a pair from the whole system instead.
   int64_t kick_redraws = 0;
   int64_t kick_far = 0;
+  template <class Ar> void state(Ar& ar) { ar(collisions, kicks, rebuilds, stale, tc, virial, kick_redraws, kick_far); }
 };
 
 // Reduced pressure Z = P A / (N T) from the collision virial accumulated
@@ -149,6 +150,10 @@ struct State {
   std::vector<uint64_t> collision_count;
   uint64_t rng[4] = {0, 0, 0, 0};
   Counters counters;
+  // Checkpoint cuts (dynhet/state_archive.hpp).
+  template <class Ar> void state(Ar& ar) {
+    ar(time, kick_in, x, y, vx, vy, last_collision, image_x, image_y, collision_count, rng, counters);
+  }
 };
 
 class Engine {

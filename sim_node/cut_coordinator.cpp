@@ -1,0 +1,141 @@
+#include "cut_coordinator.hpp"
+
+#include <cstdio>
+#include <filesystem>
+#include <thread>
+
+#include "dynhet/checkpoint_t.hpp"
+#include "dynhet/cut.hpp"
+#include "dynhet/lcm_exit.hpp"
+#include "dynhet/lcm_guard.hpp"
+#include "dynhet/lcm_url.hpp"
+#include "dynhet/message_checks.hpp"
+#include "dynhet/state_archive.hpp"
+
+namespace dynhet {
+
+CutCoordinator::CutCoordinator(lcm::LCM& lcm, std::string dir, int64_t run_id, std::string scene_text,
+                               std::vector<std::string> parts)
+    : lcm_(lcm), dir_(std::move(dir)), run_id_(run_id), scene_(std::move(scene_text)),
+      scene_hash_(dynhet::scene_hash(scene_)), parts_(std::move(parts)) {
+  std::filesystem::create_directories(dir_);
+  const std::vector<int> cuts = list_cuts(dir_);
+  next_cut_ = cuts.empty() ? 0 : cuts.back() + 1;
+  for (auto it = cuts.rbegin(); it != cuts.rend(); ++it)
+    if (read_cut_marker(dir_, *it)) {
+      if (last_whole_ < 0) last_whole_ = *it;
+      else if (previous_whole_ < 0) previous_whole_ = *it;
+    }
+  // Answers of every process (LCM patterns match whole names).
+  sub_ = lcm_.subscribe(std::string(kChanCheckpoint) + "_.*", &CutCoordinator::on_answer, this);
+  sub_->setQueueCapacity(1000);
+}
+
+CutCoordinator::~CutCoordinator() {
+  if (sub_) lcm_.unsubscribe(sub_);
+}
+
+double CutCoordinator::seconds_since_take() const {
+  return std::chrono::duration<double>(Clock::now() - last_take_).count();
+}
+
+int CutCoordinator::take(int frame, double t, const std::vector<uint8_t>& sim_payload, bool stop) {
+  const int cut = next_cut_++;
+  last_take_ = Clock::now();
+  std::filesystem::create_directories(cut_dir(dir_, cut));
+  PartHeader h;
+  h.process = "sim", h.run_id = run_id_, h.cut = cut, h.frame = frame, h.scene_hash = scene_hash_;
+  write_part(part_path(dir_, cut, "sim"), h, sim_payload);
+  // Older cuts stay open: nodes behind the sim (up to its pacing window)
+  // save them in turn.
+  while (pending_.size() >= kMaxOpen) pending_.erase(pending_.begin());
+  Pending& p = pending_[cut];
+  p.frame = frame, p.time = t, p.stop = stop;
+  p.saved.insert("sim");
+  request(cut, p);
+  return cut;
+}
+
+void CutCoordinator::request(int cut, const Pending& p) {
+  checkpoint_t m{};
+  m.utime = utime_now();
+  m.run_id = run_id_;
+  m.cut = cut;
+  m.frame = p.frame;
+  m.sim_time = p.time;
+  m.process = "sim";
+  m.state = "save";
+  m.message = p.stop ? "stop" : "";
+  lcm_.publish(kChanCheckpoint, &m);
+  pending_[cut].asked = Clock::now();
+}
+
+void CutCoordinator::on_answer(const lcm::ReceiveBuffer* rb, const std::string& channel) {
+  checkpoint_t m;
+  std::string why;
+  if (!guard::safe_decode(rb->data, static_cast<int>(rb->data_size), m, why)) return; // untrusted: dropped
+  if (m.run_id != run_id_ || channel != checkpoint_answer_channel(m.process)) return;
+  if (!checkpoint_problem(m, INT32_MAX - 1).empty()) return;
+  auto it = pending_.find(m.cut);
+  if (it == pending_.end()) return;
+  if (m.state == "saved") {
+    it->second.saved.insert(m.process);
+  } else if (m.state == "failed") {
+    std::fprintf(stderr, "\nsim_node: checkpoint cut %d: %s could not save its part (%s); the restart point stays "
+                 "cut %d\n", m.cut, m.process.c_str(), m.message.c_str(), last_whole_);
+    pending_.erase(it);
+  }
+}
+
+void CutCoordinator::complete(int cut, Pending& p) {
+  CutInfo c;
+  c.cut = cut, c.frame = p.frame, c.sim_time = p.time, c.run_id = run_id_, c.parts = parts_;
+  try {
+    mark_cut_whole(dir_, c, scene_hash_);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "\nsim_node: checkpoint cut %d is not whole: %s\n", cut, e.what());
+    return;
+  }
+  if (last_whole_ >= 0) previous_whole_ = last_whole_;
+  last_whole_ = cut;
+  // The previous whole cut stays, as the fallback if this one is damaged.
+  prune_cuts(dir_, previous_whole_ >= 0 ? previous_whole_ : cut);
+  checkpoint_t m{};
+  m.utime = utime_now();
+  m.run_id = run_id_, m.cut = cut, m.frame = p.frame, m.sim_time = p.time;
+  m.process = "sim", m.state = "whole";
+  lcm_.publish(kChanCheckpoint, &m);
+}
+
+void CutCoordinator::poll() {
+  while (handle_timeout(lcm_, 0) > 0) {
+  }
+  for (auto it = pending_.begin(); it != pending_.end();) {
+    Pending& p = it->second;
+    bool all = true;
+    for (const std::string& part : parts_) all = all && p.saved.count(part);
+    if (all) {
+      complete(it->first, p);
+      it = pending_.erase(it);
+      continue;
+    }
+    if (std::chrono::duration<double>(Clock::now() - p.asked).count() > 1.0) request(it->first, p);
+    ++it;
+  }
+}
+
+int CutCoordinator::newest_open() const { return pending_.empty() ? -1 : pending_.rbegin()->first; }
+
+bool CutCoordinator::wait_whole(int cut, double timeout, const std::function<bool()>& abort) {
+  const auto t0 = Clock::now();
+  for (;;) {
+    poll();
+    if (last_whole_ == cut) return true;
+    if (!pending_.count(cut)) return false; // failed somewhere
+    if (abort && abort()) return false;
+    if (std::chrono::duration<double>(Clock::now() - t0).count() > timeout) return false;
+    handle_timeout(lcm_, 20);
+  }
+}
+
+} // namespace dynhet
