@@ -6,6 +6,7 @@
 #include <zlib.h>
 
 #include <cerrno>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 
@@ -67,6 +68,9 @@ void write_file_atomic(const std::string& path, const std::vector<uint8_t>& byte
     }
     done += static_cast<size_t>(w);
   }
+  // Tests only: a pause between the bytes and the rename, to kill a process
+  // in the middle of writing its part (tests/kill_resume.sh).
+  if (const char* d = std::getenv("DYNHET_TEST_PART_WRITE_DELAY")) ::usleep(static_cast<useconds_t>(std::atof(d) * 1e6));
   if (::fsync(fd) != 0) {
     const std::string why = std::strerror(errno);
     ::close(fd);

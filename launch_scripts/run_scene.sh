@@ -127,7 +127,7 @@ cuts="" cut_args=() resume_cut=()
 if [[ $role == all && -z $resume ]]; then
   cuts=$out/checkpoints
   if ((fresh)); then
-    rm -rf "$cuts" "$out/run.h5" "$out/scene.toml"
+    rm -rf "$cuts"/cut-* "$cuts"/recorder.journal "$out/run.h5" "$out/scene.toml"
   fi
   if [[ -f $out/scene.toml ]] && ! cmp -s "$scene" "$out/scene.toml"; then
     # The run in DIR was of another scene: name the keys that differ.
@@ -159,7 +159,7 @@ if [[ $role == all && -z $resume ]]; then
       echo "run_scene: resuming run $run_id from checkpoint cut $cut: frames up to ${BASH_REMATCH[2]} done, t = ${BASH_REMATCH[3]}; what came after it is computed again" >&2
     else
       echo "run_scene: no whole checkpoint cut in $cuts: starting the run from the beginning" >&2
-      rm -rf "$cuts"
+      rm -rf "$cuts"/cut-* "$cuts"/recorder.journal
     fi
   fi
 fi

@@ -74,6 +74,14 @@ set_tests_properties(fuzz_scenes PROPERTIES LABELS process TIMEOUT 300)
 # A full disk (tests/full_disk.sh: a 12 MB tmpfs in a private mount
 # namespace): the recorder stops writing, keeps run.h5 readable and marked
 # incomplete with ENOSPC named; a checkpoint on a full disk names ENOSPC.
+# Runs that outlive their processes (tests/kill_resume.sh): SIGKILL of random
+# processes at random times, during a part's write, SIGTERM of the whole
+# group, a corrupted cut, a full disk; every resumed run.h5 equals the
+# uninterrupted run's.
+add_test(NAME kill_resume
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/kill_resume.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(kill_resume PROPERTIES LABELS process TIMEOUT 400)
+
 add_test(NAME full_disk
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/full_disk.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(full_disk PROPERTIES LABELS process TIMEOUT 120)

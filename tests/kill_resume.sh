@@ -1,0 +1,176 @@
+#!/usr/bin/env bash
+# Runs that outlive their processes (docs/checkpoints.md). In a private
+# network and mount namespace, a scene with a checkpoint cut every 0.5 time
+# units and slow nodes (0.1 s a frame), so that the run lasts seconds:
+#  1. the uninterrupted run: the reference;
+#  2. SIGKILL of a randomly chosen process (sim, each node, the recorder, or
+#     the whole process group) at seeded random times in production, four
+#     times in one run, each followed by the same command, which resumes;
+#  3. SIGKILL of a process while it writes its part of a cut (a pause
+#     between the bytes and the rename, DYNHET_TEST_PART_WRITE_DELAY);
+#  4. SIGTERM of the whole process group at random times, twice: every
+#     process saves its part of one last cut and exits; run_scene.sh exits
+#     75 within a bound; run.h5 says incomplete, interrupted;
+#  5. the newest whole cut corrupted (one byte of a node's part): refused
+#     with the file named, the cut before it used;
+#  6. the disk of the checkpoints fills during the run (a 1 MB tmpfs):
+#     cuts fail, the previous whole one survives, and the run resumes
+#     from it once there is room.
+# Every resumed run's run.h5 must equal the reference in every dataset and
+# attribute but the wall-clock ones (tests/compare_h5.py).
+# Usage: kill_resume.sh ROOT BUILD [SEED]
+set -euo pipefail
+[[ -z ${TRACE:-} ]] || set -x
+root=$1 build=$2 seed=${3:-2026}
+if [[ -z ${DYNHET_IN_MOUNTNS:-} ]]; then exec env DYNHET_IN_MOUNTNS=1 unshare -m bash "$0" "$@"; fi
+if [[ -z ${DYNHET_IN_NETNS:-} ]]; then exec "$root/launch_scripts/netns.sh" bash "$0" "$@"; fi
+export BUILD_DIR=$build
+export LCM_DEFAULT_URL='udpm://239.255.76.67:7699?ttl=0'
+tmp=$(mktemp -d)
+trap 'umount "$tmp/ckdisk" 2>/dev/null || true; [[ -n ${KEEP_TMP:-} ]] && echo "kept $tmp" || rm -rf "$tmp"' EXIT
+py=/usr/bin/python3
+RANDOM=$seed
+fail=0
+check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
+sed 's/^equilibration_time = 5.0/equilibration_time = 5.0\ncheckpoint_interval = 0.5/' "$root/scenes/tiny.toml" >"$tmp/scene.toml"
+grep -q "checkpoint_interval = 0.5" "$tmp/scene.toml"
+run_id=4711
+same() { $py "$root/tests/compare_h5.py" "$tmp/ref/run.h5" "$1/run.h5" >"$1.cmp" 2>&1 || { cat "$1.cmp"; return 1; }; }
+complete() { $py -c "import h5py, sys; sys.exit(0 if int(h5py.File(sys.argv[1], 'r').attrs['complete']) == 1 else 1)" "$1"; }
+
+# Starts the run in DIR in the background, in a process group of its own
+# (pid in $run_pid, the group's id too).
+start_run() {
+  set -m
+  bash "$root/launch_scripts/run_scene.sh" "$tmp/scene.toml" --out "$1" --run-id $run_id --no-build --no-plots \
+    --test-node-delay 0.1 >>"$1.log" 2>&1 &
+  run_pid=$!
+  set +m
+}
+finish_run() { # DIR: the same command until it completes (at most 4 more times)
+  for _ in 1 2 3 4; do
+    bash "$root/launch_scripts/run_scene.sh" "$tmp/scene.toml" --out "$1" --run-id $run_id --no-build --no-plots \
+      --test-node-delay 0.1 >>"$1.log" 2>&1 && return 0
+  done
+  return 1
+}
+pid_of() { # a process of this run: sim_node, overlap_node, s4_node, clusters_node or recorder
+  case $1 in
+  recorder) pgrep -f "bin/recorder --out $2/run.h5" | head -1 || true ;;
+  *) pgrep -f "bin/$1 .*--run-id $run_id" | head -1 || true ;;
+  esac
+}
+
+# 1. The reference.
+bash "$root/launch_scripts/run_scene.sh" "$tmp/scene.toml" --out "$tmp/ref" --run-id $run_id --no-build --no-plots \
+  --test-node-delay 0.1 >"$tmp/ref.log" 2>&1 || { tail -20 "$tmp/ref.log"; exit 1; }
+check 'complete "$tmp/ref/run.h5"' "reference run complete"
+
+# 2. SIGKILL of random processes at random times, four times.
+victims=(sim_node overlap_node s4_node clusters_node recorder all)
+out=$tmp/killed
+for round in 1 2 3 4; do
+  start_run "$out"
+  t=$(( 1000 + RANDOM % 2500 )) # ms: within the production (a resumed segment lasts seconds)
+  v=${victims[RANDOM % ${#victims[@]}]}
+  sleep "$(printf '%d.%03d' $((t / 1000)) $((t % 1000)))"
+  if [[ $v == all ]]; then
+    kill -KILL -- -$run_pid 2>/dev/null || true
+  else
+    p=$(pid_of "$v" "$out")
+    if [[ -n $p ]]; then kill -KILL "$p"; fi
+  fi
+  set +e; wait $run_pid; rc=$?; set -e
+  cut=$(ls -d "$out"/checkpoints/cut-*/WHOLE 2>/dev/null | tail -1 | sed 's/.*cut-0*\([0-9]*\)\/WHOLE/\1/')
+  echo "     round $round: SIGKILL of $v at $t ms: run_scene exit $rc, newest whole cut ${cut:-none}"
+done
+finish_run "$out" || true
+check 'complete "$out/run.h5"' "killed four times: the run completes"
+check 'same "$out"' "killed four times and resumed: run.h5 equals the uninterrupted run's"
+check '[[ $(grep -h "resumed from cut" "$out"/*_node.log "$out"/recorder.log | wc -l) -ge 4 ]]' "the nodes and the recorder resumed from cuts"
+
+# 3. SIGKILL while a part is written.
+out=$tmp/midwrite
+export DYNHET_TEST_PART_WRITE_DELAY=0.3
+start_run "$out"
+victim="" tmpfile=""
+for _ in $(seq 200); do ls "$out"/checkpoints/cut-*/WHOLE >/dev/null 2>&1 && break; sleep 0.05; done
+whole=$(ls -d "$out"/checkpoints/cut-*/WHOLE 2>/dev/null | tail -1)
+for _ in $(seq 200); do
+  tmpfile=$(ls "$out"/checkpoints/cut-*/*.part.tmp 2>/dev/null | tail -1 || true)
+  [[ -n $tmpfile && $(dirname "$tmpfile") > $(dirname "$whole") ]] || tmpfile=""
+  [[ -n $tmpfile ]] && break
+  sleep 0.05
+done
+unset DYNHET_TEST_PART_WRITE_DELAY
+if [[ -n $tmpfile ]]; then
+  victim=$(basename "$tmpfile" .part.tmp)
+  case $victim in sim) proc=sim_node ;; recorder) proc=recorder ;; *) proc=${victim}_node ;; esac
+  p=$(pid_of "$proc" "$out")
+  if [[ -n $p ]]; then kill -KILL "$p"; fi
+fi
+set +e; wait $run_pid; set -e
+check '[[ -n $victim && -n $whole ]]' "a process was killed while writing its part ($tmpfile), after a whole cut"
+finish_run "$out" || true
+check 'complete "$out/run.h5" && same "$out"' "killed mid-write ($victim) and resumed: run.h5 equals the uninterrupted run's"
+
+# 4. SIGTERM of the whole group, twice.
+out=$tmp/term
+for round in 1 2; do
+  start_run "$out"
+  t=$(( 1500 + RANDOM % 3000 ))
+  sleep "$(printf '%d.%03d' $((t / 1000)) $((t % 1000)))"
+  kill -TERM -- -$run_pid 2>/dev/null || true
+  s0=$(date +%s%N)
+  set +e; wait $run_pid; rc=$?; set -e
+  ms=$(( ($(date +%s%N) - s0) / 1000000 ))
+  echo "     SIGTERM at $t ms: exit $rc after $ms ms"
+  if [[ -f $out/run.h5 ]] && ! complete "$out/run.h5"; then
+    check '[[ $rc == 75 ]]' "SIGTERM $round: run_scene.sh exits 75, interrupted and resumable (got $rc)"
+    check '[[ $ms -lt 20000 ]]' "SIGTERM $round: every process has stopped within 20 s ($ms ms)"
+    check '$py -c "import h5py, sys; m = h5py.File(sys.argv[1], \"r\").attrs[\"missing\"]; m = m.decode() if isinstance(m, bytes) else str(m); sys.exit(0 if \"interrupted\" in m else 1)" "$out/run.h5"' \
+      "SIGTERM $round: run.h5 says incomplete and interrupted"
+  fi
+done
+finish_run "$out" || true
+check 'complete "$out/run.h5" && same "$out"' "stopped twice by SIGTERM and resumed: run.h5 equals the uninterrupted run's"
+
+# 5. The newest whole cut corrupted: the one before is used.
+out=$tmp/corrupt
+start_run "$out"
+sleep 3.5
+kill -TERM -- -$run_pid 2>/dev/null || true
+set +e; wait $run_pid; set -e
+cuts=($(ls -d "$out"/checkpoints/cut-*/WHOLE 2>/dev/null | sed 's/\/WHOLE//'))
+if ((${#cuts[@]} >= 2)); then
+  part=${cuts[-1]}/overlap.part
+  size=$(stat -c %s "$part")
+  printf '\xff' | dd of="$part" bs=1 seek=$((size - 9)) conv=notrunc status=none
+  finish_run "$out" || true
+  check 'grep -q "refused: $part: corrupt" "$out.log"' "a corrupted part is refused, its file named"
+  check 'grep -q "resuming run $run_id from checkpoint cut $((10#${cuts[-2]##*cut-}))" "$out.log"' \
+    "the cut before it is used (cut ${cuts[-2]##*cut-})"
+  check 'complete "$out/run.h5" && same "$out"' "resumed from the older cut: run.h5 equals the uninterrupted run's"
+else
+  check false "two whole cuts before the corruption (got ${#cuts[@]})"
+fi
+
+# 6. The checkpoints' disk fills during the run.
+out=$tmp/full
+mkdir -p "$out/checkpoints" "$tmp/ckdisk"
+mount -t tmpfs -o size=4m tmpfs "$tmp/ckdisk"
+rmdir "$out/checkpoints"
+ln -s "$tmp/ckdisk" "$out/checkpoints"
+start_run "$out"
+for _ in $(seq 100); do ls "$out"/checkpoints/cut-*/WHOLE >/dev/null 2>&1 && break; sleep 0.05; done
+sleep 0.5
+head -c 8m /dev/zero >"$tmp/ckdisk/filler" 2>/dev/null || true
+sleep 1.5
+kill -KILL -- -$run_pid 2>/dev/null || true
+set +e; wait $run_pid; set -e
+check 'grep -qh "NOT saved\|not taken" "$out"/*.log' "a cut on the full disk fails and says so"
+rm -f "$tmp/ckdisk/filler"
+finish_run "$out" || true
+check 'complete "$out/run.h5" && same "$out"' "resumed from the cut before the disk filled: run.h5 equals the uninterrupted run's"
+((fail == 0)) || { for f in "$tmp"/*.log; do echo "== $f"; tail -15 "$f"; done; }
+exit $fail
