@@ -275,7 +275,10 @@ elif [[ -n $cuts ]]; then
       if [[ -z ${reaped[$i]:-} ]] && ! kill -0 "${pids[$i]}" 2>/dev/null; then
         wait "${pids[$i]}"; rc=$?
         reaped[$i]=$rc
-        if [[ $rc -ne 0 && -z $stop_signal ]]; then died="${names[$i]} (exit $rc)"; break 2; fi
+        # Killed (by a signal, the OOM killer, ...): the others cannot finish
+        # this run; one that failed by itself has said why, and the rest end
+        # on their own as before.
+        if [[ $rc -gt 128 && -z $stop_signal ]]; then died="${names[$i]} (exit $rc)"; break 2; fi
       fi
     done
     sleep 0.2
@@ -289,7 +292,7 @@ elif [[ -n $cuts ]]; then
     wait "$sim_pid"; sim_rc=$?
     # A signal arrives during wait: wait again for the sim's own exit.
     while kill -0 "$sim_pid" 2>/dev/null; do wait "$sim_pid"; sim_rc=$?; done
-    if [[ $sim_rc -ne 0 && -z $stop_signal ]]; then # killed, or failed: the rest cannot go on
+    if [[ $sim_rc -gt 128 && -z $stop_signal ]]; then # killed: the rest cannot go on
       echo "run_scene: sim_node died (exit $sim_rc): stopping the run" >&2
       kill -KILL "${pids[@]}" 2>/dev/null || true
     fi

@@ -15,6 +15,7 @@ The study file format is in studies/README.md.
 import argparse
 import copy
 import fcntl
+import glob
 import hashlib
 import math
 import os
@@ -543,6 +544,16 @@ def stop_children():
             os.killpg(proc.pid, signal.SIGKILL)
 
 
+RESUMABLE = 75  # run_scene.sh: interrupted, resumable from a whole checkpoint cut
+
+
+def newest_whole_cut(run_dir):
+    """The number of the newest cut of a run directory that is whole (has its
+    WHOLE marker), or None. run_scene.sh checks its parts when it resumes."""
+    cuts = glob.glob(os.path.join(run_dir, "checkpoints", "cut-*", "WHOLE"))
+    return max(int(os.path.basename(os.path.dirname(c))[4:]) for c in cuts) if cuts else None
+
+
 def run_scene(scene_path, out, log_path, resume=None):
     cmd = ["bash", RUN_SCENE, "--no-build", "--out", out]
     cmd += ["--resume", resume] if resume else [scene_path]
@@ -729,7 +740,12 @@ def do_run(sd, p, log=print):
         return dict(old, state="running", message=f"still running in process {old.get('pid')}")
     if old.get("state") in ("running", "queued", "interrupted"):
         ck = os.path.join(d, "checkpoint_before_frames.h5")
-        if os.path.exists(ck) and os.path.exists(os.path.join(d, "scene.toml")):
+        cut = newest_whole_cut(d)
+        if cut is not None and os.path.exists(os.path.join(d, "scene.toml")):
+            # run_scene.sh on the same directory resumes from the cut itself.
+            resume = "cut"
+            log(f"{st.run_name(p)}: was interrupted; resuming mid-production from checkpoint cut {cut}")
+        elif os.path.exists(ck) and os.path.exists(os.path.join(d, "scene.toml")):
             resume = ck
             log(f"{st.run_name(p)}: was interrupted; resuming from {ck}")
         elif old.get("state") != "queued" or old.get("started"):
@@ -774,14 +790,27 @@ def do_run(sd, p, log=print):
     for a in AXES:
         status[a] = p[a]
     write_status(d, status)
-    rc, wall, cpu = run_scene(os.path.join(d, "scene.toml"), d, os.path.join(d, "run_scene.log"), resume)
+    if os.environ.get("SLURM_RESTART_COUNT"):
+        status["requeues"] = int(os.environ["SLURM_RESTART_COUNT"])
+    scene_path = os.path.join(d, "scene.toml")
+    rc, wall, cpu = run_scene(scene_path, d, os.path.join(d, "run_scene.log"), None if resume == "cut" else resume)
+    # A process of the run died (exit 75: resumable): again from the last
+    # whole cut, a few times, before the run counts as failed.
+    for _ in range(3):
+        if rc != RESUMABLE or STOPPING.is_set():
+            break
+        log(f"{st.run_name(p)}: interrupted (a process died); resuming from its last checkpoint cut")
+        rc2, wall2, cpu2 = run_scene(scene_path, d, os.path.join(d, "run_scene.log"))
+        rc, wall, cpu = rc2, wall + wall2, cpu + cpu2
     complete, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc)) if rc == 0 else (0, float("nan"))
     status.update({"exit": rc, "wall_s": wall, "cpu_s": cpu, "finished": time.strftime("%Y-%m-%dT%H:%M:%S"),
                    "tau_alpha": tau})
     status.pop("pid", None)
-    if STOPPING.is_set():
+    if STOPPING.is_set() or rc == RESUMABLE:
         status["state"] = "interrupted"
-        status["message"] = "the study was stopped; run it again to resume"
+        status["message"] = ("the study was stopped; run it again to resume" if STOPPING.is_set() else
+                             f"interrupted; run the study again to resume (log {d}/run_scene.log)")
+        status["resumable"] = newest_whole_cut(d) is not None
         write_status(d, status)
         return status
     if rc != 0 or not complete:
@@ -811,7 +840,7 @@ def write_index(sd):
         row = {a: p[a] for a in AXES}
         row["path"] = os.path.relpath(sd.run_dir(p), sd.dir)
         row["state"] = st.get("state", "pending")
-        for k in ("tau_estimate", "tau_source", "tau_alpha", "wall_s", "cpu_s", "attempts", "message"):
+        for k in ("tau_estimate", "tau_source", "tau_alpha", "wall_s", "cpu_s", "attempts", "requeues", "message"):
             if k in st:
                 row[k] = st[k]
         rows[sd.study.run_name(p)] = row
@@ -1001,17 +1030,42 @@ def run_slurm(sd, a):
             common.append(f"#SBATCH {flag}={val}")
     common += [f"#SBATCH {x}" for x in a.sbatch]
     array = os.path.join(sdir, f"array-{stamp}.sbatch")
+    delay = ([f"    scontrol update JobId=\"$id\" BeginTime=now+{int(a.requeue_delay)}"]
+             if a.requeue_delay is not None else [])
     write_atomic(array, "\n".join([
         "#!/bin/bash",
         f"#SBATCH --job-name=dynhet-{sd.study.name}",
         f"#SBATCH --array=0-{len(todo) - 1}" + (f"%{a.jobs}" if a.jobs else ""),
         f"#SBATCH --output={sdir}/task-%A_%a.out",
+        "#SBATCH --open-mode=append",
         "#SBATCH --cpus-per-task=2",
+        # Before the time limit Slurm sends SIGTERM to this shell: the run
+        # takes a last checkpoint cut and stops (exit 75), and the task goes
+        # back in the queue, to resume from the cut.
+        f"#SBATCH --signal=B:TERM@{int(a.signal_lead)}",
+        "#SBATCH --requeue",
         *common,
         "# One run of the study per array task (launch_scripts/study.py task).",
         f"name=$(sed -n \"$((SLURM_ARRAY_TASK_ID + 1))p\" {listing})",
         f"export BUILD_DIR={BUILD}",
-        f"exec /usr/bin/python3 {me} task {sd.dir} \"$name\"", ""]))
+        f"echo \"$(date '+%F %T') task $name: start (requeued ${{SLURM_RESTART_COUNT:-0}} times)\"",
+        f"/usr/bin/python3 {me} task {sd.dir} \"$name\" &",
+        "child=$!",
+        "trap 'kill -TERM $child 2>/dev/null' TERM",
+        "wait $child; rc=$?",
+        "while kill -0 $child 2>/dev/null; do wait $child; rc=$?; done",
+        f"if [ $rc -eq {RESUMABLE} ]; then",
+        "  id=${SLURM_ARRAY_JOB_ID}_${SLURM_ARRAY_TASK_ID}",
+        f"  if [ ${{SLURM_RESTART_COUNT:-0}} -lt {int(a.max_requeues)} ]; then",
+        "    echo \"$(date '+%F %T') task $name: interrupted and resumable: requeued\"",
+        "    scontrol requeue \"$id\"",
+        *delay,
+        "  else",
+        f"    echo \"$(date '+%F %T') task $name: interrupted, but requeued {int(a.max_requeues)} times already: "
+        "run the study again to resume\"",
+        "  fi",
+        "fi",
+        "exit $rc", ""]))
     after = os.path.join(sdir, f"index-{stamp}.sbatch")
     write_atomic(after, "\n".join([
         "#!/bin/bash", f"#SBATCH --job-name=dynhet-{sd.study.name}-index",
@@ -1047,7 +1101,9 @@ def task(sd, name):
         if sd.study.run_name(p) == name:
             st = do_run(sd, p)
             write_index(sd)
-            print(f"{name}: {st.get('state')} {st.get('message', '')}")
+            print(f"{name}: {st.get('state')} {st.get('message', '')}", flush=True)
+            if st.get("state") == "interrupted" and st.get("resumable"):
+                return RESUMABLE  # the Slurm task requeues itself
             return 0 if st.get("state") == "complete" else 1
     raise StudyError(f"{sd.dir}: no run named {name}")
 
@@ -1070,6 +1126,14 @@ def main():
     r.add_argument("--partition")
     r.add_argument("--time")
     r.add_argument("--mem")
+    r.add_argument("--signal-lead", type=float, default=300,
+                   help="slurm: seconds before the time limit at which a task is told to checkpoint and stop "
+                        "(sbatch --signal; a cut needs the sim to reach its next synchronised time), default 300")
+    r.add_argument("--max-requeues", type=int, default=20,
+                   help="slurm: a task interrupted by its time limit goes back in the queue at most this often")
+    r.add_argument("--requeue-delay", type=float, default=None,
+                   help="slurm: seconds a requeued task waits before it may start again (default: Slurm's own, "
+                        "about two minutes)")
     r.add_argument("--sbatch", action="append", default=[], help="extra sbatch flag, e.g. --sbatch=--qos=long")
     t = sub.add_parser("task")
     t.add_argument("dir")
