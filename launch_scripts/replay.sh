@@ -5,7 +5,11 @@
 # results on a private bus, where the recorder picks them up (run info and
 # status it reads from the log too).
 #
-# Usage: launch_scripts/replay.sh LOG --out DIR [--run-id ID] [--no-build]
+# Usage: launch_scripts/replay.sh LOG [LOG2 ...] --out DIR [--run-id ID] [--no-build]
+#        several logs: the segments of one run interrupted and resumed
+#        (run_scene.sh --record LOG writes LOG, LOG.2, ...), in order; they
+#        are played as one (a frame the next segment publishes again, from
+#        its checkpoint cut, is the same frame and is taken once)
 #        launch_scripts/replay.sh LOG --list    the runs in the log, and how
 #                                               many of each run's frames it holds
 # A log holding several runs needs --run-id. Before it starts, the replay
@@ -16,7 +20,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
-log="" out="" build_first=1 run_id="" list=0
+log="" out="" build_first=1 run_id="" list=0 segments=()
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
@@ -25,9 +29,21 @@ while (($#)); do
   --list) list=1; shift ;;
   -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;;
   -*) echo "replay: unknown option $1" >&2; exit 2 ;;
-  *) log=$1; shift ;;
+  *) segments+=("$1"); shift ;;
   esac
 done
+for s in "${segments[@]}"; do [[ -f $s ]] || { echo "replay: no log file $s" >&2; exit 2; }; done
+if ((${#segments[@]} == 1)); then
+  log=${segments[0]}
+elif ((${#segments[@]} > 1)); then
+  [[ -n $out || $list == 1 ]] || { echo "usage: replay.sh LOG [LOG2 ...] --out DIR [--run-id ID]" >&2; exit 2; }
+  # lcm-logger logs are sequences of events: the segments, one after the
+  # other, are one log (kept as DIR/segments.lcmlog).
+  if ((list)); then joined=$(mktemp --suffix=.lcmlog); else mkdir -p "$out"; joined=$out/segments.lcmlog; fi
+  cat "${segments[@]}" >"$joined"
+  echo "replay: ${#segments[@]} segments, played in order as one log ($joined)" >&2
+  log=$joined
+fi
 [[ -n $log ]] || { echo "usage: replay.sh LOG --out DIR [--run-id ID] | replay.sh LOG --list" >&2; exit 2; }
 [[ -f $log ]] || { echo "replay: no log file $log" >&2; exit 2; }
 runs=$root/launch_scripts/lcmlog_runs.py

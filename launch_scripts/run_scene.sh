@@ -12,6 +12,7 @@
 #                   a DIR that holds an interrupted run of the same scene is
 #                   resumed from its last whole checkpoint cut
 #   --fresh         start over in DIR (its checkpoints and run.h5 go)
+#   --no-checkpoints  no checkpoint cuts (the run cannot be resumed)
 #   --bus private   (default) a private network namespace: no packet leaves
 #                   the machine, nothing else on the host sees the run
 #   --bus host      this host's LCM bus ($LCM_DEFAULT_URL, else
@@ -54,11 +55,12 @@ build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
 scene="" out="" bus=private url="" record="" build_first=1 plots=1 resume="" run_id="" role=all author="" author_email=""
-fresh=0 test_node_delay=""
+fresh=0 no_cuts=0 test_node_delay=${DYNHET_TEST_NODE_DELAY:-} test_sim_delay=${DYNHET_TEST_SIM_DELAY:-}
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
   --fresh) fresh=1; shift ;;
+  --no-checkpoints) no_cuts=1; shift ;;
   --test-node-delay) test_node_delay=$2; shift 2 ;; # tests: seconds of sleep per frame in every node
   --bus) bus=$2; shift 2 ;;
   --url) url=$2; shift 2 ;;
@@ -117,6 +119,7 @@ if [[ ($bus == private || $bus == tcpq) && -z ${DYNHET_IN_NETNS:-} ]]; then
   [[ -z $author ]] || args+=(--author "$author")
   [[ -z $author_email ]] || args+=(--author-email "$author_email")
   ((fresh == 0)) || args+=(--fresh)
+  ((no_cuts == 0)) || args+=(--no-checkpoints)
   [[ -z $test_node_delay ]] || args+=(--test-node-delay "$test_node_delay")
   exec "$root/launch_scripts/netns.sh" "$0" ${scene:+"$scene"} "${args[@]}"
 fi
@@ -124,7 +127,7 @@ fi
 # Checkpoint cuts of the whole pipeline (one host, a scene given): a run
 # interrupted in DIR resumes from its last whole cut.
 cuts="" cut_args=() resume_cut=()
-if [[ $role == all && -z $resume ]]; then
+if [[ $role == all && -z $resume && $no_cuts == 0 ]]; then
   cuts=$out/checkpoints
   if ((fresh)); then
     rm -rf "$cuts"/cut-* "$cuts"/recorder.journal "$out/run.h5" "$out/scene.toml"
@@ -265,8 +268,9 @@ elif [[ -n $cuts ]]; then
   # In the background, watched with the others: a process that dies takes
   # the run down at once (killed: the last whole cut is the restart point).
   if ((${#resume_cut[@]})); then echo "---- resumed from cut ${resume_cut[1]}" >>"$out/sim_node.log"; else : >"$out/sim_node.log"; fi
+  sim_delay=(); [[ -z $test_sim_delay ]] || sim_delay=(--test-frame-delay "$test_sim_delay")
   "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" --pace-nodes --checkpoint "$out/checkpoint.h5" \
-    --checkpoint-before-frames "$out/checkpoint_before_frames.h5" "${cut_args[@]}" "${resume_cut[@]}" \
+    --checkpoint-before-frames "$out/checkpoint_before_frames.h5" "${cut_args[@]}" "${resume_cut[@]}" "${sim_delay[@]}" \
     2> >(trap '' TERM INT; exec tee -a "$out/sim_node.log" >&2) &
   sim_pid=$!
   died=""

@@ -1030,8 +1030,6 @@ def run_slurm(sd, a):
             common.append(f"#SBATCH {flag}={val}")
     common += [f"#SBATCH {x}" for x in a.sbatch]
     array = os.path.join(sdir, f"array-{stamp}.sbatch")
-    delay = ([f"    scontrol update JobId=\"$id\" BeginTime=now+{int(a.requeue_delay)}"]
-             if a.requeue_delay is not None else [])
     write_atomic(array, "\n".join([
         "#!/bin/bash",
         f"#SBATCH --job-name=dynhet-{sd.study.name}",
@@ -1059,7 +1057,6 @@ def run_slurm(sd, a):
         f"  if [ ${{SLURM_RESTART_COUNT:-0}} -lt {int(a.max_requeues)} ]; then",
         "    echo \"$(date '+%F %T') task $name: interrupted and resumable: requeued\"",
         "    scontrol requeue \"$id\"",
-        *delay,
         "  else",
         f"    echo \"$(date '+%F %T') task $name: interrupted, but requeued {int(a.max_requeues)} times already: "
         "run the study again to resume\"",
@@ -1103,7 +1100,7 @@ def task(sd, name):
             write_index(sd)
             print(f"{name}: {st.get('state')} {st.get('message', '')}", flush=True)
             if st.get("state") == "interrupted" and st.get("resumable"):
-                return RESUMABLE  # the Slurm task requeues itself
+                return RESUMABLE  # a Slurm task requeues itself on it
             return 0 if st.get("state") == "complete" else 1
     raise StudyError(f"{sd.dir}: no run named {name}")
 
@@ -1131,9 +1128,7 @@ def main():
                         "(sbatch --signal; a cut needs the sim to reach its next synchronised time), default 300")
     r.add_argument("--max-requeues", type=int, default=20,
                    help="slurm: a task interrupted by its time limit goes back in the queue at most this often")
-    r.add_argument("--requeue-delay", type=float, default=None,
-                   help="slurm: seconds a requeued task waits before it may start again (default: Slurm's own, "
-                        "about two minutes)")
+
     r.add_argument("--sbatch", action="append", default=[], help="extra sbatch flag, e.g. --sbatch=--qos=long")
     t = sub.add_parser("task")
     t.add_argument("dir")

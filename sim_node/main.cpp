@@ -444,7 +444,9 @@ int main(int argc, char** argv) {
   std::string cut_root;
   int resume_cut = -1;
   bool find_cut = false;
-  double cut_wait = 300;
+  double cut_wait = 300, test_frame_delay = 0;
+  app.add_option("--test-frame-delay", test_frame_delay,
+                 "tests only: sleep this many seconds before each frame, a stand-in for a slow engine (large N)");
   app.add_option("--checkpoint-dir", cut_root,
                  "take checkpoint cuts of the whole pipeline in this folder (docs/checkpoints.md): at every "
                  "run.checkpoint_interval (or run.checkpoint_wall_interval), and on SIGTERM/SIGINT before exiting");
@@ -670,9 +672,9 @@ int main(int argc, char** argv) {
       dynhet::engine::State st = eng.state();
       out(next_frame, phase, st, rep);
       const int c = cuts->take(next_frame - 1, eng.time(), out.bytes(), stop);
-      if (g_signal)
-        std::fprintf(stderr, "\nsim_node: checkpoint cut %d after frame %d at t=%.10g (sim part %.1f MB in %.2f s)\n",
-                     c, next_frame - 1, eng.time(), out.bytes().size() / 1e6, seconds_since(t0));
+      std::fprintf(stderr, "%ssim_node: checkpoint: cut %d after frame %d at t=%.10g (sim part %.1f MB in %.2f s)\n",
+                   isatty(STDERR_FILENO) ? "\n" : "", c, next_frame - 1, eng.time(), out.bytes().size() / 1e6,
+                   seconds_since(t0));
       return c;
     };
     auto cut_due = [&] {
@@ -769,6 +771,10 @@ int main(int argc, char** argv) {
     const double sim_t_production = eng.time();
     double wait_seconds = 0, publish_seconds = 0, bytes_published = 0;
     for (int f = next_frame; f < info.n_frames; ++f) {
+      for (double slept = 0; slept < test_frame_delay && !g_signal; slept += 0.01) {
+        std::this_thread::sleep_for(std::chrono::milliseconds(10));
+        if (cuts) cuts->poll();
+      }
       advance(sched.frame_time[f]);
       const auto t_wait = Clock::now();
       pacer.before_frame(f, [&] {

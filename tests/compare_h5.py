@@ -10,7 +10,9 @@ What a run's wall clock decides, and so is compared only where it is not the clo
 - s4 and displacement publish at most once a second before their final message: their last record is
   compared (the final result), the earlier ones are the clock's.
 
-Usage: compare_h5.py A.h5 B.h5 [--verbose]
+Usage: compare_h5.py A.h5 B.h5 [--verbose] [--ignore PATH]...
+  --ignore PATH  leave out a dataset (parameters/scene_toml) or an attribute (parameters/system@initial_state):
+                 runs of two study directories name their own prepared states
 """
 import sys
 
@@ -40,7 +42,7 @@ def same_array(a, b):
     return np.array_equal(a, b)
 
 
-def compare(pa, pb, verbose=False):
+def compare(pa, pb, verbose=False, ignore=()):
     bad = []
     with h5py.File(pa, "r") as fa, h5py.File(pb, "r") as fb:
         ia, ib = items(fa), items(fb)
@@ -49,11 +51,13 @@ def compare(pa, pb, verbose=False):
         for k in sorted(ia.keys() & ib.keys()):
             a, b = ia[k], ib[k]
             for an in sorted(set(a.attrs) | set(b.attrs)):
+                if f"{k}@{an}" in ignore:
+                    continue
                 if an not in a.attrs or an not in b.attrs:
                     bad.append(f"{k} @{an}: only in one")
                 elif not same_array(a.attrs[an], b.attrs[an]):
                     bad.append(f"{k} @{an}: {a.attrs[an]!r} != {b.attrs[an]!r}")
-            if not isinstance(a, h5py.Dataset):
+            if not isinstance(a, h5py.Dataset) or k in ignore:
                 continue
             path = k + "/"
             if any(w in "/" + path for w in WALL):
@@ -79,7 +83,8 @@ def main(argv):
     if len(argv) < 2 or argv[0] in ("-h", "--help"):
         print(__doc__.strip())
         return 0 if argv and argv[0] in ("-h", "--help") else 2
-    bad = compare(argv[0], argv[1], "--verbose" in argv)
+    ignore = [argv[i + 1] for i, x in enumerate(argv[:-1]) if x == "--ignore"]
+    bad = compare(argv[0], argv[1], "--verbose" in argv, ignore)
     for line in bad[:60]:
         print("DIFF", line)
     if len(bad) > 60:

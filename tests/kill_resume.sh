@@ -13,9 +13,12 @@
 #     75 within a bound; run.h5 says incomplete, interrupted;
 #  5. the newest whole cut corrupted (one byte of a node's part): refused
 #     with the file named, the cut before it used;
-#  6. the disk of the checkpoints fills during the run (a 1 MB tmpfs):
+#  6. the disk of the checkpoints fills during the run (a 4 MB tmpfs):
 #     cuts fail, the previous whole one survives, and the run resumes
-#     from it once there is room.
+#     from it once there is room;
+#  7. a run recorded with --record across a SIGTERM: one log per segment,
+#     and replay.sh of the segments in order gives the uninterrupted
+#     run's results.
 # Every resumed run's run.h5 must equal the reference in every dataset and
 # attribute but the wall-clock ones (tests/compare_h5.py).
 # Usage: kill_resume.sh ROOT BUILD [SEED]
@@ -172,5 +175,28 @@ check 'grep -qh "NOT saved\|not taken" "$out"/*.log' "a cut on the full disk fai
 rm -f "$tmp/ckdisk/filler"
 finish_run "$out" || true
 check 'complete "$out/run.h5" && same "$out"' "resumed from the cut before the disk filled: run.h5 equals the uninterrupted run's"
+# 7. Recorded across an interruption: one log per segment; replay.sh plays
+# the segments in order and gives the uninterrupted run's results.
+out=$tmp/recorded
+set -m
+bash "$root/launch_scripts/run_scene.sh" "$tmp/scene.toml" --out "$out" --run-id $run_id --no-build --no-plots \
+  --test-node-delay 0.1 --record "$tmp/seg.lcmlog" >>"$out.log" 2>&1 &
+run_pid=$!
+set +m
+sleep 3
+kill -TERM -- -$run_pid 2>/dev/null || true
+set +e; wait $run_pid; set -e
+bash "$root/launch_scripts/run_scene.sh" "$tmp/scene.toml" --out "$out" --run-id $run_id --no-build --no-plots \
+  --test-node-delay 0.1 --record "$tmp/seg.lcmlog" >>"$out.log" 2>&1 || true
+check '[[ -s $tmp/seg.lcmlog && -s $tmp/seg.lcmlog.2 ]]' "each segment has its log (seg.lcmlog, seg.lcmlog.2)"
+bash "$root/launch_scripts/replay.sh" "$tmp/seg.lcmlog" "$tmp/seg.lcmlog.2" --out "$tmp/replayed" --no-build \
+  >"$tmp/replayed.log" 2>&1 || true
+check 'PYTHONPATH="$root/tests" $py -c "
+import sys
+from compare_runs import final_results, same
+(a, la), (b, lb) = final_results(sys.argv[1]), final_results(sys.argv[2])
+sys.exit(0 if same(a, b) and la == lb == 0 else 1)" "$tmp/ref/run.h5" "$tmp/replayed/run.h5"' \
+  "the two segments replayed in order give the uninterrupted run's results bit for bit"
+
 ((fail == 0)) || { for f in "$tmp"/*.log; do echo "== $f"; tail -15 "$f"; done; }
 exit $fail

@@ -41,6 +41,12 @@ add_test(NAME study_slurm_tiny
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/slurm_study.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(study_slurm_tiny PROPERTIES LABELS process TIMEOUT 600)
 
+# A run longer than its Slurm time limit completes through requeues
+# (tests/slurm_requeue.sh) and equals the local executor's run.
+add_test(NAME study_slurm_requeue
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/slurm_requeue.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(study_slurm_requeue PROPERTIES LABELS process TIMEOUT 900)
+
 # Prepared states (sim_node --prepare-only, system.initial_state): runs from
 # one equal the runs that compress themselves, bit for bit; bad states refused.
 add_test(NAME prepared_state_bit_for_bit

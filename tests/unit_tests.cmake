@@ -5,6 +5,10 @@ foreach(name test_collision test_engine test_scene test_schedule test_chunking t
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 30 PROPERTIES LABELS unit)
 endforeach()
 target_compile_definitions(test_scene PRIVATE DYNHET_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
+# Checkpoint parts and cuts (state_archive, cut): round trips, refusals.
+add_executable(test_state_archive ${CMAKE_CURRENT_SOURCE_DIR}/test_state_archive.cpp)
+target_link_libraries(test_state_archive PRIVATE dynhet_analysis dynhet_common GTest::gtest_main)
+gtest_discover_tests(test_state_archive DISCOVERY_TIMEOUT 30 PROPERTIES LABELS unit)
 # The bounded queue between a node's receive thread and its compute thread.
 add_executable(test_inbox ${CMAKE_CURRENT_SOURCE_DIR}/test_inbox.cpp)
 target_link_libraries(test_inbox PRIVATE dynhet_node dynhet_common GTest::gtest_main)
