@@ -199,7 +199,7 @@ void FrameNode::on_chunk(const frame_chunk_t& mm) {
   const ChunkHeader h{m->frame_index, m->time,           m->n_particles, m->chunk_index,
                       m->chunk_count, m->first_particle, m->count};
   // A cut after an earlier frame is taken before any later chunk counts.
-  if (!pending_cuts_.empty() && m->frame_index > pending_cuts_.begin()->second.frame) {
+  if (!pending_cuts_.empty() && m->frame_index > first_pending_frame()) {
     try_cut(m->frame_index);
     if (finished_) return;
   }
@@ -221,12 +221,10 @@ void FrameNode::on_sim_status(const sim_status_t& mm) {
   if (!info_ || m->run_id != info_->run_id || finished_) return;
   last_sim_news_ = Clock::now();
   sim_interrupted_ = m->phase == "interrupted"; // checkpointed: wait for --resume
-  if (sim_interrupted_ && checkpointing()) {
-    // The pipeline resumes as a whole from its last whole cut.
-    return stop_resumable("the sim stopped resumably" +
-                          (saved_cut_ >= 0 ? "; this node's last saved cut is " + std::to_string(saved_cut_)
-                                           : std::string("; this node saved no cut")));
-  }
+  // The pipeline resumes as a whole from its last whole cut: a node that
+  // has had the signal too stops now; else once the sim is silent (anyone
+  // can say "interrupted": a live sim goes on talking).
+  if (sim_interrupted_ && checkpointing() && signal_) return stop_resumable(sim_stopped_why());
   // Chunks of a frame the sim has sent stopped coming: the rest are lost
   // (the sim, pacing on this node, would otherwise wait for it).
   if (m->frames_published > 0 && std::chrono::duration<double>(Clock::now() - last_chunk_).count() > kChunkGrace) {
@@ -286,6 +284,58 @@ void FrameNode::on_frame(const Frame& f) {
   // (flow control, sim_node --pace-nodes).
   publish_status();
   try_cut();
+}
+
+void FrameNode::publish_status() {
+  status_.utime = utime_now();
+  status_.frames_whole = assembler_.frames_whole();
+  status_.frames_lost = assembler_.frames_lost();
+  status_.chunks_received = assembler_.chunks_received();
+  status_.pairs_done = pairs_done_;
+  status_.origins_held = static_cast<int32_t>(origins_.size());
+  out_.publish(node_status_channel(name_), &status_);
+  last_status_ = Clock::now();
+}
+
+std::string FrameNode::sim_stopped_why() const {
+  return "the sim stopped resumably" + (saved_frame_ >= -1 ? "; this node's last part is after frame " +
+                                                                 std::to_string(saved_frame_)
+                                                           : std::string("; this node saved no part"));
+}
+
+void FrameNode::tick() {
+  watch_inbox();
+  if (sim_interrupted_ && checkpointing() && !finished_ &&
+      std::chrono::duration<double>(Clock::now() - last_sim_news_).count() > kDoneGrace)
+    stop_resumable(sim_stopped_why());
+  if (signal_ && !finished_ && std::chrono::duration<double>(Clock::now() - signalled_at_).count() > kSignalWait)
+    stop_resumable("signal " + std::to_string(signal_) + ", and no last cut from the sim within " +
+                   std::to_string(static_cast<int>(kSignalWait)) + " s");
+  if (info_) maybe_done();
+  if (finished_) return;
+  if (std::chrono::duration<double>(Clock::now() - last_status_).count() >= 1.0) publish_status();
+}
+
+void FrameNode::finish(int code, const std::string& why) {
+  if (info_) assembler_.finish(info_->n_frames);
+  if (info_ && started_) publish_results(true);
+  status_.state = code == 0 ? "done" : "failed";
+  // Frames lost in a run that ended: the cause this node knows, in its
+  // last status (run.h5 keeps it) and its log.
+  const std::string cause = code == 0 && assembler_.frames_lost() > 0 ? loss_cause() : "";
+  status_.message = cause.empty() ? why : std::to_string(assembler_.frames_lost()) + " frames lost: " + cause;
+  publish_status();
+  std::fprintf(stderr, "%s_node: %s: %d frames whole, %d lost%s%s\n", name_.c_str(), status_.state.c_str(),
+               assembler_.frames_whole(), assembler_.frames_lost(), why.empty() ? "" : "; ", why.c_str());
+  if (!cause.empty()) std::fprintf(stderr, "%s_node: frames lost: %s\n", name_.c_str(), cause.c_str());
+  if (inbox_) {
+    const Inbox::Stats s = inbox_->stats();
+    std::fprintf(stderr, "%s_node: queue (receive thread -> computation): peak %.2f MiB of %lld MiB, %lld messages "
+                 "dropped; the longest message took %.3f s\n", name_.c_str(), double(s.peak_bytes) / (1 << 20),
+                 static_cast<long long>(s.bound >> 20), static_cast<long long>(s.dropped), longest_handler_);
+  }
+  finished_ = true;
+  exit_code_ = code;
 }
 
 namespace {

@@ -167,10 +167,16 @@ private:
   // `frame` folded in and nothing later (next_chunk_frame: the frame of a
   // chunk about to be added, -1 none).
   void try_cut(int next_chunk_frame = -1);
-  void save_cut(const checkpoint_t& c);
-  void answer_cut(int cut, const std::string& state, int64_t bytes, double seconds, const std::string& message);
+  struct Boundary { // the cuts asked for at one frame boundary
+    std::vector<int> cuts;
+    bool stop = false; // one of them is the sim's last before it stops
+  };
+  void save_cut(int frame, const Boundary& b);
+  void answer_cut(int cut, int frame, const std::string& state, int64_t bytes, double seconds,
+                  const std::string& message);
   void load_cut();
   void stop_resumable(const std::string& why);
+  std::string sim_stopped_why() const;
   template <class Ar> void base_state(Ar& ar) {
     ar(origins_, last_frame_, last_time_, pairs_done_, assembler_, status_.messages_rejected, status_.chunks_rejected,
        status_.last_rejection);
@@ -178,8 +184,9 @@ private:
   std::string cut_dir_;
   int resume_cut_ = -1, signal_ = 0;
   Clock::time_point signalled_at_;
-  std::map<int, checkpoint_t> pending_cuts_; // asked for, not yet saved: cut -> request
-  int saved_cut_ = -1;                      // the last cut saved
+  std::map<int, Boundary> pending_cuts_; // asked for, not yet saved: frame -> cuts
+  int saved_frame_ = -2;                  // the boundary of the last part saved (-2: none)
+  int first_pending_frame() const;           // the earliest frame a pending cut is after (INT32_MAX: none)
   int64_t saved_bytes_ = 0;
   double saved_seconds_ = 0;
 

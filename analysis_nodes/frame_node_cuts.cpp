@@ -3,6 +3,8 @@
 // is folded in (or at the first chunk of a later frame, k being lost) and
 // answers on DYNHET_CHECKPOINT_<node>; a request it is already past is
 // answered "failed". A resumed node loads its part after start().
+#include <algorithm>
+#include <climits>
 #include <cstdio>
 #include <filesystem>
 
@@ -18,67 +20,77 @@ void FrameNode::on_checkpoint(const checkpoint_t& m) {
     return reject(kChanCheckpoint, "checkpoint: " + bad);
   if (m.process == "sim" && m.state == "whole") return; // news of a cut: nothing to do here
   if (m.process != "sim" || m.state != "save") return reject(kChanCheckpoint, "checkpoint: not a request of the sim");
-  if (m.cut == saved_cut_) return answer_cut(saved_cut_, "saved", saved_bytes_, saved_seconds_, ""); // asked again
-  if (m.cut < saved_cut_ || pending_cuts_.count(m.cut)) return;
-  if (pending_cuts_.size() >= 64) pending_cuts_.erase(pending_cuts_.begin()); // a flood: the oldest go
-  pending_cuts_[m.cut] = m;
+  // Requests are untrusted. The node's state at a frame boundary is one
+  // part, whichever cut asks for it: requests for a boundary already saved
+  // are answered from it, and a flood of requests for one boundary costs
+  // one part. The 64 nearest boundaries are kept (a flood of far ones goes).
+  if (m.frame == saved_frame_) return answer_cut(m.cut, m.frame, "saved", saved_bytes_, saved_seconds_, "");
+  Boundary& b = pending_cuts_[m.frame];
+  if (std::find(b.cuts.begin(), b.cuts.end(), m.cut) == b.cuts.end() && b.cuts.size() < 16) b.cuts.push_back(m.cut);
+  b.stop = b.stop || m.message == "stop";
+  if (pending_cuts_.size() > 64) pending_cuts_.erase(std::prev(pending_cuts_.end()));
   try_cut();
 }
 
-// The cuts asked for, in order: each is saved when this node stands at its
-// boundary, and refused when it is past it.
+// Each boundary asked for is saved when this node stands at it, and refused
+// when it is past it.
 void FrameNode::try_cut(int next_chunk_frame) {
   while (!pending_cuts_.empty() && !finished_) {
-    const checkpoint_t c = pending_cuts_.begin()->second;
-    if (last_frame_ > c.frame) {
-      // Past the boundary already (a request that came late): this cut
-      // cannot have this node's part, so it will not be whole.
+    const int frame = pending_cuts_.begin()->first;
+    const Boundary b = pending_cuts_.begin()->second;
+    if (last_frame_ > frame) {
+      // Past the boundary already (a request that came late): these cuts
+      // cannot have this node's part, so they will not be whole.
       pending_cuts_.erase(pending_cuts_.begin());
-      answer_cut(c.cut, "failed", 0, 0, "frame " + std::to_string(last_frame_) +
-                                           " already folded in, past the cut's " + std::to_string(c.frame));
+      for (int cut : b.cuts)
+        answer_cut(cut, frame, "failed", 0, 0, "frame " + std::to_string(last_frame_) +
+                                                  " already folded in, past the cut's " + std::to_string(frame));
       continue;
     }
-    if (!(last_frame_ == c.frame || next_chunk_frame > c.frame)) return;
+    if (!(last_frame_ == frame || next_chunk_frame > frame)) return;
     pending_cuts_.erase(pending_cuts_.begin());
-    save_cut(c);
+    save_cut(frame, b);
   }
 }
 
-void FrameNode::save_cut(const checkpoint_t& c) {
+int FrameNode::first_pending_frame() const { return pending_cuts_.empty() ? INT32_MAX : pending_cuts_.begin()->first; }
+
+void FrameNode::save_cut(int frame, const Boundary& b) {
   const auto t0 = Clock::now();
   try {
-    assembler_.give_up_before(c.frame + 1); // frames up to the cut are settled
+    assembler_.give_up_before(frame + 1); // frames up to the boundary are settled
     StateOut out;
     base_state(out);
     save_state(out);
-    std::filesystem::create_directories(cut_dir(cut_dir_, c.cut));
+    const std::string path = part_path(cut_dir_, b.cuts.front(), name_, frame);
+    std::filesystem::create_directories(std::filesystem::path(path).parent_path());
     PartHeader h;
-    h.process = name_, h.run_id = info_->run_id, h.cut = c.cut, h.frame = c.frame;
+    h.process = name_, h.run_id = info_->run_id, h.cut = b.cuts.front(), h.frame = frame;
     h.scene_hash = scene_hash(info_->scene_toml);
-    write_part(part_path(cut_dir_, c.cut, name_), h, out.bytes());
-    saved_cut_ = c.cut;
+    write_part(path, h, out.bytes());
+    saved_frame_ = frame;
     saved_bytes_ = static_cast<int64_t>(out.bytes().size());
     saved_seconds_ = std::chrono::duration<double>(Clock::now() - t0).count();
     std::fprintf(stderr, "%s_node: checkpoint: cut %d after frame %d saved (%.1f MB in %.2f s)\n", name_.c_str(),
-                 c.cut, c.frame, saved_bytes_ / 1e6, saved_seconds_);
-    answer_cut(c.cut, "saved", saved_bytes_, saved_seconds_, "");
+                 b.cuts.front(), frame, saved_bytes_ / 1e6, saved_seconds_);
+    for (int cut : b.cuts) answer_cut(cut, frame, "saved", saved_bytes_, saved_seconds_, "");
   } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s_node: checkpoint: cut %d NOT saved: %s\n", name_.c_str(), c.cut, e.what());
-    answer_cut(c.cut, "failed", 0, 0, e.what());
+    std::fprintf(stderr, "%s_node: checkpoint: cut %d NOT saved: %s\n", name_.c_str(), b.cuts.front(), e.what());
+    for (int cut : b.cuts) answer_cut(cut, frame, "failed", 0, 0, e.what());
     if (!signal_) return;
   }
   // After a signal: stop with the sim's last cut (its request says "stop").
-  if (signal_ && c.message == "stop")
-    stop_resumable("signal " + std::to_string(signal_) + ": stopped after cut " + std::to_string(c.cut));
+  if (signal_ && b.stop)
+    stop_resumable("signal " + std::to_string(signal_) + ": stopped after cut " + std::to_string(b.cuts.back()));
 }
 
-void FrameNode::answer_cut(int cut, const std::string& state, int64_t bytes, double seconds,
+void FrameNode::answer_cut(int cut, int frame, const std::string& state, int64_t bytes, double seconds,
                            const std::string& message) {
   checkpoint_t a{};
   a.utime = utime_now();
   a.run_id = info_->run_id;
   a.cut = cut;
-  a.frame = last_frame_;
+  a.frame = frame;
   a.sim_time = last_time_;
   a.process = name_;
   a.state = state;
@@ -89,8 +101,11 @@ void FrameNode::answer_cut(int cut, const std::string& state, int64_t bytes, dou
 }
 
 void FrameNode::load_cut() {
-  const std::string path = part_path(cut_dir_, resume_cut_, name_);
+  std::string path = cut_dir(cut_dir_, resume_cut_) + "/WHOLE";
   try {
+    const std::optional<CutInfo> whole = read_cut_marker(cut_dir_, resume_cut_);
+    if (!whole) throw BadPart(path + ": missing or unreadable: cut " + std::to_string(resume_cut_) + " is not whole");
+    path = part_path(cut_dir_, resume_cut_, name_, whole->frame);
     PartHeader h;
     const std::vector<uint8_t> bytes =
         read_part(path, name_, info_->run_id, scene_hash(info_->scene_toml), &h);
@@ -98,7 +113,7 @@ void FrameNode::load_cut() {
     base_state(in);
     load_state(in);
     if (!in.at_end()) throw BadPart(path + ": " + std::to_string(bytes.size() - in.offset()) + " bytes left over");
-    saved_cut_ = resume_cut_;
+    saved_frame_ = h.frame;
     std::fprintf(stderr, "%s_node: resumed from cut %d after frame %d (t = %.10g): %d frames whole, %d lost, %d "
                  "pairs done, %zu origins held\n", name_.c_str(), h.cut, h.frame, last_time_,
                  assembler_.frames_whole(), assembler_.frames_lost(), pairs_done_, origins_.size());
@@ -117,49 +132,6 @@ void FrameNode::stop_resumable(const std::string& why) {
   std::fprintf(stderr, "%s_node: interrupted, resumable: %s\n", name_.c_str(), why.c_str());
   finished_ = true;
   exit_code_ = kInterrupted;
-}
-
-void FrameNode::publish_status() {
-  status_.utime = utime_now();
-  status_.frames_whole = assembler_.frames_whole();
-  status_.frames_lost = assembler_.frames_lost();
-  status_.chunks_received = assembler_.chunks_received();
-  status_.pairs_done = pairs_done_;
-  status_.origins_held = static_cast<int32_t>(origins_.size());
-  out_.publish(node_status_channel(name_), &status_);
-  last_status_ = Clock::now();
-}
-
-void FrameNode::tick() {
-  watch_inbox();
-  if (signal_ && !finished_ && std::chrono::duration<double>(Clock::now() - signalled_at_).count() > kSignalWait)
-    stop_resumable("signal " + std::to_string(signal_) + ", and no last cut from the sim within " +
-                   std::to_string(static_cast<int>(kSignalWait)) + " s");
-  if (info_) maybe_done();
-  if (finished_) return;
-  if (std::chrono::duration<double>(Clock::now() - last_status_).count() >= 1.0) publish_status();
-}
-
-void FrameNode::finish(int code, const std::string& why) {
-  if (info_) assembler_.finish(info_->n_frames);
-  if (info_ && started_) publish_results(true);
-  status_.state = code == 0 ? "done" : "failed";
-  // Frames lost in a run that ended: the cause this node knows, in its
-  // last status (run.h5 keeps it) and its log.
-  const std::string cause = code == 0 && assembler_.frames_lost() > 0 ? loss_cause() : "";
-  status_.message = cause.empty() ? why : std::to_string(assembler_.frames_lost()) + " frames lost: " + cause;
-  publish_status();
-  std::fprintf(stderr, "%s_node: %s: %d frames whole, %d lost%s%s\n", name_.c_str(), status_.state.c_str(),
-               assembler_.frames_whole(), assembler_.frames_lost(), why.empty() ? "" : "; ", why.c_str());
-  if (!cause.empty()) std::fprintf(stderr, "%s_node: frames lost: %s\n", name_.c_str(), cause.c_str());
-  if (inbox_) {
-    const Inbox::Stats s = inbox_->stats();
-    std::fprintf(stderr, "%s_node: queue (receive thread -> computation): peak %.2f MiB of %lld MiB, %lld messages "
-                 "dropped; the longest message took %.3f s\n", name_.c_str(), double(s.peak_bytes) / (1 << 20),
-                 static_cast<long long>(s.bound >> 20), static_cast<long long>(s.dropped), longest_handler_);
-  }
-  finished_ = true;
-  exit_code_ = code;
 }
 
 } // namespace dynhet

@@ -19,8 +19,9 @@ std::string cut_dir(const std::string& root, int cut) {
   return root + "/" + name;
 }
 
-std::string part_path(const std::string& root, int cut, const std::string& process) {
-  return cut_dir(root, cut) + "/" + process + ".part";
+std::string part_path(const std::string& root, int cut, const std::string& process, int frame) {
+  if (process == "sim") return cut_dir(root, cut) + "/sim.part";
+  return root + "/frames/" + process + "-" + std::to_string(frame + 1) + ".part";
 }
 
 std::vector<int> list_cuts(const std::string& root) {
@@ -37,7 +38,8 @@ std::vector<int> list_cuts(const std::string& root) {
   return cuts;
 }
 
-void mark_cut_whole(const std::string& root, const CutInfo& c, uint64_t scene) {
+std::vector<std::string> mark_cut_whole(const std::string& root, const CutInfo& c, uint64_t scene) {
+  std::vector<std::string> bad;
   std::ostringstream text;
   text << "dynhet cut\ncut " << c.cut << "\nframe " << c.frame << "\nrun_id " << c.run_id << "\n";
   char t[64];
@@ -45,15 +47,21 @@ void mark_cut_whole(const std::string& root, const CutInfo& c, uint64_t scene) {
   text << "sim_time " << t << "\nbuild " << build_id() << "\n";
   for (const std::string& p : c.parts) {
     PartHeader h;
-    read_part(part_path(root, c.cut, p), p, c.run_id, scene, &h); // throws BadPart
-    if (h.cut != c.cut || h.frame != c.frame)
-      throw BadPart(part_path(root, c.cut, p) + ": saved for cut " + std::to_string(h.cut) + " after frame " +
-                    std::to_string(h.frame) + ", not cut " + std::to_string(c.cut) + " after frame " +
-                    std::to_string(c.frame));
-    text << "part " << p << " " << h.crc << "\n";
+    try {
+      const std::string path = part_path(root, c.cut, p, c.frame);
+      read_part(path, p, c.run_id, scene, &h);
+      if (h.frame != c.frame || (p == "sim" && h.cut != c.cut))
+        throw BadPart(path + ": saved for cut " + std::to_string(h.cut) + " after frame " + std::to_string(h.frame) +
+                      ", not cut " + std::to_string(c.cut) + " after frame " + std::to_string(c.frame));
+      text << "part " << p << " " << h.crc << "\n";
+    } catch (const BadPart& e) {
+      bad.push_back(p + ": " + e.what());
+    }
   }
+  if (!bad.empty()) return bad;
   const std::string s = text.str();
   write_file_atomic(cut_dir(root, c.cut) + "/WHOLE", std::vector<uint8_t>(s.begin(), s.end()));
+  return bad;
 }
 
 std::optional<CutInfo> read_cut_marker(const std::string& root, int cut) {
@@ -87,8 +95,10 @@ std::optional<CutInfo> latest_whole_cut(const std::string& root, uint64_t scene,
     try {
       for (const std::string& p : c->parts) {
         PartHeader h;
-        read_part(part_path(root, c->cut, p), p, c->run_id, scene, &h);
-        if (h.frame != c->frame) throw BadPart(part_path(root, c->cut, p) + ": saved after another frame");
+        const std::string path = part_path(root, c->cut, p, c->frame);
+        read_part(path, p, c->run_id, scene, &h);
+        if (h.frame != c->frame || (p == "sim" && h.cut != c->cut))
+          throw BadPart(path + ": saved for another cut or frame");
       }
       return c;
     } catch (const BadPart& e) {
@@ -98,11 +108,17 @@ std::optional<CutInfo> latest_whole_cut(const std::string& root, uint64_t scene,
   return std::nullopt;
 }
 
-void prune_cuts(const std::string& root, int keep_from) {
-  for (int c : list_cuts(root)) {
-    if (c >= keep_from) continue;
-    std::error_code ec;
-    std::filesystem::remove_all(cut_dir(root, c), ec);
+void prune_cuts(const std::string& root, int keep_from, int keep_frame) {
+  std::error_code ec;
+  for (int c : list_cuts(root))
+    if (c < keep_from) std::filesystem::remove_all(cut_dir(root, c), ec);
+  for (const auto& e : std::filesystem::directory_iterator(root + "/frames", ec)) {
+    const std::string name = e.path().filename().string();
+    const auto dash = name.rfind('-');
+    int f = -1;
+    if (dash == std::string::npos || std::sscanf(name.c_str() + dash + 1, "%d.part", &f) != 1) continue;
+    std::error_code ec2;
+    if (f < keep_frame + 1) std::filesystem::remove(e.path(), ec2); // before the fallback cut's boundary
   }
 }
 

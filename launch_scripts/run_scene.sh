@@ -33,7 +33,8 @@
 #                   the same --run-id (README, "Several hosts")
 #   --url URL       LCM URL (default udpm://239.255.76.67:7667?ttl=0, and
 #                   ttl=1 with --bus lan)
-#   --record LOG    also record everything with lcm-logger into LOG
+#   --record LOG    also record everything with lcm-logger into LOG (a
+#                   resumed run records its segment into LOG.2, LOG.3, ...)
 #   --no-build      skip setup.sh (packages and build)
 #   --no-plots      write run.h5 only, no PNGs (plot later with
 #                   launch_scripts/plot_<observable>.py RUN.h5 OUT.png)
@@ -234,6 +235,13 @@ if [[ $role == sim ]]; then # the sim alone; the analysis host records and plots
   exit $?
 fi
 if [[ -n $record ]]; then
+  if ((${#resume_cut[@]})) && [[ -e $record ]]; then
+    # A resumed run records a new segment beside the earlier ones:
+    # replay.sh LOG LOG.2 LOG.3 ... plays them in order as one run.
+    n=2; while [[ -e $record.$n ]]; do n=$((n + 1)); done
+    record=$record.$n
+    echo "run_scene: recording this segment into $record (replay.sh takes the segments in order)" >&2
+  fi
   rm -f "$record"
   # Ahead of the other processes where allowed (root): a starved lcm-logger
   # drops what overflows its 30-message subscription queue.

@@ -241,7 +241,7 @@ void Session::take_run(const dynhet::run_info_t &m) {
 void Session::take_sim(const dynhet::sim_status_t &m) {
   if (!rec_.has_run() && m.phase == "failed") early_failure_ = m.message;
   if (!rec_.on_sim_status(m)) return;
-  if (m.phase == "interrupted" && !replaying_) sim_interrupted_ = true;
+  if (!replaying_) sim_interrupted_ = m.phase == "interrupted";
   last_sim_ = Clock::now();
   if (rec_.completion().sim_ended()) last_progress_ = Clock::now();
 }
@@ -297,10 +297,10 @@ bool Session::start_cuts() {
     replaying_ = false;
     if (!fatal_.empty()) return false;
     if (!rec_.has_run() || rec_.run_id() != r.run_id)
-      throw dynhet::BadPart(dynhet::part_path(cuts_->dir(), opt_.resume_cut, "recorder") +
+      throw dynhet::BadPart(r.part +
                             ": its journal holds no run info of run " + std::to_string(r.run_id));
     if (dynhet::scene_hash(rec_.run_info()->scene_toml) != r.scene_hash)
-      throw dynhet::BadPart(dynhet::part_path(cuts_->dir(), opt_.resume_cut, "recorder") + ": of another scene");
+      throw dynhet::BadPart(r.part + ": of another scene");
     std::fprintf(stderr, "recorder: resumed from cut %d after frame %d: %llu bytes of journal replayed into %s\n",
                  opt_.resume_cut, r.frame, static_cast<unsigned long long>(r.journal_bytes), opt_.out.c_str());
     return true;
@@ -371,7 +371,9 @@ int Session::step() {
     return -1;
   }
   if (g_signal) return finish("interrupted by signal " + std::to_string(g_signal.load()));
-  if (cuts_ && sim_interrupted_) return finish("interrupted: the sim stopped; " + resumable());
+  // Anyone can say "interrupted": a live sim goes on talking; a stopped one is silent.
+  if (cuts_ && sim_interrupted_ && since(last_sim_) > 10)
+    return finish("interrupted: the sim stopped; " + resumable());
   if (!rec_.has_run()) {
     if (!early_failure_.empty() || log_done_ || since(start_) > opt_.wait_run) {
       std::fprintf(stderr, "recorder: no run info %s; no file written\n",

@@ -1,5 +1,6 @@
 #include "recorder_cuts.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -25,29 +26,52 @@ std::string RecorderCuts::on_message(const checkpoint_t& m, const std::string& c
     if (channel != kChanCheckpoint) return "a request of the sim on another channel";
     if (m.state == "whole") return "";
     if (m.state != "save") return "the sim's state \"" + m.state + "\"";
-    if (m.cut == saved_cut_) {
-      answer(m.cut, "saved", saved_bytes_, 0, ""); // asked again
+    if (auto s = saved_.find(m.frame); s != saved_.end()) {
+      answer(m.cut, m.frame, "saved", s->second, 0, ""); // this boundary is saved: whichever cut asks
       return "";
     }
-    if (m.cut < saved_cut_) return "";
-    pending_[m.cut].frame = m.frame;
-    pending_[m.cut].stop = m.message == "stop";
+    Boundary& b = entry(m.frame);
+    b.requested = true;
+    if (std::find(b.cuts.begin(), b.cuts.end(), m.cut) == b.cuts.end() && b.cuts.size() < 16) b.cuts.push_back(m.cut);
+    b.stop = b.stop || m.message == "stop";
   } else {
     if (channel != checkpoint_answer_channel(m.process)) return "not this process's channel";
-    if (!nodes_.count(m.process) || m.state != "saved" || m.cut <= saved_cut_) return "";
-    pending_[m.cut].saved.insert(m.process);
+    if (!nodes_.count(m.process) || m.state != "saved" || saved_.count(m.frame)) return "";
+    entry(m.frame).saved.insert(m.process);
   }
-  while (pending_.size() > 64) pending_.erase(pending_.begin()); // a flood: the oldest go
   return "";
+}
+
+// Requests and answers are untrusted: one entry per frame boundary, and a
+// flood of them keeps the 64 nearest boundaries.
+RecorderCuts::Boundary& RecorderCuts::entry(int frame) {
+  pending_[frame];
+  if (pending_.size() > 64) pending_.erase(std::prev(pending_.end()));
+  return pending_[frame];
+}
+
+// Every node's part of the boundary is on disk: an answer alone could be
+// anyone's.
+bool RecorderCuts::parts_on_disk(int cut, int frame) const {
+  for (const std::string& n : nodes_) {
+    try {
+      const PartHeader h = read_part_header(part_path(dir_, cut, n, frame));
+      if (h.process != n || h.frame != frame || h.run_id != run_id_) return false;
+    } catch (const std::exception&) {
+      return false;
+    }
+  }
+  return true;
 }
 
 std::vector<int> RecorderCuts::save_ready() {
   std::vector<int> saved;
   for (auto it = pending_.begin(); it != pending_.end();) {
-    const int cut = it->first;
-    const Pending& p = it->second;
-    bool ready = p.frame >= -1;
-    for (const std::string& n : nodes_) ready = ready && p.saved.count(n);
+    const int frame = it->first;
+    const Boundary& b = it->second;
+    bool ready = b.requested;
+    for (const std::string& n : nodes_) ready = ready && b.saved.count(n);
+    ready = ready && parts_on_disk(b.cuts.front(), frame);
     if (!ready) {
       ++it;
       continue;
@@ -59,33 +83,35 @@ std::vector<int> RecorderCuts::save_ready() {
       uint64_t length = journal_.length();
       uint32_t crc = journal_.crc();
       out(length, crc);
-      std::filesystem::create_directories(cut_dir(dir_, cut));
+      const std::string path = part_path(dir_, b.cuts.front(), kRecorderNode, frame);
+      std::filesystem::create_directories(std::filesystem::path(path).parent_path());
       PartHeader h;
-      h.process = kRecorderNode, h.run_id = run_id_, h.cut = cut, h.frame = p.frame, h.scene_hash = scene_hash_;
-      write_part(part_path(dir_, cut, kRecorderNode), h, out.bytes());
-      saved_cut_ = cut, saved_frame_ = p.frame;
-      stop_saved_ = stop_saved_ || p.stop;
-      saved_bytes_ = static_cast<int64_t>(length);
+      h.process = kRecorderNode, h.run_id = run_id_, h.cut = b.cuts.front(), h.frame = frame;
+      h.scene_hash = scene_hash_;
+      write_part(path, h, out.bytes());
+      saved_[frame] = static_cast<int64_t>(length);
+      if (saved_.size() > 64) saved_.erase(saved_.begin());
+      saved_cut_ = std::max(saved_cut_, b.cuts.back());
+      stop_saved_ = stop_saved_ || b.stop;
       const double s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-      answer(cut, "saved", saved_bytes_, s, "");
-      saved.push_back(cut);
+      for (int cut : b.cuts) answer(cut, frame, "saved", static_cast<int64_t>(length), s, "");
+      saved.push_back(b.cuts.front());
     } catch (const std::exception& e) {
-      std::fprintf(stderr, "recorder: checkpoint: cut %d NOT saved: %s\n", cut, e.what());
-      answer(cut, "failed", 0, 0, e.what());
+      std::fprintf(stderr, "recorder: checkpoint: cut %d NOT saved: %s\n", b.cuts.front(), e.what());
+      for (int cut : b.cuts) answer(cut, frame, "failed", 0, 0, e.what());
     }
-    // Older cuts than one saved (or failed) are over.
-    it = pending_.erase(pending_.begin(), std::next(it));
+    it = pending_.erase(it);
   }
   return saved;
 }
 
-void RecorderCuts::answer(int cut, const std::string& state, int64_t bytes, double seconds,
+void RecorderCuts::answer(int cut, int frame, const std::string& state, int64_t bytes, double seconds,
                           const std::string& message) {
   checkpoint_t a{};
   a.utime = utime_now();
   a.run_id = run_id_;
   a.cut = cut;
-  a.frame = state == "saved" ? saved_frame_ : -1;
+  a.frame = frame;
   a.process = kRecorderNode;
   a.state = state;
   a.bytes = bytes;
@@ -96,7 +122,10 @@ void RecorderCuts::answer(int cut, const std::string& state, int64_t bytes, doub
 
 RecorderCuts::Resumed RecorderCuts::read_and_replay(
     int cut, const std::function<void(const std::string&, const uint8_t*, uint32_t)>& replay) {
-  const std::string path = part_path(dir_, cut, kRecorderNode);
+  const std::optional<CutInfo> whole = read_cut_marker(dir_, cut);
+  if (!whole) throw BadPart(cut_dir(dir_, cut) + "/WHOLE: missing or unreadable: cut " + std::to_string(cut) +
+                            " is not whole");
+  const std::string path = part_path(dir_, cut, kRecorderNode, whole->frame);
   const PartHeader h0 = read_part_header(path);
   PartHeader h;
   const std::vector<uint8_t> bytes = read_part(path, kRecorderNode, h0.run_id, h0.scene_hash, &h);
@@ -105,8 +134,9 @@ RecorderCuts::Resumed RecorderCuts::read_and_replay(
   uint32_t crc = 0;
   in(length, crc);
   journal_.resume(journal_path(), length, crc, replay);
-  saved_cut_ = cut, saved_frame_ = h.frame, saved_bytes_ = static_cast<int64_t>(length);
-  return Resumed{h.run_id, h.scene_hash, h.frame, length};
+  saved_cut_ = cut;
+  saved_[h.frame] = static_cast<int64_t>(length);
+  return Resumed{h.run_id, h.scene_hash, h.frame, length, path};
 }
 
 } // namespace dynhet

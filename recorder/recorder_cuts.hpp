@@ -50,16 +50,20 @@ public:
     uint64_t scene_hash;
     int frame;
     uint64_t journal_bytes;
+    std::string part; // its file
   };
   template <class Replay> Resumed resume(int cut, Replay&& replay);
 
 private:
-  struct Pending {
-    int frame = -2; // -2: the sim's request not here yet
-    bool stop = false;
-    std::set<std::string> saved;
+  struct Boundary { // the cuts asked for at one frame boundary
+    bool requested = false; // by the sim (else only answers so far)
+    bool stop = false;      // one is the sim's last before it stops
+    std::vector<int> cuts;
+    std::set<std::string> saved; // nodes that said "saved"
   };
-  void answer(int cut, const std::string& state, int64_t bytes, double seconds, const std::string& message);
+  void answer(int cut, int frame, const std::string& state, int64_t bytes, double seconds, const std::string& message);
+  Boundary& entry(int frame);
+  bool parts_on_disk(int cut, int frame) const;
   Resumed read_and_replay(int cut, const std::function<void(const std::string&, const uint8_t*, uint32_t)>& replay);
 
   lcm::LCM& lcm_;
@@ -68,9 +72,9 @@ private:
   int64_t run_id_ = 0;
   uint64_t scene_hash_ = 0;
   std::set<std::string> nodes_;
-  std::map<int, Pending> pending_;
-  int saved_cut_ = -1, saved_frame_ = -1;
-  int64_t saved_bytes_ = 0;
+  std::map<int, Boundary> pending_; // frame -> cuts asked for there
+  std::map<int, int64_t> saved_;    // frame boundaries saved -> journal bytes
+  int saved_cut_ = -1;
   bool stop_saved_ = false;
 };
 

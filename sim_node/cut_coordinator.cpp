@@ -22,9 +22,9 @@ CutCoordinator::CutCoordinator(lcm::LCM& lcm, std::string dir, int64_t run_id, s
   const std::vector<int> cuts = list_cuts(dir_);
   next_cut_ = cuts.empty() ? 0 : cuts.back() + 1;
   for (auto it = cuts.rbegin(); it != cuts.rend(); ++it)
-    if (read_cut_marker(dir_, *it)) {
-      if (last_whole_ < 0) last_whole_ = *it;
-      else if (previous_whole_ < 0) previous_whole_ = *it;
+    if (const auto m = read_cut_marker(dir_, *it)) {
+      if (last_whole_ < 0) last_whole_ = *it, last_whole_frame_ = m->frame;
+      else if (previous_whole_ < 0) previous_whole_ = *it, previous_whole_frame_ = m->frame;
     }
   // Answers of every process (LCM patterns match whole names).
   sub_ = lcm_.subscribe(std::string(kChanCheckpoint) + "_.*", &CutCoordinator::on_answer, this);
@@ -45,7 +45,7 @@ int CutCoordinator::take(int frame, double t, const std::vector<uint8_t>& sim_pa
   std::filesystem::create_directories(cut_dir(dir_, cut));
   PartHeader h;
   h.process = "sim", h.run_id = run_id_, h.cut = cut, h.frame = frame, h.scene_hash = scene_hash_;
-  write_part(part_path(dir_, cut, "sim"), h, sim_payload);
+  write_part(part_path(dir_, cut, "sim", frame), h, sim_payload);
   // Older cuts stay open: nodes behind the sim (up to its pacing window)
   // save them in turn.
   while (pending_.size() >= kMaxOpen) pending_.erase(pending_.begin());
@@ -77,7 +77,7 @@ void CutCoordinator::on_answer(const lcm::ReceiveBuffer* rb, const std::string& 
   if (m.run_id != run_id_ || channel != checkpoint_answer_channel(m.process)) return;
   if (!checkpoint_problem(m, INT32_MAX - 1).empty()) return;
   auto it = pending_.find(m.cut);
-  if (it == pending_.end()) return;
+  if (it == pending_.end() || m.frame != it->second.frame) return; // not this cut's boundary
   if (m.state == "saved") {
     it->second.saved.insert(m.process);
   } else if (m.state == "failed") {
@@ -87,24 +87,37 @@ void CutCoordinator::on_answer(const lcm::ReceiveBuffer* rb, const std::string& 
   }
 }
 
-void CutCoordinator::complete(int cut, Pending& p) {
+bool CutCoordinator::complete(int cut, Pending& p) {
   CutInfo c;
   c.cut = cut, c.frame = p.frame, c.sim_time = p.time, c.run_id = run_id_, c.parts = parts_;
   try {
-    mark_cut_whole(dir_, c, scene_hash_);
-  } catch (const std::exception& e) {
+    const std::vector<std::string> bad = mark_cut_whole(dir_, c, scene_hash_);
+    if (!bad.empty()) {
+      // Answered but not on disk (a forged answer, or a write that failed
+      // after it): wait for those processes' own answers again.
+      for (const std::string& b : bad) {
+        const std::string who = b.substr(0, b.find(':'));
+        p.saved.erase(who);
+        if (p.said.insert(who).second)
+          std::fprintf(stderr, "\nsim_node: checkpoint cut %d: no usable part of %s\n", cut, b.c_str());
+      }
+      return false;
+    }
+  } catch (const std::exception& e) { // WHOLE itself cannot be written
     std::fprintf(stderr, "\nsim_node: checkpoint cut %d is not whole: %s\n", cut, e.what());
-    return;
+    return false;
   }
-  if (last_whole_ >= 0) previous_whole_ = last_whole_;
-  last_whole_ = cut;
+  if (last_whole_ >= 0) previous_whole_ = last_whole_, previous_whole_frame_ = last_whole_frame_;
+  last_whole_ = cut, last_whole_frame_ = p.frame;
   // The previous whole cut stays, as the fallback if this one is damaged.
-  prune_cuts(dir_, previous_whole_ >= 0 ? previous_whole_ : cut);
+  if (previous_whole_ >= 0) prune_cuts(dir_, previous_whole_, previous_whole_frame_);
+  else prune_cuts(dir_, cut, p.frame);
   checkpoint_t m{};
   m.utime = utime_now();
   m.run_id = run_id_, m.cut = cut, m.frame = p.frame, m.sim_time = p.time;
   m.process = "sim", m.state = "whole";
   lcm_.publish(kChanCheckpoint, &m);
+  return true;
 }
 
 void CutCoordinator::poll() {
@@ -114,8 +127,7 @@ void CutCoordinator::poll() {
     Pending& p = it->second;
     bool all = true;
     for (const std::string& part : parts_) all = all && p.saved.count(part);
-    if (all) {
-      complete(it->first, p);
+    if (all && complete(it->first, p)) {
       it = pending_.erase(it);
       continue;
     }

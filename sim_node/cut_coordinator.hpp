@@ -59,12 +59,12 @@ private:
     int frame;
     double time;
     bool stop = false;
-    std::set<std::string> saved;
+    std::set<std::string> saved, said; // answered "saved"; named as missing a part
     Clock::time_point asked;
   };
   void on_answer(const lcm::ReceiveBuffer* rb, const std::string& channel);
   void request(int cut, const Pending& p);
-  void complete(int cut, Pending& p);
+  bool complete(int cut, Pending& p); // false: not whole (yet)
 
   lcm::LCM& lcm_;
   std::string dir_;
@@ -73,6 +73,7 @@ private:
   uint64_t scene_hash_;
   std::vector<std::string> parts_;
   int next_cut_ = 0, last_whole_ = -1, previous_whole_ = -1;
+  int last_whole_frame_ = -1, previous_whole_frame_ = -1;
   std::map<int, Pending> pending_;
   lcm::Subscription* sub_ = nullptr;
   Clock::time_point last_take_ = Clock::now();

@@ -21,6 +21,8 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "checkpoint.hpp"
+#include "pacer.hpp"
+#include "reporter.hpp"
 #include "cut_coordinator.hpp"
 #include "dynhet/cut.hpp"
 #include "dynhet/state_archive.hpp"
@@ -41,6 +43,9 @@
 
 namespace {
 
+using dynhet::hms;
+using dynhet::Pacer;
+using dynhet::Reporter;
 using dynhet::utime_now;
 
 std::atomic<int> g_signal{0};
@@ -51,13 +56,6 @@ double seconds_since(Clock::time_point t0) {
   return std::chrono::duration<double>(Clock::now() - t0).count();
 }
 
-std::string hms(double s) {
-  if (!(s >= 0) || !std::isfinite(s)) return "?";
-  char buf[32];
-  const long t = std::lround(s);
-  std::snprintf(buf, sizeof buf, "%ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
-  return buf;
-}
 
 dynhet::run_info_t make_run_info(const dynhet::Scene& sc, const dynhet::engine::Engine& e,
                                  const dynhet::FrameSchedule& s, int64_t run_id) {
@@ -89,91 +87,6 @@ dynhet::run_info_t make_run_info(const dynhet::Scene& sc, const dynhet::engine::
   m.scene_toml = sc.text;
   return m;
 }
-
-// Everything the status message and the terminal line show.
-class Reporter {
-public:
-  Reporter(lcm::LCM& lcm, int64_t run_id, bool tty) : lcm_(lcm), tty_(tty) {
-    msg_.run_id = run_id;
-    msg_.eta_seconds = -1;
-  }
-  dynhet::sim_status_t& msg() { return msg_; }
-
-  // Adds what happened since the last sample (every slice of events, at
-  // most a few N events apart) to the pressure and collision-frequency
-  // blocks, which are in simulation time. Then publishes (and prints) if a
-  // second has passed, or if forced.
-  void update(const dynhet::engine::Engine& e, double remaining_sim_time, bool force = false) {
-    const auto& c = e.counters();
-    const long n = e.size();
-    const double ke = e.kinetic_energy_per_particle();
-    const double dsim = e.time() - s_time_;
-    if (dsim > 0 && msg_.phase != "compress") {
-      // Z = 1 + (N-1)/N sum virial / (2 N sum ke dt) (engine.hpp): the
-      // blocks hold the virial and ke dt; the frequency 2 collisions / N and dt.
-      pressure_.add((c.virial - s_virial_) / (2.0 * n), 0.5 * (ke + s_ke_) * dsim, dsim);
-      frequency_.add(2.0 * (c.collisions - s_coll_) / double(n), dsim, dsim);
-    }
-    s_time_ = e.time(), s_coll_ = c.collisions, s_virial_ = c.virial, s_ke_ = ke;
-    const double dt = seconds_since(last_);
-    if (!force && dt < 1.0) return;
-    msg_.utime = utime_now();
-    msg_.sim_time = e.time();
-    msg_.packing_fraction = e.packing_fraction();
-    msg_.n_collisions = c.collisions;
-    msg_.n_kicks = c.kicks;
-    const double dpub = e.time() - last_sim_;
-    msg_.collisions_per_second = dt > 0 && c.collisions >= last_coll_ ? (c.collisions - last_coll_) / dt : 0;
-    const double f = (n - 1.0) / n;
-    msg_.reduced_pressure = dynhet::engine::reduced_pressure_from_ratio(pressure_.mean(), n);
-    msg_.reduced_pressure_err = f * pressure_.standard_error();
-    msg_.collision_frequency = frequency_.mean();
-    msg_.collision_frequency_err = frequency_.standard_error();
-    msg_.n_tc = c.tc;
-    msg_.kinetic_energy = ke;
-    if (dpub > 0 && remaining_sim_time >= 0) msg_.eta_seconds = remaining_sim_time / (dpub / dt);
-    lcm_.publish(dynhet::kChanSimStatus, &msg_);
-    print();
-    last_ = Clock::now();
-    last_sim_ = e.time();
-    last_coll_ = c.collisions;
-  }
-  // Fine blocks of the pressure and frequency in this phase.
-  long blocks() const { return pressure_.blocks(); }
-  // What a checkpoint cut keeps: the blocks and the last sample, so that a
-  // resumed run's Z and collision frequency equal the uninterrupted run's.
-  template <class Ar> void state(Ar& ar) { ar(pressure_, frequency_, s_time_, s_virial_, s_ke_, s_coll_); }
-  // A new phase of this length in simulation time: rates and block
-  // averages start afresh, with 256 fine blocks over the phase.
-  void reset_rates(const dynhet::engine::Engine& e, double phase_length) {
-    last_sim_ = s_time_ = e.time();
-    last_coll_ = s_coll_ = e.counters().collisions;
-    s_virial_ = e.counters().virial;
-    msg_.kinetic_energy = s_ke_ = e.kinetic_energy_per_particle();
-    msg_.eta_seconds = -1;
-    pressure_.reset(phase_length / 256);
-    frequency_.reset(phase_length / 256);
-  }
-  void print() {
-    std::fprintf(stderr, "%s[%-11s] t=%-10.4g/%-10.4g phi=%.4f  coll/s=%.3g  T=%.4f  Z=%.4g  frames %d/%d  ETA %s%s",
-                 tty_ ? "\r" : "", msg_.phase.c_str(), msg_.sim_time, msg_.phase_end_time,
-                 msg_.packing_fraction, msg_.collisions_per_second, msg_.kinetic_energy, msg_.reduced_pressure,
-                 msg_.frames_published, msg_.frames_total, hms(msg_.eta_seconds).c_str(),
-                 tty_ ? "   " : "\n");
-    std::fflush(stderr);
-  }
-
-private:
-  lcm::LCM& lcm_;
-  bool tty_;
-  dynhet::sim_status_t msg_{};
-  Clock::time_point last_ = Clock::now();
-  double last_sim_ = 0;
-  int64_t last_coll_ = 0;
-  double s_time_ = 0, s_virial_ = 0, s_ke_ = 0; // the last sample
-  int64_t s_coll_ = 0;
-  dynhet::RatioBlocks pressure_, frequency_;
-};
 
 dynhet::engine::Params engine_params(const dynhet::Scene& scene) {
   dynhet::engine::Params p;
@@ -316,98 +229,6 @@ int prepare_only(const dynhet::Scene& scene, const std::string& path, bool equil
   }
 }
 
-// Flow control: the sim does not publish frame f until every node it paces
-// on has reassembled frame f - window (from their node status, which they
-// publish after every frame), so that a slow or stopped node finds at most
-// `window` frames waiting in its socket buffer (half of the 4 MiB
-// run_scene.sh asks for, dynhet::pacing_window_frames) and loses none.
-// When the scene keeps the frames, the recorder is paced on too (it
-// publishes its own status, node "recorder", after every kept frame). A
-// node that failed or finished is not waited for; one silent for kGiveUp
-// seconds (the recorder: kGiveUpRecorder) is dropped from the pacing with a
-// warning (its losses are then its own, and counted).
-class Pacer {
-public:
-  Pacer(lcm::LCM& lcm, int64_t run_id, std::vector<std::string> nodes, long n_particles)
-      : lcm_(lcm), run_id_(run_id) {
-    for (auto& n : nodes) nodes_[n] = Node{};
-    window_ = dynhet::pacing_window_frames(n_particles);
-    // Each node's own channel (DYNHET_NODE_STATUS_<node>; node names hold
-    // no regex characters).
-    for (auto& [name, n] : nodes_)
-      subs_.push_back(lcm_.subscribe(dynhet::node_status_channel(name), &Pacer::on_status, this));
-  }
-  ~Pacer() {
-    for (lcm::Subscription* s : subs_) lcm_.unsubscribe(s);
-  }
-  long window() const { return window_; }
-  // Waits until frame f may go out; `idle` is called every ~20 ms meanwhile.
-  template <class Idle> void before_frame(int f, Idle&& idle) {
-    if (nodes_.empty()) return;
-    for (;;) {
-      if (dynhet::handle_timeout(lcm_, 0) < 0 && dynhet::bus_lost(lcm_)) throw std::runtime_error(dynhet::kBusLost);
-      const auto now = Clock::now();
-      bool wait = false;
-      for (auto& [name, n] : nodes_) {
-        if (n.gone) continue;
-        if (n.state == "failed" || n.state == "done") continue;
-        if (n.whole >= f - window_ && n.seen) continue;
-        const double silent = std::chrono::duration<double>(now - (n.seen ? n.last : start_)).count();
-        if (silent > (name == dynhet::kRecorderNode ? kGiveUpRecorder : kGiveUp)) {
-          std::fprintf(stderr, "\nsim_node: node %s silent for %.0f s at frame %d: no longer waited for\n",
-                       name.c_str(), silent, f);
-          n.gone = true;
-          continue;
-        }
-        wait = true;
-        // Said once per node: when it is behind, or silent for longer than
-        // its status interval (1 s) allows (stopped, or not started).
-        if (!n.waited_for && (n.seen || silent > 2.0)) {
-          std::fprintf(stderr, "\nsim_node: waiting for slow nodes (flow control, window %ld frames): %s at frame %d%s\n",
-                       window_, name.c_str(), f, n.seen ? "" : " (no status from it yet)");
-          n.waited_for = true;
-        }
-      }
-      if (!wait) return;
-      idle();
-      dynhet::handle_timeout(lcm_, 20);
-    }
-  }
-
-private:
-  using Clock = std::chrono::steady_clock;
-  // A node's compute thread, which publishes its status, can be busy for
-  // minutes on one frame at large N (S4 over many pairs); the recorder's
-  // loop publishes every second, so a recorder silent for 30 s is stopped
-  // or dead (killed: the sim then goes on without it after 30 s, not 300).
-  static constexpr double kGiveUp = 300.0, kGiveUpRecorder = 30.0;
-  struct Node {
-    int whole = -1;
-    std::string state;
-    bool seen = false, gone = false, waited_for = false;
-    Clock::time_point last;
-  };
-  void on_status(const lcm::ReceiveBuffer* rb, const std::string& channel) {
-    dynhet::node_status_t m;
-    std::string why;
-    if (!dynhet::guard::safe_decode(rb->data, static_cast<int>(rb->data_size), m, why)) return;
-    if (m.run_id != run_id_ || channel != dynhet::node_status_channel(m.node)) return; // not this node's own
-    auto it = nodes_.find(m.node);
-    if (it == nodes_.end()) return;
-    Node& n = it->second;
-    n.whole = std::max(n.whole, m.frames_whole + m.frames_lost - 1); // the last frame index it is past
-    n.state = m.state;
-    n.seen = true;
-    n.last = Clock::now();
-  }
-  lcm::LCM& lcm_;
-  int64_t run_id_;
-  std::map<std::string, Node> nodes_;
-  long window_ = 1;
-  std::vector<lcm::Subscription*> subs_;
-  Clock::time_point start_ = Clock::now();
-};
-
 } // namespace
 
 int main(int argc, char** argv) {
@@ -502,7 +323,7 @@ int main(int argc, char** argv) {
     try {
       if (cut_root.empty()) throw std::runtime_error("--resume-cut needs --checkpoint-dir");
       dynhet::PartHeader h;
-      cut_part = dynhet::read_part(dynhet::part_path(cut_root, resume_cut, "sim"), "sim", 0,
+      cut_part = dynhet::read_part(dynhet::part_path(cut_root, resume_cut, "sim", 0), "sim", 0,
                                    dynhet::scene_hash(scene.text), &h);
       if (run_id != 0 && run_id != h.run_id)
         throw std::runtime_error("cut " + std::to_string(resume_cut) + " is of run " + std::to_string(h.run_id) +
@@ -602,7 +423,7 @@ int main(int argc, char** argv) {
     std::string cut_phase;
     size_t cut_reporter_at = 0;
     if (!cut_part.empty()) {
-      dynhet::StateIn in(cut_part.data(), cut_part.size(), dynhet::part_path(cut_root, resume_cut, "sim"));
+      dynhet::StateIn in(cut_part.data(), cut_part.size(), dynhet::part_path(cut_root, resume_cut, "sim", 0));
       dynhet::engine::State st;
       in(resumed.next_frame, cut_phase, st);
       cut_reporter_at = in.offset();

@@ -35,6 +35,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "dynhet/checkpoint_t.hpp"
 #include "dynhet/chi4_t.hpp"
 #include "dynhet/clusters_t.hpp"
 #include "dynhet/displacement_t.hpp"
@@ -209,6 +210,32 @@ int main(int argc, char** argv) {
     random_after_fingerprint<dynhet::s4_t>(lcm, "DYNHET_S4_a1", gen);
     random_after_fingerprint<dynhet::clusters_t>(lcm, "DYNHET_CLUSTERS_a1", gen);
     random_after_fingerprint<dynhet::displacement_t>(lcm, "DYNHET_DISPLACEMENT", gen);
+    random_after_fingerprint<dynhet::checkpoint_t>(lcm, "DYNHET_CHECKPOINT", gen);
+    random_after_fingerprint<dynhet::checkpoint_t>(lcm, "DYNHET_CHECKPOINT_overlap", gen);
+    // Checkpoint cuts of this run: forged requests (a huge cut number, a
+    // frame far ahead, NaN time, a process name that is a path, a state
+    // nobody knows) and forged "saved" answers of every node and the
+    // recorder: no cut may become whole without its parts on disk, none may
+    // block the real cuts, and the results must not change.
+    dynhet::checkpoint_t ck{};
+    ck.run_id = run;
+    ck.process = "sim", ck.state = "save", ck.cut = 999999 - static_cast<int>(rounds % 7), ck.frame = 0;
+    lcm.publish("DYNHET_CHECKPOINT", &ck);
+    ck.cut = static_cast<int>(rounds % 5), ck.frame = 55; // an early number, a late frame
+    lcm.publish("DYNHET_CHECKPOINT", &ck);
+    ck.sim_time = nan;
+    lcm.publish("DYNHET_CHECKPOINT", &ck);
+    ck.sim_time = 1, ck.process = "../../etc", ck.state = "saved";
+    lcm.publish("DYNHET_CHECKPOINT_overlap", &ck);
+    ck.process = "sim", ck.state = "explode";
+    lcm.publish("DYNHET_CHECKPOINT", &ck);
+    for (const char* p : {"overlap", "s4", "clusters", "recorder"}) {
+      ck.process = p, ck.state = "saved", ck.frame = static_cast<int>(rounds % 56);
+      for (int c = 0; c < 3; ++c) {
+        ck.cut = c;
+        lcm.publish(std::string("DYNHET_CHECKPOINT_") + p, &ck);
+      }
+    }
     // Declared lengths the message cannot hold: negative, and 2^31 - 1.
     chunk(lcm, run, 0, 300, 0, 3, 0, 128, -5, 0, 0.0);
     chunk(lcm, run, 0, 300, 0, 3, 0, 128, 0x7fffffff, 4, 0.0);
@@ -242,6 +269,6 @@ int main(int argc, char** argv) {
     ++rounds;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }
-  std::printf("hostile_publisher: %ld rounds of %d bad messages\n", rounds, forge_done ? 20 : 19);
+  std::printf("hostile_publisher: %ld rounds of %d bad messages\n", rounds, forge_done ? 38 : 37);
   return 0;
 }

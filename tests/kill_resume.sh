@@ -100,14 +100,14 @@ victim="" tmpfile=""
 for _ in $(seq 200); do ls "$out"/checkpoints/cut-*/WHOLE >/dev/null 2>&1 && break; sleep 0.05; done
 whole=$(ls -d "$out"/checkpoints/cut-*/WHOLE 2>/dev/null | tail -1)
 for _ in $(seq 200); do
-  tmpfile=$(ls "$out"/checkpoints/cut-*/*.part.tmp 2>/dev/null | tail -1 || true)
-  [[ -n $tmpfile && $(dirname "$tmpfile") > $(dirname "$whole") ]] || tmpfile=""
+  tmpfile=$(ls -t "$out"/checkpoints/cut-*/*.part.tmp "$out"/checkpoints/frames/*.part.tmp 2>/dev/null | head -1 || true)
   [[ -n $tmpfile ]] && break
   sleep 0.05
 done
 unset DYNHET_TEST_PART_WRITE_DELAY
 if [[ -n $tmpfile ]]; then
   victim=$(basename "$tmpfile" .part.tmp)
+  victim=${victim%-*} # frames/overlap-18.part: the part of overlap
   case $victim in sim) proc=sim_node ;; recorder) proc=recorder ;; *) proc=${victim}_node ;; esac
   p=$(pid_of "$proc" "$out")
   if [[ -n $p ]]; then kill -KILL "$p"; fi
@@ -146,13 +146,15 @@ kill -TERM -- -$run_pid 2>/dev/null || true
 set +e; wait $run_pid; set -e
 cuts=($(ls -d "$out"/checkpoints/cut-*/WHOLE 2>/dev/null | sed 's/\/WHOLE//'))
 if ((${#cuts[@]} >= 2)); then
-  part=${cuts[-1]}/overlap.part
+  frame=$(sed -n 's/^frame //p' "${cuts[-1]}/WHOLE")
+  part=$out/checkpoints/frames/overlap-$((frame + 1)).part
   size=$(stat -c %s "$part")
   printf '\xff' | dd of="$part" bs=1 seek=$((size - 9)) conv=notrunc status=none
   finish_run "$out" || true
   check 'grep -q "refused: $part: corrupt" "$out.log"' "a corrupted part is refused, its file named"
-  check 'grep -q "resuming run $run_id from checkpoint cut $((10#${cuts[-2]##*cut-}))" "$out.log"' \
-    "the cut before it is used (cut ${cuts[-2]##*cut-})"
+  newest=$((10#${cuts[-1]##*cut-}))
+  used=$(grep -o "resuming run $run_id from checkpoint cut [0-9]*" "$out.log" | tail -1 | awk '{print $NF}')
+  check '[[ -n $used && $used -lt $newest ]]' "an older whole cut is used (cut ${used:-none}, not $newest)"
   check 'complete "$out/run.h5" && same "$out"' "resumed from the older cut: run.h5 equals the uninterrupted run's"
 else
   check false "two whole cuts before the corruption (got ${#cuts[@]})"

@@ -79,7 +79,8 @@ wait "$runner" && rc=0 || rc=$?
 check '[[ $rc == 130 ]]' "stopped study exits 130 (got $rc)"
 check 'grep -qs "state = \"interrupted\"" "$tmp"/b/runs/*/status.toml' "the stopped run is marked interrupted"
 "${study[@]}" "$root/studies/tiny.toml" --out "$tmp/b" --jobs 2 >"$tmp/b2.out" 2>&1 || { cat "$tmp/b2.out"; exit 1; }
-check 'grep -q "was interrupted; resuming from .*checkpoint_before_frames.h5" "$tmp/b2.out"' "run again: the interrupted run resumes from its checkpoint"
+check 'grep -qE "was interrupted; resuming (mid-production from checkpoint cut [0-9]+|from .*checkpoint_before_frames.h5)" "$tmp/b2.out"' \
+  "run again: the interrupted run resumes from its last checkpoint cut (or, before any, from its state before the frames)"
 check 'grep -q "4 of 4 runs complete, 0 failed" "$tmp/b2.out"' "run again: 4 of 4 complete"
 /usr/bin/python3 "$root/tests/compare_studies.py" "$tmp/a" "$tmp/b" || fail=1
 

@@ -189,15 +189,19 @@ TEST(Cuts, TheNewestWholeCutIsUsedAndADamagedOneIsPassedOver) {
   const std::vector<std::string> parts{"sim", "overlap", "recorder"};
   auto write_cut = [&](int cut, int frame, bool all) {
     fs::create_directories(dynhet::cut_dir(root, cut));
+    fs::create_directories(root + "/frames");
     for (const auto& p : parts)
-      if (all || p != "recorder") dynhet::write_part(dynhet::part_path(root, cut, p), header(p, cut, frame), {1, 2, 3});
+      if (all || p != "recorder")
+        dynhet::write_part(dynhet::part_path(root, cut, p, frame), header(p, cut, frame), {1, 2, 3});
     dynhet::CutInfo c;
     c.cut = cut, c.frame = frame, c.run_id = 42, c.parts = parts, c.sim_time = 1.5 * cut;
-    dynhet::mark_cut_whole(root, c, scene);
+    return dynhet::mark_cut_whole(root, c, scene);
   };
-  write_cut(0, 4, true);
-  write_cut(1, 9, true);
-  EXPECT_THROW(write_cut(2, 12, false), BadPart); // the recorder's part is missing: never whole
+  EXPECT_TRUE(write_cut(0, 4, true).empty());
+  EXPECT_TRUE(write_cut(1, 9, true).empty());
+  const auto bad = write_cut(2, 12, false); // the recorder's part is missing: never whole
+  ASSERT_EQ(bad.size(), 1u);
+  EXPECT_EQ(bad[0].rfind("recorder: ", 0), 0u) << bad[0];
   EXPECT_FALSE(dynhet::read_cut_marker(root, 2).has_value());
   std::vector<std::string> refused;
   auto c = dynhet::latest_whole_cut(root, scene, refused);
@@ -208,7 +212,7 @@ TEST(Cuts, TheNewestWholeCutIsUsedAndADamagedOneIsPassedOver) {
   EXPECT_TRUE(refused.empty());
   // Cut 1's overlap part corrupted: cut 0, and cut 1 named as refused.
   {
-    std::fstream f(dynhet::part_path(root, 1, "overlap"), std::ios::in | std::ios::out | std::ios::binary);
+    std::fstream f(dynhet::part_path(root, 1, "overlap", 9), std::ios::in | std::ios::out | std::ios::binary);
     f.seekp(-1, std::ios::end);
     f.put('\x77');
   }
@@ -216,14 +220,17 @@ TEST(Cuts, TheNewestWholeCutIsUsedAndADamagedOneIsPassedOver) {
   ASSERT_TRUE(c.has_value());
   EXPECT_EQ(c->cut, 0);
   ASSERT_EQ(refused.size(), 1u);
-  EXPECT_NE(refused[0].find("cut-000001/overlap.part: corrupt"), std::string::npos) << refused[0];
+  EXPECT_NE(refused[0].find("frames/overlap-10.part: corrupt"), std::string::npos) << refused[0];
   // Another scene's folder: nothing usable.
   refused.clear();
   EXPECT_FALSE(dynhet::latest_whole_cut(root, dynhet::scene_hash("other"), refused).has_value());
   EXPECT_EQ(refused.size(), 2u);
-  // Pruning keeps the cuts from the one given on.
-  dynhet::prune_cuts(root, 1);
+  // Pruning keeps the cuts from the one given on, and the frame parts from its boundary on.
+  dynhet::prune_cuts(root, 1, 9);
   EXPECT_EQ(dynhet::list_cuts(root), (std::vector<int>{1, 2}));
+  EXPECT_FALSE(fs::exists(dynhet::part_path(root, 0, "overlap", 4)));
+  EXPECT_TRUE(fs::exists(dynhet::part_path(root, 1, "overlap", 9)));
+  EXPECT_TRUE(fs::exists(dynhet::part_path(root, 2, "overlap", 12)));
 }
 
 } // namespace

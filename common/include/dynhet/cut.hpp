@@ -4,7 +4,14 @@
 // frame k folded in, the recorder's results up to the point where every
 // node had saved. Layout of a run's checkpoint folder:
 //
-//   DIR/cut-000012/sim.part, overlap.part, s4.part, ..., recorder.part
+//   DIR/cut-000012/sim.part    the sim's part (two cuts between the same
+//                              frames hold two engine states)
+//   DIR/frames/overlap-18.part, s4-18.part, ..., recorder-18.part
+//                              every other process's part at the boundary
+//                              after frame 17 (18 frames in): its state
+//                              there is one, whichever cut asked for it, so
+//                              requests for one boundary (forged or not)
+//                              cost one part
 //   DIR/cut-000012/WHOLE       written (atomically) last, by the sim, once
 //                              it has read back every part of the cut
 //   DIR/recorder.journal       the recorder's messages; its part holds a
@@ -23,7 +30,8 @@
 namespace dynhet {
 
 std::string cut_dir(const std::string& root, int cut);
-std::string part_path(const std::string& root, int cut, const std::string& process);
+// The part of `process` in cut `cut`, taken after frame `frame` (-1: before any).
+std::string part_path(const std::string& root, int cut, const std::string& process, int frame);
 // The cuts in the folder (numbers of cut-* folders), ascending.
 std::vector<int> list_cuts(const std::string& root);
 
@@ -34,9 +42,10 @@ struct CutInfo {
   int64_t run_id = 0;
   std::vector<std::string> parts; // processes
 };
-// Marks a cut whole once every part listed reads back (read_part); throws
-// BadPart naming the part that does not.
-void mark_cut_whole(const std::string& root, const CutInfo& c, uint64_t scene);
+// Marks a cut whole if every part listed reads back (read_part: whole, CRC,
+// build, run, scene, this cut and frame). Returns the parts that do not,
+// each with why (the cut is then not marked); empty: marked whole.
+std::vector<std::string> mark_cut_whole(const std::string& root, const CutInfo& c, uint64_t scene);
 // The WHOLE marker of a cut, if it has one that parses.
 std::optional<CutInfo> read_cut_marker(const std::string& root, int cut);
 
@@ -45,7 +54,7 @@ std::optional<CutInfo> read_cut_marker(const std::string& root, int cut);
 std::optional<CutInfo> latest_whole_cut(const std::string& root, uint64_t scene, std::vector<std::string>& refused);
 
 // Removes the cuts older than `keep_from` (the older of the two newest whole
-// cuts stays as the fallback) and unfinished cuts older than the newest.
-void prune_cuts(const std::string& root, int keep_from);
+// cuts stays as the fallback), and the frame parts before its frame.
+void prune_cuts(const std::string& root, int keep_from, int keep_frame);
 
 } // namespace dynhet
