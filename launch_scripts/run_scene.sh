@@ -353,6 +353,11 @@ if ((plots)) && [[ -f $out/run.h5 ]]; then
   /usr/bin/python3 "$root/launch_scripts/plot_overlap.py" "$out/run.h5" "$out/overlap.png" ||
     { echo "run_scene: plotting failed" >&2; status=1; }
 fi
+if [[ -n $cuts && $status -eq 0 && -f $out/run.h5 ]] &&
+  /usr/bin/python3 -c "import h5py, sys; sys.exit(0 if int(h5py.File(sys.argv[1], 'r').attrs.get('complete', 0)) == 1 else 1)" "$out/run.h5" 2>/dev/null; then
+  rm -rf "$cuts"/cut-* "$cuts"/frames "$cuts"/recorder.journal # complete: nothing to resume
+  rmdir "$cuts" 2>/dev/null || true
+fi
 if [[ -n $cuts && $status -ne 0 ]]; then
   last=$(ls -d "$cuts"/cut-*/WHOLE 2>/dev/null | tail -1)
   if [[ -n $last ]]; then
