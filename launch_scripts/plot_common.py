@@ -12,6 +12,7 @@ matplotlib.rcParams.update({"font.size": 10, "axes.titlesize": 10, "axes.labelsi
                             "xtick.labelsize": 9, "ytick.labelsize": 9, "legend.framealpha": 0.9})
 
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
+import numpy as np  # noqa: E402
 
 
 def tidy_log(ax):
@@ -52,7 +53,14 @@ def last(group, name):
 
 def save(fig, f, png, dpi):
     """Saves the figure; an incomplete run (the file's `complete` is not 1)
-    says so in red across the top, with what is missing."""
+    says so in red across the top, with what is missing. A log axis with
+    nothing positive on it (an incomplete run's empty panel) turns linear
+    rather than fail the whole figure."""
+    for ax in fig.axes:
+        lim = ax.dataLim
+        for scale, hi, setter in ((ax.get_xscale(), lim.x1, ax.set_xscale), (ax.get_yscale(), lim.y1, ax.set_yscale)):
+            if scale == "log" and not (np.isfinite(hi) and hi > 0):
+                setter("linear")
     if int(f.attrs.get("complete", 0)) != 1:
         missing = f.attrs.get("missing", "")
         missing = missing.decode() if isinstance(missing, bytes) else str(missing)

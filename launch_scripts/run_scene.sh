@@ -345,7 +345,9 @@ if [[ -n $record ]]; then
 fi
 grep -h -E "tau_alpha|frames whole|complete|missing" "$out"/*_node.log "$out/recorder.log" >&2 || true
 
-if ((plots)) && [[ -f $out/run.h5 ]]; then
+# A run stopped by a signal goes on later: no plots now (a Slurm task has
+# seconds left before its time limit).
+if ((plots)) && [[ -f $out/run.h5 && -z ${stop_signal:-} ]]; then
   for obs in chi4 msd displacement clusters s4; do # plots of the observables the run has
     /usr/bin/python3 -c "import h5py,sys; sys.exit(0 if 'observables/$obs' in h5py.File('$out/run.h5','r') else 1)" 2>/dev/null &&
       { /usr/bin/python3 "$root/launch_scripts/plot_$obs.py" "$out/run.h5" "$out/$obs.png" || status=1; }

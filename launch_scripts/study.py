@@ -554,6 +554,34 @@ def newest_whole_cut(run_dir):
     return max(int(os.path.basename(os.path.dirname(c))[4:]) for c in cuts) if cuts else None
 
 
+def signal_children(*_):
+    """SIGTERM/SIGINT of a Slurm task: every child stops at a checkpoint cut
+    (run_scene.sh passes the signal on); the task goes on to record what
+    its run came to: complete if it finished meanwhile, else interrupted.
+    A signal handler: it neither waits nor takes a lock."""
+    STOPPING.set()
+    for proc in list(CHILDREN):
+        try:
+            os.killpg(proc.pid, signal.SIGTERM)
+        except (ProcessLookupError, PermissionError):
+            pass
+
+
+def call_child(cmd, log, **kw):
+    """subprocess.call in a session of its own, stopped with the others on
+    SIGTERM (signal_children, stop_children)."""
+    proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, start_new_session=True, **kw)
+    with CHILDREN_LOCK:
+        CHILDREN.add(proc)
+    if STOPPING.is_set():  # the signal came before the child was known
+        signal_children()
+    try:
+        return proc.wait()
+    finally:
+        with CHILDREN_LOCK:
+            CHILDREN.discard(proc)
+
+
 def run_scene(scene_path, out, log_path, resume=None):
     cmd = ["bash", RUN_SCENE, "--no-build", "--out", out]
     cmd += ["--resume", resume] if resume else [scene_path]
@@ -568,18 +596,11 @@ def run_scene(scene_path, out, log_path, resume=None):
         # a new network namespace unless told it is in one already): runs that
         # share a bus would take each other's frames.
         env = {k: v for k, v in os.environ.items() if k != "DYNHET_IN_NETNS"}
-        proc = subprocess.Popen(cmd, stdout=log, stderr=subprocess.STDOUT, start_new_session=True, env=env)
-        with CHILDREN_LOCK:
-            CHILDREN.add(proc)
         try:
-            rc = proc.wait()
-        except KeyboardInterrupt:  # a Slurm task cancelled, or Ctrl-C: the run stops at a checkpoint
-            STOPPING.set()
-            os.killpg(proc.pid, signal.SIGTERM)
-            rc = proc.wait()
-        finally:
-            with CHILDREN_LOCK:
-                CHILDREN.discard(proc)
+            rc = call_child(cmd, log, env=env)
+        except KeyboardInterrupt:  # Ctrl-C in the local executor's worker: the run stops at a checkpoint
+            stop_children()
+            rc = RESUMABLE
         r1 = os.times()
     return rc, time.time() - t0, (r1.children_user - r0.children_user) + (r1.children_system - r0.children_system)
 
@@ -604,8 +625,7 @@ def prepared_state(sd, sc):
             scene_path = os.path.join(d, key + ".toml")
             write_atomic(scene_path, toml_dump(sc, f"# the system of prepared state {key}"))
             with open(os.path.join(d, key + ".log"), "w") as log:
-                rc = subprocess.call([SIM, scene_path, "--prepare-only", path + ".tmp"], stdout=log,
-                                     stderr=subprocess.STDOUT)
+                rc = call_child([SIM, scene_path, "--prepare-only", path + ".tmp"], log)
             if rc != 0 or STOPPING.is_set():
                 if STOPPING.is_set():
                     raise StudyInterrupted(f"preparing {key} stopped")
@@ -657,8 +677,7 @@ def equilibrated_state(sd, sc):
         with open(os.path.join(d, key + ".log"), "a") as log:
             log.write(f"\n# {time.strftime('%Y-%m-%d %H:%M:%S')} to t = {t_eq:g}\n")
             log.flush()
-            rc = subprocess.call([SIM, scene_path, "--prepare-only", tmp, "--equilibrate"], stdout=log,
-                                 stderr=subprocess.STDOUT)
+            rc = call_child([SIM, scene_path, "--prepare-only", tmp, "--equilibrate"], log)
         if rc != 0 or STOPPING.is_set():
             if STOPPING.is_set():
                 raise StudyInterrupted(f"equilibrating {key} stopped")
@@ -793,20 +812,33 @@ def do_run(sd, p, log=print):
     if os.environ.get("SLURM_RESTART_COUNT"):
         status["requeues"] = int(os.environ["SLURM_RESTART_COUNT"])
     scene_path = os.path.join(d, "scene.toml")
+    cut0 = newest_whole_cut(d)
     rc, wall, cpu = run_scene(scene_path, d, os.path.join(d, "run_scene.log"), None if resume == "cut" else resume)
     # A process of the run died (exit 75: resumable): again from the last
-    # whole cut, a few times, before the run counts as failed.
+    # whole cut, a few times, before the run counts as failed; twice in a row
+    # without a new whole cut is no transient (a resume that fails the same
+    # way each time) and the run fails, with its log, rather than loop.
+    stuck = 0
     for _ in range(3):
         if rc != RESUMABLE or STOPPING.is_set():
             break
+        cut1 = newest_whole_cut(d)
+        stuck = stuck + 1 if cut1 == cut0 else 0
+        if stuck >= 2:
+            break
+        cut0 = cut1
         log(f"{st.run_name(p)}: interrupted (a process died); resuming from its last checkpoint cut")
         rc2, wall2, cpu2 = run_scene(scene_path, d, os.path.join(d, "run_scene.log"))
         rc, wall, cpu = rc2, wall + wall2, cpu + cpu2
+    if rc == RESUMABLE and not STOPPING.is_set() and newest_whole_cut(d) == cut0:
+        rc = 1  # no progress: a failure, not an interruption
     complete, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc)) if rc == 0 else (0, float("nan"))
     status.update({"exit": rc, "wall_s": wall, "cpu_s": cpu, "finished": time.strftime("%Y-%m-%dT%H:%M:%S"),
                    "tau_alpha": tau})
     status.pop("pid", None)
-    if STOPPING.is_set() or rc == RESUMABLE:
+    # A run that finished before the stop reached it is complete: a signal
+    # late in a Slurm task's time must not cost the run its result.
+    if rc == RESUMABLE or (STOPPING.is_set() and rc != 0):
         status["state"] = "interrupted"
         status["message"] = ("the study was stopped; run it again to resume" if STOPPING.is_set() else
                              f"interrupted; run the study again to resume (log {d}/run_scene.log)")
@@ -824,7 +856,7 @@ def do_run(sd, p, log=print):
     else:
         status["state"] = "complete"
     write_status(d, status)
-    if status["state"] == "too_short" and status["attempts"] < rl["max_attempts"]:
+    if status["state"] == "too_short" and status["attempts"] < rl["max_attempts"] and not STOPPING.is_set():
         log(f"{st.run_name(p)}: {status['message']}; again with 1.3 tau_alpha")
         return do_run(sd, p, log)
     return status
@@ -1094,6 +1126,10 @@ def run_slurm(sd, a):
 
 
 def task(sd, name):
+    # The task does its run in this thread: a signal must not raise in it
+    # (a run that completes just as the signal comes stays complete).
+    signal.signal(signal.SIGTERM, signal_children)
+    signal.signal(signal.SIGINT, signal_children)
     for p in sd.study.points():
         if sd.study.run_name(p) == name:
             st = do_run(sd, p)

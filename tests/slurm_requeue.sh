@@ -39,9 +39,13 @@ TOML
 export DYNHET_TEST_SIM_DELAY=1.5
 bash "$root/launch_scripts/run_study.sh" "$tmp/requeue.toml" --no-build --executor slurm --out "$tmp/s" --time=1 \
   --signal-lead 45 >"$tmp/s.out" 2>&1 || { cat "$tmp/s.out"; tail -20 "$d"/*.log; exit 1; }
-( # the administrator: a requeued task waiting out its hold may start now
+( # the administrator: a requeued task waiting out its hold may start now,
+  # once the node has let go of its previous allocation (released at once,
+  # Slurm kills it: "Job credential revoked").
   while sleep 2; do
+    sinfo -h -o %T 2>/dev/null | grep -qx idle || continue
     for j in $(squeue -h -t PENDING -o "%i %r" 2>/dev/null | awk '$2 == "BeginTime" { print $1 }'); do
+      sleep 3
       scontrol update JobId="$j" StartTime=now 2>/dev/null && echo "$(date '+%T') released $j" >>"$tmp/released.out"
     done
   done
@@ -58,7 +62,7 @@ for _ in $(seq 2400); do # 8 minutes at most
 done
 ((done_)) || { echo "FAIL the Slurm jobs did not finish in 8 min"; squeue; }
 task_out=$(ls "$tmp"/s/slurm/task-*_0.out 2>/dev/null | head -1)
-[[ -n $task_out ]] && grep -E "task |requeued|interrupted" "$task_out" | head -20
+[[ -n $task_out ]] && grep -E "task |requeued|interrupted|died|failed" "$task_out" | tail -40
 run=$(ls -d "$tmp"/s/runs/*/ 2>/dev/null | head -1)
 check '[[ $(grep -c "state = \"complete\"" "$tmp/s/index.toml") == 1 ]]' "the run completes through requeues"
 requeues=$(sed -n 's/^requeues = \([0-9]*\)/\1/p' "$tmp/s/index.toml")
