@@ -319,14 +319,14 @@ private:
       m.lag_time = info().lag_time;
       for (size_t g = 0; g < ng; ++g) {
         const auto r = chi4_acc_[g * nc + c].result();
-        // The whole box has one sub-box: its chi4 is N var(Q) over origins.
-        const bool whole = spec_.grids[g].per_side == 1;
         m.subbox_particles.push_back(spec_.grids[g].mean_particles);
         m.subbox_per_side.push_back(spec_.grids[g].per_side);
-        const auto& v = whole ? r.chi4_pooled : r.chi4;
-        m.chi4.insert(m.chi4.end(), v.begin(), v.end());
-        const auto& e = whole ? r.chi4_pooled_err : r.chi4_err;
-        m.chi4_err.insert(m.chi4_err.end(), e.begin(), e.end());
+        m.chi4.insert(m.chi4.end(), r.chi4.begin(), r.chi4.end());
+        m.chi4_err.insert(m.chi4_err.end(), r.chi4_err.begin(), r.chi4_err.end());
+        m.chi4_per_origin.insert(m.chi4_per_origin.end(), r.chi4_per_origin.begin(), r.chi4_per_origin.end());
+        m.chi4_per_origin_err.insert(m.chi4_per_origin_err.end(), r.chi4_per_origin_err.begin(),
+                                     r.chi4_per_origin_err.end());
+        m.tau4_interior.push_back(r.tau4_interior ? 1 : 0);
         m.chi4_peak.push_back(r.chi4_peak);
         m.tau4.push_back(r.tau4);
         m.chi4_peak_err.push_back(r.chi4_peak_err);

@@ -183,8 +183,15 @@ private:
       for (size_t g = 0; g < grids_.size(); ++g) {
         const std::vector<double> s4 = c.acc[g].mean(static_cast<int>(t)).s4;
         m.s4_lag.insert(m.s4_lag.end(), s4.begin(), s4.end());
-        const an::OzFit f = an::fit_oz(c.acc[g].q(), s4, {}, kQxiMax);
+        // One rule for xi wherever it is reported: the fit at each lag
+        // gives no xi where the whole box's fit at t_s4 would give none
+        // (no per-lag errors here, so not the error rule).
+        an::OzFit f = an::fit_oz(c.acc[g].q(), s4, {}, kQxiMax);
+        const bool fitted = std::isfinite(f.xi);
+        const bool range_ok = f.range_ok;
+        const bool kept = an::keep_determined_xi(f, kQxiMax, false);
         m.xi_lag.push_back(f.xi), m.chi0_lag.push_back(f.chi0);
+        m.xi_lag_rule.push_back(!fitted ? 3 : kept ? 0 : !range_ok ? 1 : 2);
       }
     m.n_grids = static_cast<int32_t>(grids_.size());
     m.scan_qxi_max = an::kOzRangeScan;

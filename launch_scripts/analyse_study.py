@@ -111,6 +111,9 @@ def read_run(path, meta):
                 c["chi4_err"] = last(h, "chi4_err").reshape(len(n_sub), nl)
                 for k in ("chi4_peak", "chi4_peak_err", "tau4", "tau4_err"):
                     c[k] = last(h, k)
+                # Older files lack it: their peaks count as interior.
+                c["tau4_interior"] = (last(h, "tau4_interior").astype(bool) if "tau4_interior" in h
+                                      else np.ones(len(n_sub), bool))
             if a in s4g:
                 s = s4g[a]
                 q = s["q"][:]
@@ -209,18 +212,29 @@ def series_arrays(points, fn, drop=None):
     return paired_arrays(points, fn, None, drop)
 
 
+def point_error(m):
+    """The error of a per-point mean (Point.mean): the quoted error, else the
+    standard error over seeds, else 10%."""
+    v, e, sem, _ = m
+    return e if np.isfinite(e) and e > 0 else (sem if np.isfinite(sem) and sem > 0 else abs(v) * 0.1)
+
+
 def paired_arrays(points, fn, xrun=None, drop=None, xpoint=lambda p: p.phi):
     """Per-point means of fn against x: a per-point function (xpoint) or the
-    per-point mean of a per-run quantity (xrun, e.g. tau_alpha)."""
-    xs, ys, es = [], [], []
+    per-point mean of a per-run quantity (xrun, e.g. tau_alpha). With xrun,
+    also the errors of x (a fourth array): x is then measured too."""
+    xs, ys, es, sxs = [], [], [], []
     for p in points:
-        mx = p.mean(xrun, drop)[0] if xrun is not None else xpoint(p)
-        my, ey, semy, n = p.mean(fn, drop)
-        if n and np.isfinite(mx) and np.isfinite(my):
-            xs.append(mx)
-            ys.append(my)
-            es.append(ey if np.isfinite(ey) and ey > 0 else (semy if np.isfinite(semy) and semy > 0 else abs(my) * 0.1))
-    return np.array(xs), np.array(ys), np.array(es)
+        mx = p.mean(xrun, drop) if xrun is not None else (xpoint(p), 0.0, 0.0, 1)
+        my = p.mean(fn, drop)
+        if my[3] and np.isfinite(mx[0]) and np.isfinite(my[0]):
+            xs.append(mx[0])
+            ys.append(my[0])
+            es.append(point_error(my))
+            sxs.append(point_error(mx) if xrun is not None else 0.0)
+    if xrun is None:
+        return np.array(xs), np.array(ys), np.array(es)
+    return np.array(xs), np.array(ys), np.array(es), np.array(sxs)
 
 
 def seeds_of(points):
@@ -231,7 +245,8 @@ def fit_series(points, fn, form, xrun=None, xpoint=lambda p: p.phi, **kw):
     """A cross-run fit of the per-point means of fn against x (see
     paired_arrays), jackknifed over seeds: each seed left out of every point."""
     def one(drop):
-        return form(*paired_arrays(points, fn, xrun, drop, xpoint), **kw)
+        a = paired_arrays(points, fn, xrun, drop, xpoint)
+        return form(*a[:3], sx=a[3], **kw) if len(a) == 4 else form(*a, **kw)
     return sf.jackknife_over_seeds(one, seeds_of(points))
 
 
@@ -251,6 +266,22 @@ def proper_subbox(c, N):
     ns = np.asarray(c["chi4_N"], float)
     ok = np.where(ns < 0.999 * N)[0]
     return int(ok[np.argmax(ns[ok])]) if len(ok) else int(np.argmax(ns))
+
+
+def tau4_of(r, g):
+    """tau4 of sub-box grid g with its error; NaN where the peak is not
+    interior (the largest chi4 at the first or last lag: a bound, which
+    scales with the lag window, not a peak)."""
+    c = cut(r)
+    if not c["tau4_interior"][g]:
+        return math.nan, math.nan
+    return c["tau4"][g], c["tau4_err"][g]
+
+
+def interior_note(points, g_of):
+    """How many points' runs have an interior tau4 peak (all of their seeds)."""
+    ok = sum(all(cut(r)["tau4_interior"][g_of(r)] for r in p.runs) for p in points)
+    return f"{ok} of {len(points)} points with an interior χ4 peak (the others left out)"
 
 
 def whole_box_s4(c):
@@ -815,7 +846,7 @@ def chi4_results(A, phi_c_tau):
         c = cut(pts[0].runs[0])
         ax[0].set_title(f"Fig. chi4: χ4(t), sub-box N = {c['chi4_N'][proper_subbox(c, pts[0].N)]:.4g}")
     ax[0].legend(fontsize=6, ncol=2)
-    t4 = lambda r: (cut(r)["tau4"][proper_subbox(cut(r), r["N"])], cut(r)["tau4_err"][proper_subbox(cut(r), r["N"])])
+    t4 = lambda r: tau4_of(r, proper_subbox(cut(r), r["N"]))
     sub = [p for p in pts if p.phi <= 0.80 + 1e-9]
     f4 = A.fit("tau4_tau_alpha", fit_series(sub, t4, sf.power, xrun=tau))
     x, y, e = [], [], []
@@ -847,11 +878,13 @@ def chi4_results(A, phi_c_tau):
     ax[2].set_title("χ4(τ_α) against φ")
     f = A.save(fig, "chi4.png")
     A.row("χ4(t) for all φ", "3.4, fig. chi4", "figure only", f"{len(pts)} densities", "figure", f, pts)
-    A.row("τ4 ∝ τ_α^z (φ ≤ 0.80)", "3.4, inset of fig. chi4", "1.19", fmt(f4.p["s"], f4.error("s")), fit_verdict(f4, "s", 1.19), f, sub, f4.note)
-    t4w = lambda r: (cut(r)["tau4"][int(np.argmax(cut(r)["chi4_N"]))], cut(r)["tau4_err"][int(np.argmax(cut(r)["chi4_N"]))])
+    A.row("τ4 ∝ τ_α^z (φ ≤ 0.80)", "3.4, inset of fig. chi4", "1.19", fmt(f4.p["s"], f4.error("s")), fit_verdict(f4, "s", 1.19), f, sub,
+          "; ".join(x for x in (f4.note, interior_note(sub, lambda r: proper_subbox(cut(r), r["N"]))) if x))
+    whole = lambda r: int(np.argmax(cut(r)["chi4_N"]))
+    t4w = lambda r: tau4_of(r, whole(r))
     f4w = A.fit("tau4_box_tau_alpha", fit_series(sub, t4w, sf.power, xrun=tau))
     A.row("the same with τ4 of the whole box (no sub-box)", "3.4, inset of fig. chi4", "1.19", fmt(f4w.p["s"], f4w.error("s")),
-          fit_verdict(f4w, "s", 1.19), f, sub, f4w.note)
+          fit_verdict(f4w, "s", 1.19), f, sub, "; ".join(x for x in (f4w.note, interior_note(sub, whole)) if x))
     A.row("χ4(τ_α) ∝ (φ_c - φ)^-γχ: γχ (own φ_c)", "3.4 (from ref. AvilaPRL2014)", "≈ 2.5", fmt(fc.p["g"], fc.error("g")),
           fit_verdict(fc, "g", 2.5), f, pts, fc.note)
     A.row("χ4(τ_α) ∝ (φ_c - φ)^-γχ: φ_c", "3.4", "≈ 0.82", fmt(fc.p["xc"], fc.error("xc"), 4), fit_verdict(fc, "xc", 0.82), f, pts, fc.note)

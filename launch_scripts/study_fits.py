@@ -18,6 +18,7 @@ Forms (the paper's eqs. and section 3):
 import math
 
 import numpy as np
+from scipy import odr
 from scipy.optimize import least_squares
 
 
@@ -94,24 +95,48 @@ def _finish(fit, res, names, n):
     return fit
 
 
-def power(x, y, sy, x_range=None):
-    """y = A x^s: a straight line in ln-ln, weighted by sy/y. Parameters A, s."""
+def power(x, y, sy, x_range=None, sx=None):
+    """y = A x^s: a straight line in ln-ln, weighted by sy/y. Parameters A, s.
+    With errors sx on x (x itself measured: tau_alpha, xi), orthogonal
+    distance regression (scipy.odr) on the line in ln-ln with both errors
+    (sx/x, sy/y): weighted least squares in y alone would let the points
+    with the smallest y errors set the slope whatever their x errors."""
     fit = Fit("power", ["A", "s"])
-    x, y, sy = _in_range(x, y, sy, x_range)
+    if sx is None:
+        x, y, sy = _in_range(x, y, sy, x_range)
+    else:
+        x, y, sy, sx = _in_range(x, y, sy, x_range, sx)
     m = x > 0
     x, y, sy = x[m], y[m], sy[m]
+    sx = sx[m] if sx is not None else None
     if len(x) < 3:
         fit.note = f"{len(x)} points with data in the range: a power law needs 3"
         return fit
     fit.x_range = (float(x.min()), float(x.max()))
     c, cov, chi2 = _wlin(np.log(x), np.log(y), (y / sy) ** 2)
+    if sx is not None and np.any(sx > 0):
+        u_err = np.where(sx > 0, sx / x, np.min(sx[sx > 0] / x[sx > 0]) * 1e-3)
+        out = odr.ODR(odr.RealData(np.log(x), np.log(y), sx=u_err, sy=sy / y),
+                      odr.Model(lambda b, u: b[0] + b[1] * u), beta0=c).run()
+        # sd_beta is scaled by the residual variance; cov_beta is not (the
+        # points' errors taken as they are, as everywhere here).
+        c, cov, chi2 = out.beta, out.cov_beta, float(out.sum_square)
+        fit.note = "orthogonal distance regression (errors in x and y)"
     fit.p.update(A=float(math.exp(c[0])), s=float(c[1]))
     fit.err.update(A=float(math.exp(c[0]) * math.sqrt(cov[0, 0])), s=float(math.sqrt(cov[1, 1])))
     fit.chi2, fit.n, fit.dof = chi2, len(x), len(x) - 2
     return fit
 
 
-def _in_range(x, y, sy, x_range):
+def _in_range(x, y, sy, x_range, sx=None):
+    """The finite points (y > 0, sy > 0) within x_range; with sx, also sx
+    (NaN read as 0) of those points, as a fourth value."""
+    if sx is not None:
+        x, y, sy, sx = (np.asarray(v, float) for v in (x, y, sy, sx))
+        m = np.isfinite(x) & np.isfinite(y) & (y > 0) & np.isfinite(sy) & (sy > 0)
+        if x_range is not None:
+            m &= (x >= x_range[0]) & (x <= x_range[1])
+        return x[m], y[m], sy[m], np.nan_to_num(sx[m], nan=0.0)
     x, y, sy = _clean(x, y, sy)
     if x_range is not None:
         m = (x >= x_range[0]) & (x <= x_range[1])

@@ -378,7 +378,12 @@ void RunRecorder::write_s4(const s4_t &m) {
     writer_->set_attribute(g, "qxi_max", m.qxi_max);
     writer_->set_attribute(g, "layout",
                            "s4[record][value], grid g's shells after grid g-1's; s4_lag[record][lag][value]; "
-                           "xi_lag, chi0_lag[record][lag][grid]");
+                           "xi_lag, chi0_lag, xi_lag_rule[record][lag][grid]");
+    writer_->set_attribute(g, "xi_lag_rule",
+                           "0: the OZ fit at that lag kept; 1: fewer than 3 shells with q xi <= qxi_max (xi and "
+                           "chi0 NaN); 2: xi below the q range, q xi < 0.5 at the largest q fitted (xi NaN); "
+                           "3: no fit. The same rule as oz_xi at t_s4 (whose jackknife error must also be "
+                           "below xi)");
     s4_started_[label] = true;
   }
   if (m.n_values <= 0) return;
@@ -404,6 +409,8 @@ void RunRecorder::write_s4(const s4_t &m) {
   writer_->append_observable(base + "s4_lag", at, m.s4_lag.data(), {dim(m.n_lags), dim(m.n_values)});
   writer_->append_observable(base + "xi_lag", at, m.xi_lag.data(), {dim(m.n_lags), dim(m.n_grids)});
   writer_->append_observable(base + "chi0_lag", at, m.chi0_lag.data(), {dim(m.n_lags), dim(m.n_grids)});
+  const std::vector<int32_t> rule(m.xi_lag_rule.begin(), m.xi_lag_rule.end());
+  writer_->append_observable(base + "xi_lag_rule", at, rule.data(), {dim(m.n_lags), dim(m.n_grids)});
   writer_->append_observable(base + "oz_n_fit", at, m.oz_n_fit);
   if (m.n_scan > 0) { // a sender without the range scan (n_scan 0) still has its S4 recorded
     writer_->append_observable(base + "scan_qxi_max", at, m.scan_qxi_max);
@@ -514,7 +521,16 @@ void RunRecorder::write_chi4(const chi4_t &m) {
     writer_->write_fixed(base + "subbox_particles", m.subbox_particles);
     writer_->write_fixed(base + "subbox_per_side", m.subbox_per_side);
     writer_->set_attribute("observables/" + base, "cutoff_a", m.cutoff_a);
-    writer_->set_attribute("observables/" + base, "layout", "chi4, chi4_err [record][grid][lag]");
+    writer_->set_attribute("observables/" + base, "layout",
+                           "chi4, chi4_err, chi4_per_origin, chi4_per_origin_err [record][grid][lag]; chi4_peak, "
+                           "tau4, their errors, tau4_interior [record][grid]");
+    writer_->set_attribute("observables/" + base, "estimator",
+                           "chi4: the pooled estimator, N_r times the variance of Q_r over every sub-box of every origin, denominator "
+                           "n - 1 (unbiased for any number of sub-boxes), error a jackknife over blocks of "
+                           "origins; chi4_per_origin: paper eq. (14) as written, the variance about each "
+                           "origin's own mean averaged over origins (low by about chi4 / n_boxes); chi4_peak, "
+                           "tau4: the half-maximum peak fit of chi4, tau4_interior 0 where the peak is at "
+                           "the first or last lag (a bound)");
     chi4_started_[label] = true;
   }
   if (m.n_values <= 0) return;
@@ -527,6 +543,10 @@ void RunRecorder::write_chi4(const chi4_t &m) {
   writer_->append_observable(base + "tau4", at, m.tau4);
   writer_->append_observable(base + "chi4_peak_err", at, m.chi4_peak_err);
   writer_->append_observable(base + "tau4_err", at, m.tau4_err);
+  writer_->append_observable(base + "chi4_per_origin", at, m.chi4_per_origin.data(), grid_lag);
+  writer_->append_observable(base + "chi4_per_origin_err", at, m.chi4_per_origin_err.data(), grid_lag);
+  std::vector<int32_t> interior(m.tau4_interior.begin(), m.tau4_interior.end());
+  writer_->append_observable(base + "tau4_interior", at, interior);
 }
 
 void RunRecorder::write_overlap(const overlap_t &m) {

@@ -277,7 +277,7 @@ dynhet::s4_t s4(double a, bool final, int frame) {
   m.n_lag_values = 8;
   m.s4_lag.assign(8, a);
   m.n_lag_fits = 4;
-  m.xi_lag.assign(4, a), m.chi0_lag.assign(4, a);
+  m.xi_lag.assign(4, a), m.chi0_lag.assign(4, a), m.xi_lag_rule.assign(4, 0);
   return m;
 }
 
@@ -333,7 +333,9 @@ TEST(RunRecorder, MultiDimensionalResultsKeepTheirShape) {
   c.n_lags = 3, c.lag_time = {0.5, 1, 1.5};
   c.n_values = 6;
   for (int i = 0; i < 6; ++i) c.chi4.push_back(i), c.chi4_err.push_back(10 + i); // [g * 3 + j] = 3 g + j
+  c.chi4_per_origin = c.chi4, c.chi4_per_origin_err = c.chi4_err;
   c.chi4_peak = c.tau4 = c.chi4_peak_err = c.tau4_err = {1, 2};
+  c.tau4_interior = {1, 0};
   EXPECT_TRUE(rec.on_chi4(c));
   auto wrong = c;
   wrong.n_lags = 2, wrong.lag_time = {0.5, 1}; // 6 values are not 2 x 2
@@ -364,6 +366,8 @@ TEST(RunRecorder, MultiDimensionalResultsKeepTheirShape) {
   EXPECT_EQ(h5read::shape(f, g + "/chi4_err/value"), (Shape{1, 2, 3}));
   EXPECT_EQ(h5read::read<double>(f, g + "/chi4/value"), (std::vector<double>{0, 1, 2, 3, 4, 5}));
   EXPECT_EQ(h5read::shape(f, g + "/chi4_peak/value"), (Shape{1, 2}));
+  EXPECT_EQ(h5read::shape(f, g + "/chi4_per_origin/value"), (Shape{1, 2, 3}));
+  EXPECT_EQ(h5read::read<int32_t>(f, g + "/tau4_interior/value"), (std::vector<int32_t>{1, 0}));
   EXPECT_EQ(h5read::read<int64_t>(f, g + "/chi4/step"), std::vector<int64_t>{1});
   EXPECT_EQ(h5read::read<double>(f, g + "/chi4/time"), std::vector<double>{100.5});
   const std::string p = "/observables/displacement";

@@ -76,20 +76,7 @@ S4FitAtLag jackknife_fits(const S4Accumulator& acc, int j, double qxi_max) {
 
 // Where xi is not determined, say so instead of printing a number.
 void flag_undetermined(S4FitAtLag& out, double qxi_max) {
-  for (OzFit* f : {&out.oz, &out.oz_a2}) {
-    if (!std::isfinite(f->xi)) continue;
-    char buf[200];
-    if (!f->range_ok) {
-      std::snprintf(buf, sizeof buf, "beyond the sub-box: fewer than 3 shells with q xi <= %g", qxi_max);
-      f->note = buf, f->xi = f->xi_err = f->chi0 = f->chi0_err = kNaN;
-    } else if (f->q_fit_max * f->xi < kQxiResolved) {
-      std::snprintf(buf, sizeof buf, "below the q range: q xi reaches only %.2g at q_max", f->q_fit_max * f->xi);
-      f->note = buf, f->xi = f->xi_err = kNaN;
-    } else if (!(f->xi_err < f->xi)) {
-      std::snprintf(buf, sizeof buf, "the jackknife error (%.3g) is not below xi (%.3g)", f->xi_err, f->xi);
-      f->note = buf, f->xi = f->xi_err = kNaN;
-    }
-  }
+  for (OzFit* f : {&out.oz, &out.oz_a2}) keep_determined_xi(*f, qxi_max);
 }
 
 // err and |a - b| in quadrature; err unchanged where a or b is not finite.
@@ -98,6 +85,24 @@ double with_difference(double err, double a, double b) {
 }
 
 } // namespace
+
+bool keep_determined_xi(OzFit& f, double qxi_max, bool check_error) {
+  if (!std::isfinite(f.xi)) return false;
+  char buf[200];
+  if (!f.range_ok) {
+    std::snprintf(buf, sizeof buf, "beyond the sub-box: fewer than 3 shells with q xi <= %g", qxi_max);
+    f.note = buf, f.xi = f.xi_err = f.chi0 = f.chi0_err = kNaN;
+  } else if (f.q_fit_max * f.xi < kQxiResolved) {
+    std::snprintf(buf, sizeof buf, "below the q range: q xi reaches only %.2g at q_max", f.q_fit_max * f.xi);
+    f.note = buf, f.xi = f.xi_err = kNaN;
+  } else if (check_error && !(f.xi_err < f.xi)) {
+    std::snprintf(buf, sizeof buf, "the jackknife error (%.3g) is not below xi (%.3g)", f.xi_err, f.xi);
+    f.note = buf, f.xi = f.xi_err = kNaN;
+  } else {
+    return true;
+  }
+  return false;
+}
 
 S4FitAtLag fit_s4_at_lag(const S4Accumulator& acc, int j, double qxi_max) {
   S4FitAtLag out = jackknife_fits(acc, j, qxi_max);

@@ -61,6 +61,13 @@ struct S4FitAtLag {
 };
 S4FitAtLag fit_s4_at_lag(const S4Accumulator& acc, int j, double qxi_max = 1.0);
 
+// The same rules for one fit, wherever a xi is reported (the fit at every
+// lag included): xi (and chi0 where the sub-box cannot hold it) set to NaN
+// with the reason in f.note, where the fit's range held too few shells or
+// xi lies below the q range; with check_error, also where xi_err is not
+// below xi. Returns false where xi was set to NaN.
+bool keep_determined_xi(OzFit& f, double qxi_max, bool check_error = true);
+
 // chi4 of the whole box at one lag, where the sub-box average of eq. (14)
 // has one term: N_tot times the variance over origins of Q(t;t0) (n/(n-1)
 // corrected), with its jackknife error. NaN below 2 (error 3) origins.
