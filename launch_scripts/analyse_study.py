@@ -52,6 +52,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 
 A_MAIN = 0.6          # the paper's cutoff, "unless stated otherwise"
 EPS_MAIN = 0.9        # the paper's restitution, "unless stated otherwise"
+XI_MIN_DF = 3.0      # d_f' (chi4 against xi) over xi >= 3 particle diameters (item 4 of issue 31)
 PHI_SNAP = (0.60, 0.78, 0.805)   # the paper's snapshot densities (nearest available are used)
 PHI_AGE = (0.78, 0.805)          # the paper's ageing densities
 PHI_PDX = (0.60, 0.72, 0.78)     # three densities for P(dx) (the paper's fig. 8a shows several)
@@ -137,6 +138,7 @@ def read_run(path, meta):
                     c["cl_width"] = (g2["size_hi"][:] - g2["size_lo"][:] + 1).astype(float)
                 for k in ("p_slow", "p_fast", "rg_slow", "rg_fast", "rg_size_slow", "rg_size_fast"):
                     c["cl_" + k] = last(g2, k)
+                c["cl_p_slow_err"] = last(g2, "p_slow_err") if "p_slow_err" in g2 else np.full_like(c["cl_p_slow"], np.nan)
                 for k in ("slow_d_f", "slow_d_f_err", "fast_d_f", "fast_d_f_err", "slow_kappa", "slow_kappa_err",
                           "fast_sigma", "fast_n_sigma", "fast_p0", "lag"):
                     c["cl_" + k] = fnum(last(g2, k))
@@ -352,6 +354,26 @@ def n_star(r, a=A_MAIN):
     return (s2 / s1 if s1 > 0 else math.nan), math.nan
 
 
+KAPPA_LO = (1.0, 3.0, 10.0)   # lower bounds of the kappa fit scanned (monomers in or out)
+
+
+def kappa_of(r, lo=3.0, a=A_MAIN):
+    """kappa of slow clusters: P(N_c) ~ N_c^-kappa fitted to the bins with
+    lo <= N_c <= N* (the run's cutoff size <N_c^2>/<N_c>: beyond it the
+    scaling function cuts the power law off), weighted by the bins' errors;
+    NaN with fewer than 3 bins."""
+    c = cut(r, a)
+    if "cl_size" not in c:
+        return math.nan, math.nan
+    p, pe, n = c["cl_p_slow"], c["cl_p_slow_err"], c["cl_size"]
+    ns = n_star(r, a)[0]
+    m = np.isfinite(p) & (p > 0) & np.isfinite(pe) & (pe > 0) & (n >= lo) & (n <= ns)
+    if m.sum() < 3:
+        return math.nan, math.nan
+    f = sf.power(n[m], p[m], pe[m])
+    return (-f.p["s"], f.err["s"]) if f.ok else (math.nan, math.nan)
+
+
 def oz_fit(q, s, q_max):
     """S4 = chi0/(1 + (q xi)^2) over 0 < q <= q_max, relative residuals (as the node)."""
     from scipy.optimize import least_squares
@@ -481,16 +503,56 @@ def verdict(v, e, paper):
 
 def fit_verdict(f, name, paper, transform=lambda v: v):
     """verdict() for a fit's parameter; a fit that did not resolve its singular
-    point, or whose form misses the points badly, says so instead."""
+    point, whose chi2 is improbable, or whose singular point sits on the edge
+    of the data (sf.cannot_judge) says so instead of a sigma."""
     if not f.ok:
         return "not determined"
     if not f.determined:
         return "not determined (no divergence resolved)"
-    r = f.chi2_dof()
-    if np.isfinite(r) and r > 100:
-        return f"not judged: χ²/dof {r:.2g}, the form does not describe the points"
-    v = verdict(transform(f.p[name]), f.error(name), paper)
-    return v + (f"; χ²/dof {r:.2g}: the form misses the points" if np.isfinite(r) and r > 4 else "")
+    singular = {"critical": "xc", "critical_joint": "xc", "vft": "x0"}.get(f.form)
+    if singular is not None and f.err.get(singular) == 0.0:
+        singular = None  # held fixed
+    why = sf.cannot_judge(f, singular)
+    if why:
+        return f"not judged: {why}"
+    return verdict(transform(f.p[name]), f.error(name), paper)
+
+
+def fixed_xc_row(A, key, item, sec, paper, fn, pts, joint, fig):
+    """A critical fit y = A (phi_c - phi)^-g with phi_c held at the joint
+    fit's (item 6 of the checks: a free phi_c that sits on the edge of the
+    data decides the exponent; the same exponent with the shared phi_c is
+    the comparison that can be judged). phi_c's own error is not carried."""
+    xc = joint.p["xc"] if joint is not None and joint.ok else math.nan
+    fx = A.fit(key, fit_series(pts, fn, sf.critical_fixed, xc=xc))
+    num = paper.lstrip("≈ ")
+    judged = num[:1].isdigit()
+    A.row(item + (f" (φ_c held at the joint fit's {xc:.4f})" if np.isfinite(xc) else " (φ_c of the joint fit: none)"),
+          sec, paper, fmt(fx.p["g"], fx.error("g")), fit_verdict(fx, "g", float(num)) if judged else "—", fig, pts, fx.note)
+    return fx
+
+
+def range_scan(fits, name, label):
+    """How a fitted parameter moves with the range: `fits` {bound: Fit}.
+    Returns (note, systematic error = half the spread of the determined
+    values)."""
+    vals = {b: f.p[name] for b, f in fits.items() if f.ok}
+    if len(vals) < 2:
+        return f"scan of {label}: fewer than 2 ranges fit", math.nan
+    v = np.array(list(vals.values()))
+    syst = float((v.max() - v.min()) / 2)
+    return (f"scan of {label}: " + ", ".join(f"{b:g}: {x:.3g}" for b, x in vals.items())
+            + f" (systematic ± {syst:.2g})"), syst
+
+
+def log_axes(ax, xlabel, ylabel, title, legend=8):
+    """Both axes logarithmic, labelled, with a legend."""
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.legend(fontsize=legend)
+    ax.set_title(title)
 
 
 def colours(n):
@@ -588,7 +650,7 @@ def better(fp, fv):
     return f"{w} (χ²/dof {fv.chi2_dof():.2g} VFT, {fp.chi2_dof():.2g} power law, {fp.n} points)"
 
 
-def tau_results(A):
+def tau_results(A, joint=None):
     pts = A.series()
     fp, fv = tau_fits(A, pts, "eps0.9")
     fig, ax = plt.subplots(figsize=(6, 4.5))
@@ -607,6 +669,7 @@ def tau_results(A):
     f = A.save(fig, "tau_alpha_phi.png")
     A.row("τ_α(φ) power law: φ_c", "3.1, fig. taueps09", "0.82", fmt(fp.p["xc"], fp.error("xc"), 4), fit_verdict(fp, "xc", 0.82), f, pts, fp.note)
     A.row("τ_α(φ) power law: γ", "3.1, fig. taueps09", "not given", fmt(fp.p["g"], fp.error("g")), "—", f, pts, fp.note)
+    fixed_xc_row(A, "tau_power_eps0.9_xc_joint", "τ_α(φ) power law: γ", "3.1, fig. taueps09", "not given", tau, pts, joint, f)
     A.row("τ_α(φ) VFT: φ_0", "3.1, fig. taueps09", "0.83", fmt(fv.p["x0"], fv.error("x0"), 4), fit_verdict(fv, "x0", 0.83), f, pts, fv.note)
     A.row("τ_α(φ) VFT: B", "3.1, fig. taueps09", "not given", fmt(fv.p["B"], fv.error("B")), "—", f, pts, fv.note)
     # "the inverse power law ... only works for a narrower range of values of phi": the densities from 0.74 up
@@ -710,7 +773,7 @@ def pdx_results(A):
           ", ".join(f"φ = {p.phi:g}" for p in used), "figure", f, used)
 
 
-def cluster_results(A, phi_c):
+def cluster_results(A, phi_c, phi_c_why=None, joint=None):
     pts = A.series()
     dfs = lambda r: (cut(r)["cl_slow_d_f"], cut(r)["cl_slow_d_f_err"])
     dff = lambda r: (cut(r)["cl_fast_d_f"], cut(r)["cl_fast_d_f_err"])
@@ -759,17 +822,30 @@ def cluster_results(A, phi_c):
         m, e, sem, n = hi.mean(dff)
         A.row(f"d_f of fast clusters at φ = {hi.phi:g} (highest run)", "3.3, fig. clusters-VF805(b)", "1.73 (φ = 0.805)", fmt(m, e),
               verdict(m, e, 1.73) + ("" if abs(hi.phi - 0.805) < 1e-9 else f"; our φ is {hi.phi:g}"), f1, [hi])
-    # kappa: the node's power-law exponent of P(N_c), slow, over the densities from 0.76 up
+    # kappa: P(N_c) ~ N_c^-kappa of slow clusters per run over
+    # KAPPA_LO[1] <= N_c <= N* (the run's cutoff size), the weighted mean over
+    # the densities from 0.76 up; the lower bound scanned (monomers in or out).
+    # The clusters node's own kappa (N_c in [1, 100], fixed) is left aside.
     dense = [p for p in pts if p.phi >= 0.76]
-    kap = lambda r: (cut(r)["cl_slow_kappa"], cut(r)["cl_slow_kappa_err"])
-    ks = [p.mean(kap) for p in dense]
-    kv = np.array([k[0] for k in ks])
-    ke = np.array([k[1] for k in ks])
-    m = np.isfinite(kv) & np.isfinite(ke) & (ke > 0)
-    kappa = float(np.sum(kv[m] / ke[m] ** 2) / np.sum(1 / ke[m] ** 2)) if m.any() else math.nan
-    kappa_e = float(1 / math.sqrt(np.sum(1 / ke[m] ** 2))) if m.any() else math.nan
-    A.row("κ: P(N_c) ∝ N_c^-κ, slow clusters (weighted mean over φ ≥ 0.76)", "3.3, fig. dist(a), dist-collapse", "≈ 1.8",
-          fmt(kappa, kappa_e), verdict(kappa, kappa_e, 1.8), f1, dense)
+
+    def kappa_mean(lo):
+        ks = [p.mean(lambda r: kappa_of(r, lo)) for p in dense]
+        kv = np.array([k[0] for k in ks])
+        ke = np.array([point_error(k) for k in ks])
+        m = np.isfinite(kv) & np.isfinite(ke) & (ke > 0)
+        if not m.any():
+            return math.nan, math.nan, 0
+        return (float(np.sum(kv[m] / ke[m] ** 2) / np.sum(1 / ke[m] ** 2)), float(1 / math.sqrt(np.sum(1 / ke[m] ** 2))),
+                int(m.sum()))
+    scan = {lo: kappa_mean(lo) for lo in KAPPA_LO}
+    kappa, kappa_e, nk = scan[KAPPA_LO[1]]
+    vals = [v[0] for v in scan.values() if np.isfinite(v[0])]
+    syst = (max(vals) - min(vals)) / 2 if len(vals) >= 2 else math.nan
+    knote = (f"N_c from {KAPPA_LO[1]:g} to N* per run, {nk} densities; scan of the lower bound: "
+             + (", ".join(f"{lo:g}: {v[0]:.3g}" for lo, v in scan.items() if np.isfinite(v[0])) or "no range fits")
+             + (f" (systematic ± {syst:.2g})" if np.isfinite(syst) else ""))
+    A.row(f"κ: P(N_c) ∝ N_c^-κ, slow clusters (weighted mean over φ ≥ 0.76, {KAPPA_LO[1]:g} ≤ N_c ≤ N*)",
+          "3.3, fig. dist(a), dist-collapse", "≈ 1.8", fmt(kappa, kappa_e), verdict(kappa, kappa_e, 1.8), f1, dense, knote)
     # rho: N* = <N_c^2>/<N_c> against (phi_c - phi), phi_c from the tau_alpha power law
     frho = Fitless = None
     if np.isfinite(phi_c):
@@ -800,8 +876,20 @@ def cluster_results(A, phi_c):
     for a_ in ax:
         a_.legend(fontsize=6, ncol=2)
     f2 = A.save(fig, "clusters_collapse.png")
+    # rho against (phi_c - phi): a phi_c on the edge of the data gives the
+    # last point all the leverage, so that verdict is not judged; rho is also
+    # given with the joint fit's phi_c.
     A.row("ρ: N* ∝ (φ_c - φ)^(-1/ρ), slow clusters (φ_c from τ_α's power law)", "3.3, fig. dist-collapse", "≈ 1.63",
-          fmt(rho, rho_e), verdict(rho, rho_e, 1.63), f2, pts, frho.note if frho else "no φ_c")
+          fmt(rho, rho_e), f"not judged: τ_α's power law: {phi_c_why}" if phi_c_why else verdict(rho, rho_e, 1.63),
+          f2, pts, frho.note if frho else "no φ_c")
+    xj = joint.p["xc"] if joint is not None and joint.ok else math.nan
+    fj = (A.fit("n_star_xc_joint", fit_series([p for p in pts if p.phi < xj], n_star, sf.power, xpoint=lambda p: xj - p.phi))
+          if np.isfinite(xj) else None)
+    if fj is not None and fj.ok:
+        rj, rje = -1 / fj.p["s"], abs(fj.error("s")) / fj.p["s"] ** 2
+        why = sf.cannot_judge(joint, "xc")
+        A.row(f"ρ with the joint fit's φ_c = {xj:.4f}", "3.3, fig. dist-collapse", "≈ 1.63", fmt(rj, rje),
+              f"not judged: the joint fit: {why}" if why else verdict(rj, rje, 1.63), f2, pts, fj.note)
     A.row("fast clusters: log-normal collapse", "3.3, fig. lognormal-scaled", "figure only", "per-point fits of the clusters node",
           "figure", f2, pts)
     # snapshots
@@ -832,7 +920,7 @@ def cluster_results(A, phi_c):
     return kappa
 
 
-def chi4_results(A, phi_c_tau):
+def chi4_results(A, phi_c_tau, joint=None):
     pts = A.series()
     fig, ax = plt.subplots(1, 3, figsize=(16, 4.5))
     for p, col in zip(pts, colours(len(pts))):
@@ -888,6 +976,8 @@ def chi4_results(A, phi_c_tau):
     A.row("χ4(τ_α) ∝ (φ_c - φ)^-γχ: γχ (own φ_c)", "3.4 (from ref. AvilaPRL2014)", "≈ 2.5", fmt(fc.p["g"], fc.error("g")),
           fit_verdict(fc, "g", 2.5), f, pts, fc.note)
     A.row("χ4(τ_α) ∝ (φ_c - φ)^-γχ: φ_c", "3.4", "≈ 0.82", fmt(fc.p["xc"], fc.error("xc"), 4), fit_verdict(fc, "xc", 0.82), f, pts, fc.note)
+    fixed_xc_row(A, "chi4_tau_phi_xc_joint", "χ4(τ_α) ∝ (φ_c - φ)^-γχ: γχ", "3.4 (from ref. AvilaPRL2014)", "≈ 2.5",
+                 chi4_at_tau, pts, joint, f)
     # The sub-box chi4 saturates once xi^2 approaches the sub-box; the whole
     # box's OZ chi0 (S4 extrapolated to q -> 0) has no sub-box: the same fit on it.
     f0 = A.fit("chi0_tau_phi", fit_series(pts, chi0_at_tau, sf.critical))
@@ -920,7 +1010,11 @@ def s4_results(A, joint):
     f = A.save(fig, "s4.png")
     fx = A.fit("xi_phi", fit_series(pts, xi_at_tau, sf.critical))
     fz = A.fit("tau_xi", fit_series(pts, tau, sf.power, xrun=xi_at_tau))
-    fd = A.fit("chi4_xi", fit_series(pts, chi4_at_tau, sf.power, xrun=xi_at_tau))
+    # d_f' over xi >= 3 (below, xi is a few particle sizes and the sub-box
+    # chi4 is not yet in its scaling regime), with the lower bound scanned.
+    fd = A.fit("chi4_xi", fit_series(pts, chi4_at_tau, sf.power, xrun=xi_at_tau, x_range=(XI_MIN_DF, math.inf)))
+    fd_scan = {lo: fit_series(pts, chi4_at_tau, sf.power, xrun=xi_at_tau, x_range=(lo, math.inf)) for lo in (1.0, 2.0, 3.0, 4.0, 5.0)}
+    fd_note, _ = range_scan(fd_scan, "s", "ξ_min")
     fig, ax = plt.subplots(1, 3, figsize=(16, 4.5))
     x, y, e = series_arrays(pts, xi_at_tau)
     ax[0].errorbar(x, y, e, fmt="o")
@@ -955,9 +1049,11 @@ def s4_results(A, joint):
     A.row("S4(q, τ_α) for all φ; S4/χ4 against qξ collapse", "3.4, figs. S4, scalingS4", "figure only", f"{nx} of {len(pts)} densities with ξ", "figure", f, pts)
     A.row("ξ(τ_α) ∝ (φ_c - φ)^-γξ: γξ (own φ_c)", "3.4", "1.6", fmt(fx.p["g"], fx.error("g")), fit_verdict(fx, "g", 1.6), f2, pts, fx.note)
     A.row("τ_α ∝ ξ^z: z", "3.4 (z = γ_τ/γ_ξ)", "not given", fmt(fz.p["s"], fz.error("s")), "—", f2, pts, fz.note)
-    A.row("χ4(τ_α) ∝ ξ^d_f': d_f'", "3.4, fig. xi-chi_4-2", "≈ 1.6", fmt(fd.p["s"], fd.error("s")), fit_verdict(fd, "s", 1.6), f2, pts, fd.note)
-    fd0 = A.fit("chi0_xi", fit_series(pts, chi0_at_tau, sf.power, xrun=xi_at_tau))
-    A.row("the same with the whole box's OZ χ0 in place of the sub-box χ4: d_f'", "3.4 (eq. 18)", "≈ 1.6",
+    A.row(f"χ4(τ_α) ∝ ξ^d_f': d_f' (ξ ≥ {XI_MIN_DF:g})", "3.4, fig. xi-chi_4-2", "≈ 1.6", fmt(fd.p["s"], fd.error("s")), fit_verdict(fd, "s", 1.6),
+          f2, pts, "; ".join(x for x in (fd.note, fd_note) if x))
+    fixed_xc_row(A, "xi_phi_xc_joint", "ξ(τ_α) ∝ (φ_c - φ)^-γξ: γξ", "3.4", "1.6", xi_at_tau, pts, joint, f2)
+    fd0 = A.fit("chi0_xi", fit_series(pts, chi0_at_tau, sf.power, xrun=xi_at_tau, x_range=(XI_MIN_DF, math.inf)))
+    A.row(f"the same with the whole box's OZ χ0 in place of the sub-box χ4: d_f' (ξ ≥ {XI_MIN_DF:g})", "3.4 (eq. 18)", "≈ 1.6",
           fmt(fd0.p["s"], fd0.error("s")), fit_verdict(fd0, "s", 1.6), f2, pts, fd0.note)
     if joint is not None and joint.ok:
         for k, paper in (("tau", "not given"), ("chi4", "2.5"), ("xi", "1.6")):
@@ -992,18 +1088,75 @@ def fss_results(A, joint):
           f"exponent ratio γχ/γξ = {gc:.3g} from our joint fit", "figure", f, pts)
 
 
-def tau_n_results(A):
-    """tau_alpha against N at each density run at several N (this study's
-    points and those of --also studies with the same dynamics)."""
+def points_by_phi_n(A, has=lambda p: True):
+    """{phi: {N: Point}} of the main dynamics over this study and the --also
+    studies, the point with most runs where several have the same phi and N;
+    only densities run at more than one N."""
     allp = [p for p in list(A.points.values()) + list(A.extra.values())
-            if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9]
+            if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p)]
     by_phi = {}
     for p in allp:
         by_phi.setdefault(p.phi, {})
         q = by_phi[p.phi].get(p.N)
         if q is None or len(p.runs) > len(q.runs):
             by_phi[p.phi][p.N] = p
-    multi = {phi: d for phi, d in sorted(by_phi.items()) if len(d) > 1}
+    return {phi: d for phi, d in sorted(by_phi.items()) if len(d) > 1}
+
+
+def d_n_results(A):
+    """D against N at each density run at several N, and theta of
+    D ~ tau_alpha^-theta at each N over the densities it has (studies/d_size.toml):
+    in two dimensions box-scale flows carry part of D and may make both
+    depend on the box (issue 31, item 8)."""
+    dD = lambda r: (r.get("D", math.nan), r.get("D_err", math.nan))
+    multi = points_by_phi_n(A, lambda p: np.isfinite(p.mean(dD)[0]))
+    if not multi:
+        A.row("D against N (box-scale flows)", "3.2 (D, θ)", "not studied",
+              "one N per density (add studies/d_size.toml with --also)", "not run", "", [])
+        return
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    cells, used = [], []
+    for (phi, d), col in zip(multi.items(), colours(len(multi))):
+        ns = sorted(d)
+        vals = [d[n].mean(dD) for n in ns]
+        ax[0].errorbar(ns, [v[0] for v in vals], [point_error(v) for v in vals], fmt="o-", color=col, label=f"φ = {phi:g}")
+        cells.append(f"φ {phi:g}: " + ", ".join(f"{fmt(v[0], point_error(v))} (N {n})" for n, v in zip(ns, vals)))
+        used += list(d.values())
+    log_axes(ax[0], "N", "D", "D against the number of particles")
+    # theta at each N from the densities that N has
+    per_n = {}
+    for d in multi.values():
+        for n, p in d.items():
+            per_n.setdefault(n, []).append(p)
+    th = {}
+    for n, pts in sorted(per_n.items()):
+        if len(pts) >= 3:
+            f = A.fit(f"D_tau_N{n}", fit_series(sorted(pts, key=lambda p: p.phi), dD, sf.power, xrun=tau))
+            if f.ok:
+                th[n] = (-f.p["s"], f.error("s"), len(pts))
+    if th:
+        ns = sorted(th)
+        ax[1].errorbar(ns, [th[n][0] for n in ns], [th[n][1] for n in ns], fmt="o-", color="k")
+    ax[1].set_xscale("log")
+    ax[1].set_xlabel("N")
+    ax[1].set_ylabel("θ (D ∝ τ_α^-θ over the densities run)")
+    ax[1].set_title("θ against N")
+    f = A.save(fig, "D_N.png")
+    A.row("D against N (box-scale flows)", "3.2 (D, θ)", "not studied", "; ".join(cells), "figure", f, used)
+    if len(th) >= 2:
+        ns = sorted(th)
+        lo, hi = th[ns[0]], th[ns[-1]]
+        z = abs(hi[0] - lo[0]) / math.hypot(lo[1], hi[1]) if np.isfinite(math.hypot(lo[1], hi[1])) else math.nan
+        A.row("θ against N (D ∝ τ_α^-θ at each N)", "3.2, fig. D-vs-tau", "not studied",
+              ", ".join(f"N {n}: {fmt(th[n][0], th[n][1])} ({th[n][2]} φ)" for n in ns),
+              ("moves with N" if z > 2 else "no change with N resolved") + f" ({z:.1f} σ from N {ns[0]} to {ns[-1]})"
+              if np.isfinite(z) else "not determined", f, used)
+
+
+def tau_n_results(A):
+    """tau_alpha against N at each density run at several N (this study's
+    points and those of --also studies with the same dynamics)."""
+    multi = points_by_phi_n(A)
     if not multi:
         A.row("τ_α against N (finite size)", "2 (N = 3.6 x 10^5 to 4 x 10^6)", "not studied",
               "one N per density in this study (add one with --also, e.g. studies/finite_size.toml)", "not run", "", [])
@@ -1172,31 +1325,39 @@ def restitution_results(A):
               f, [p for *_, ps in pc for p in ps])
     # d_f' over every eps: chi4(tau_alpha) against xi(tau_alpha), all points of the neighbour series
     allp = [p for eps in eps_list for p in A.series(eps=eps)]
-    fd = A.fit("chi4_xi_all_eps", fit_series(allp, chi4_at_tau, sf.power, xrun=xi_at_tau))
-    A.row("χ4 ∝ ξ^d_f' over all ε (the paper: ε-independent)", "3.4, fig. chi_4-peak inset", "1.58", fmt(fd.p["s"], fd.error("s")),
-          fit_verdict(fd, "s", 1.58), f, allp, fd.note)
+    # The paper's 1.58 is the exponent of a finite-size collapse of chi4^P over
+    # sub-box sizes at phi = 0.78, not a fit of chi4 against xi pooled over
+    # eps: the row states ours and is not judged against it.
+    fd = A.fit("chi4_xi_all_eps", fit_series(allp, chi4_at_tau, sf.power, xrun=xi_at_tau, x_range=(XI_MIN_DF, math.inf)))
+    A.row(f"χ4 ∝ ξ^d_f' over all ε (ξ ≥ {XI_MIN_DF:g}; the paper: ε-independent)", "3.4, fig. chi_4-peak inset", "1.58",
+          fmt(fd.p["s"], fd.error("s")),
+          "not comparable: the paper's 1.58 is a finite-size collapse exponent of χ4^P at φ = 0.78, ours a fit of χ4 "
+          "against ξ pooled over ε", f, allp, fd.note)
 
 
 def appendix_results(A):
     """chi0 of the whole box's S4 fits (fit 2: OZ, fit 3: with A^2; the finest
-    q) against chi4 of the largest proper sub-box (the whole box, of fixed N,
-    has no q = 0 fluctuation of its own), both at the s4 node's t_s4; and
-    the OZ refit at tau_alpha over 0 < q <= q_m for several q_m."""
+    q) against chi4 of the same whole box (N var(Q) over origins, the s4
+    node's at t_s4): estimators of one box on both sides (until session 14
+    the 455-particle sub-box's eq. (14) chi4, biased low, stood against the
+    whole box's chi0); the largest proper sub-box's pooled chi4 is drawn
+    beside them. And the OZ refit at tau_alpha over 0 < q <= q_m for
+    several q_m, against the same whole-box chi4."""
     pts = A.series()
     fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
     rat = []
     qms = (0.1, 0.2, 0.3, 0.5, 1.0)
-    x, c4, oz, a2 = [], [], [], []
+    x, c4, c4s, oz, a2 = [], [], [], [], []
     for p in pts:
         c = cut(p.runs[0])
-        gs = proper_subbox({"chi4_N": c["s4_N"]}, p.N)
         gw = whole_box_s4(c)
         x.append(p.phi)
-        c4.append(p.mean(lambda r: (cut(r)["s4_chi4"][gs], cut(r)["s4_chi4_err"][gs])))
+        c4.append(p.mean(lambda r: (cut(r)["s4_chi4"][gw], cut(r)["s4_chi4_err"][gw])))
+        c4s.append(p.mean(lambda r: chi4_at_tau(r)))
         oz.append(p.mean(lambda r: (cut(r)["s4_oz_chi0"][gw], cut(r)["s4_oz_chi0_err"][gw])))
         a2.append(p.mean(lambda r: (cut(r)["s4_a2_chi0"][gw], cut(r)["s4_a2_chi0_err"][gw])))
         row = []
-        per_run = [(s4_at_tau(r, A_MAIN, gw), chi4_at_tau(r)[0]) for r in p.runs]  # once, for every q_m
+        per_run = [(s4_at_tau(r, A_MAIN, gw), cut(r)["s4_chi4"][gw]) for r in p.runs]  # once, for every q_m
         for qm in qms:
             vals = []
             for (q, s), ref in per_run:
@@ -1205,7 +1366,8 @@ def appendix_results(A):
             row.append(np.nanmean(vals) if np.any(np.isfinite(vals)) else math.nan)
         rat.append(row)
     x = np.array(x)
-    for arr, m, lab in ((c4, "-", "χ4 (eq. 14), largest proper sub-box"), (oz, "^", "χ0, fit 2 (OZ), whole box"),
+    for arr, m, lab in ((c4, "-", "χ4, whole box (N var Q)"), (c4s, ":", "χ4 (pooled), largest proper sub-box"),
+                        (oz, "^", "χ0, fit 2 (OZ), whole box"),
                         (a2, "o", "χ0, fit 3 (with A²), whole box")):
         arr = np.array([v[:2] for v in arr])
         ax[0].errorbar(x, arr[:, 0], arr[:, 1], fmt=m, label=lab, mfc="none")
@@ -1219,17 +1381,17 @@ def appendix_results(A):
         ax[1].plot(x, rat[:, k], "o-", ms=3, label=f"q_m = {qm:g}")
     ax[1].axhline(1, color="k", lw=0.6)
     ax[1].set_xlabel("φ")
-    ax[1].set_ylabel("χ0 (OZ over 0 < q ≤ q_m, whole box) / χ4(τ_α)")
+    ax[1].set_ylabel("χ0 (OZ over 0 < q ≤ q_m) / χ4(τ_α), whole box")
     ax[1].legend(fontsize=8)
     ax[1].set_title("robustness to the fit range [0, q_m]")
     f = A.save(fig, "appendix_chi0.png")
     oz_r = np.array([o[0] / c[0] for o, c in zip(oz, c4) if np.isfinite(o[0]) and c[0] > 0])
     a2_r = np.array([o[0] / c[0] for o, c in zip(a2, c4) if np.isfinite(o[0]) and c[0] > 0])
     med = lambda v: f"median {np.median(v):.3g} (range {v.min():.3g}-{v.max():.3g}, {len(v)} φ)" if len(v) else "not determined"
-    A.row("appendix: χ0 (fit 2, OZ) / χ4", "appendix, fig. fitting", "≈ 1 for all φ", med(oz_r),
+    A.row("appendix: χ0 (fit 2, OZ) / χ4, both of the whole box", "appendix, fig. fitting", "≈ 1 for all φ", med(oz_r),
           ("agrees" if abs(np.median(oz_r) - 1) < 0.15 else "differs") if len(oz_r) else "not determined", f, pts,
           "criterion: the median within 15% of 1")
-    A.row("appendix: χ0 (fit 3, with A²) / χ4", "appendix, fig. fitting", "≈ 1 for all φ", med(a2_r),
+    A.row("appendix: χ0 (fit 3, with A²) / χ4, both of the whole box", "appendix, fig. fitting", "≈ 1 for all φ", med(a2_r),
           ("agrees" if abs(np.median(a2_r) - 1) < 0.15 else "differs") if len(a2_r) else "not determined", f, pts,
           "criterion: the median within 15% of 1")
     spread = np.nanmax(rat, axis=1) - np.nanmin(rat, axis=1) if rat.size else np.array([])
@@ -1328,7 +1490,8 @@ def write_h5(A, path):
                    "chi0_tau_alpha": chi0_at_tau,
                    "d_f_slow": lambda r: (cut(r)["cl_slow_d_f"], cut(r)["cl_slow_d_f_err"]),
                    "d_f_fast": lambda r: (cut(r)["cl_fast_d_f"], cut(r)["cl_fast_d_f_err"]),
-                   "kappa_slow": lambda r: (cut(r)["cl_slow_kappa"], cut(r)["cl_slow_kappa_err"]),
+                   "kappa_slow": kappa_of,
+                   "kappa_slow_node": lambda r: (cut(r)["cl_slow_kappa"], cut(r)["cl_slow_kappa_err"]),
                    "n_star_slow": n_star,
                    "cluster_lag_over_tau_alpha": lambda r: (cut(r)["cl_lag"] / cut(r)["tau_alpha"], math.nan),
                    "s4_lag_over_tau_alpha": lambda r: (cut(r)["s4_t_s4"] / cut(r)["tau_alpha"], math.nan)}
@@ -1454,14 +1617,17 @@ def main(argv=None):
 
     for name, fn in (("overlap", overlap_results), ("ageing", ageing_results), ("D", d_results), ("P(dx)", pdx_results)):
         step(name, fn)
-    res = step("tau_alpha(phi)", tau_results)
-    phi_c = res[0].p["xc"] if res and res[0].ok else math.nan
-    step("clusters", cluster_results, phi_c)
-    step("chi4", chi4_results, phi_c)
+    # The joint fit first: the critical fits are also given with its phi_c.
     joint = step("joint fit of tau_alpha, chi4, xi", joint_fit)
+    res = step("tau_alpha(phi)", tau_results, joint)
+    phi_c = res[0].p["xc"] if res and res[0].ok else math.nan
+    phi_c_why = sf.cannot_judge(res[0], "xc") if res and res[0].ok else None
+    step("clusters", cluster_results, phi_c, phi_c_why, joint)
+    step("chi4", chi4_results, phi_c, joint)
     step("S4 and xi", s4_results, joint)
     step("finite size", fss_results, joint)
     step("tau_alpha against N", tau_n_results)
+    step("D against N", d_n_results)
     step("cutoff a", cutoff_results)
     step("restitution", restitution_results)
     step("appendix", appendix_results)

@@ -14,6 +14,9 @@ Forms (the paper's eqs. and section 3):
   vft        y = A exp(B / (x0 - x))      (tau_alpha against phi)
   power      y = A x^s                    (D against tau_alpha, tau4 against tau_alpha, ...)
   critical_joint: one xc shared by several critical series
+  critical_fixed: critical with xc given (the joint fit's)
+`cannot_judge` says why a fit may not carry a verdict in sigma (an
+improbable chi2, a singular point on the edge of the data).
 """
 import math
 
@@ -33,6 +36,7 @@ class Fit:
         self.dof = 0
         self.n = 0
         self.x_range = x_range
+        self.xs = np.array([])   # the distinct x the fit used (singular forms: for the edge test)
         self.note = note
 
     @property
@@ -155,6 +159,7 @@ def _singular(form, names, x, y, sy, x_range, s_max, u, sign):
         fit.note = f"{len(x)} points with data in the range: three parameters need 4"
         return fit
     fit.x_range = (float(x.min()), float(x.max()))
+    fit.xs = np.unique(x)
     top = x.max()
     scan = top + np.geomspace(1e-4, s_max - top, 400)
     v, w = np.log(y), (y / sy) ** 2
@@ -182,6 +187,53 @@ def critical(x, y, sy, x_range=None, xc_max=1.0):
     return _singular("critical", ["xc", "g", "A"], x, y, sy, x_range, xc_max, np.log, -1.0)
 
 
+def critical_fixed(x, y, sy, xc, x_range=None):
+    """y = A (xc - x)^-g with xc given (another fit's, e.g. the joint fit's
+    phi_c): a weighted straight line in ln(xc - x). Parameters xc (as given,
+    no error), g, A."""
+    fit = Fit("critical", ["xc", "g", "A"])
+    x, y, sy = _in_range(x, y, sy, x_range)
+    if not np.isfinite(xc):
+        fit.note = "no phi_c to hold fixed"
+        return fit
+    m = x < xc
+    x, y, sy = x[m], y[m], sy[m]
+    if len(x) < 3:
+        fit.note = f"{len(x)} points below xc = {xc:.4g}: two parameters need 3"
+        return fit
+    fit.x_range = (float(x.min()), float(x.max()))
+    c, cov, chi2 = _wlin(np.log(xc - x), np.log(y), (y / sy) ** 2)
+    fit.p.update(xc=float(xc), g=float(-c[1]), A=float(math.exp(c[0])))
+    fit.err.update(xc=0.0, g=float(math.sqrt(cov[1, 1])), A=float(math.exp(c[0]) * math.sqrt(cov[0, 0])))
+    fit.chi2, fit.n, fit.dof = chi2, len(x), len(x) - 2
+    fit.note = f"xc held at {xc:.4f}"
+    return fit
+
+
+def cannot_judge(fit, singular=None, p_min=1e-3):
+    """Why a fit cannot carry a verdict in sigma, or None where it can.
+    - its chi2 is improbable for its degrees of freedom (p < p_min): the form
+      does not describe the points, and its errors mean nothing;
+    - its singular point (singular: the parameter's name, e.g. "xc") lies
+      closer to the last point than two of its own errors, or than half the
+      spacing of the last two points: the fit sits on the edge of the data,
+      where the last point alone places the divergence and a quantity
+      plotted against (xc - x) gets all its leverage from that point."""
+    r = fit.chi2_dof()
+    if fit.dof > 0 and np.isfinite(fit.chi2):
+        from scipy.stats import chi2 as chi2_dist
+        pv = float(chi2_dist.sf(fit.chi2, fit.dof))
+        if pv < p_min:
+            return f"χ²/dof {r:.2g} over {fit.n} points (p = {pv:.1g}): the form does not describe the points"
+    if singular is not None and singular in fit.p and np.isfinite(fit.p[singular]) and np.isfinite(fit.x_range[1]):
+        gap, e = fit.p[singular] - fit.x_range[1], fit.error(singular)
+        step = float(fit.xs[-1] - fit.xs[-2]) if len(fit.xs) >= 2 else math.nan
+        if (np.isfinite(e) and gap < 2 * e) or (np.isfinite(step) and gap < step / 2):
+            return (f"{singular} = {fit.p[singular]:.4g} lies {gap:.2g} above the last point (its error {e:.2g}, "
+                    f"the last spacing {step:.2g}): the fit sits on the edge of the data")
+    return None
+
+
 def vft(x, y, sy, x_range=None, x0_max=1.0):
     """y = A exp(B/(x0 - x)), x0 above every x. Parameters x0, B, A."""
     return _singular("vft", ["x0", "B", "A"], x, y, sy, x_range, x0_max, lambda d: 1.0 / d, 1.0)
@@ -203,6 +255,7 @@ def critical_joint(series, x_range=None, xc_max=1.0):
         data[k] = (x, y, sy)
     allx = np.concatenate([d[0] for d in data.values()])
     fit.x_range = (float(allx.min()), float(allx.max()))
+    fit.xs = np.unique(allx)
     top = allx.max()
     best = None
     for xc in top + np.geomspace(1e-4, xc_max - top, 300):

@@ -56,6 +56,7 @@ check '[[ $(ls "$tmp"/a/states/*.h5 | wc -l) == 5 ]] && grep -q "initial_state =
 # The study analysis ran at the end (run_study.sh): study.h5, figures and
 # the reproduction table, checked against the runs themselves.
 check 'grep -q "analyse_study: .* rows" "$tmp/a.out"' "the study analysis ran when the runs were done"
+check '! grep -q "analyse_study: FAILED\|Traceback" "$tmp/a.out"' "no step of the study analysis failed"
 /usr/bin/python3 "$root/tests/check_study_analysis.py" "$tmp/a" || fail=1
 bash "$root/launch_scripts/analyse_study.sh" "$tmp/nothing" >"$tmp/n.out" 2>&1 && rc=0 || rc=$?
 check '[[ $rc == 1 ]] && grep -q "index.toml does not exist: is .* a study directory" "$tmp/n.out"' "analysing a directory that is no study: a clear error"

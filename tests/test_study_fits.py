@@ -7,7 +7,11 @@ seeds must recover every parameter within 3 errors in every one of R
 synthetic studies, and the errors must be honest: the fraction of studies
 whose parameter lies within one jackknife error of the truth must be that
 of a t distribution with K-1 degrees of freedom (0.64 for K = 6) within
-its binomial spread. Also: the ln t interpolation is exact for a line in
+its binomial spread. Through the study analysis' own fit_series: chi4
+against xi with errors on both axes (orthogonal distance regression) and
+the sub-box bias of eq. (14), which the pooled estimator does not have;
+critical fits on the edge of the data not judged, and with phi_c held
+fixed. Also: the ln t interpolation is exact for a line in
 ln t and its error estimate is zero there; fits with too few points say so.
 Usage: test_study_fits.py LAUNCH_SCRIPTS_DIR"""
 import math
@@ -106,6 +110,84 @@ v, e = sf.interp_ln_t(t, np.log(t) ** 2, 7.3)
 true = math.log(7.3) ** 2
 check(abs(v - true) <= 1.5 * e + 1e-12 and e > 0, f"interp_ln_t on a parabola: error estimate {e:.3g} covers the miss {abs(v - true):.3g}")
 check(all(math.isnan(x) for x in sf.interp_ln_t(t, t, 1000.0)), "interp_ln_t outside the lags: NaN")
+
+# --- The analysis path itself (analyse_study.fit_series on Points of runs):
+# chi4 ~ xi^d_f with errors on both axes and a known sub-box bias.
+import analyse_study as an  # noqa: E402
+
+DF, XI_S, CHI_S = 1.6, 0.25, 0.03   # true d_f'; relative error of one run's xi and chi4
+xi_true = np.geomspace(1.2, 12.0, 10)
+M, ELL = 9, 7.0                     # a 3 x 3 grid of sub-boxes of side ELL
+
+
+def eq14_factor(xi):
+    """eq. (14) removes each origin's mean over the M boxes: low by the part
+    of the variance the boxes share, here (xi/ELL)^2/(1 + (xi/ELL)^2) of it
+    (more as xi approaches the box), times (M - 1)/M of the rest."""
+    shared = (xi / ELL) ** 2 / (1 + (xi / ELL) ** 2)
+    return (1 - shared) * (M - 1) / M
+
+
+def synthetic_points(rng):
+    pts = []
+    for i, x in enumerate(xi_true):
+        pt = an.Point(("neighbours", 0.9, 0.7 + 0.01 * i, 4096))
+        for k in range(K):
+            xv = x * (1 + XI_S * rng.standard_normal())
+            c = 0.5 * x ** DF * (1 + CHI_S * rng.standard_normal())
+            pt.runs.append({"seed": k, "xi": (xv, XI_S * x), "chi4": (c, CHI_S * c),
+                            "chi4_eq14": (c * eq14_factor(x), CHI_S * c * eq14_factor(x))})
+        pts.append(pt)
+    return pts
+
+
+dev_odr, dev_wls, dev_eq14, chi_odr, chi_wls = [], [], [], [], []
+for _ in range(R // 2):
+    pts = synthetic_points(rng)
+    f = an.fit_series(pts, lambda r: r["chi4"], sf.power, xrun=lambda r: r["xi"], x_range=(an.XI_MIN_DF, math.inf))
+    dev_odr.append((f.p["s"] - DF) / f.error("s"))
+    chi_odr.append(f.chi2_dof())
+    w = an.fit_series(pts, lambda r: r["chi4"], sf.power, xpoint=lambda p: p.mean(lambda r: r["xi"])[0],
+                      x_range=(an.XI_MIN_DF, math.inf))  # x errors ignored: weighted least squares in y
+    dev_wls.append((w.p["s"] - DF) / w.error("s"))
+    chi_wls.append(w.chi2_dof())
+    b = an.fit_series(pts, lambda r: r["chi4_eq14"], sf.power, xrun=lambda r: r["xi"], x_range=(an.XI_MIN_DF, math.inf))
+    dev_eq14.append((b.p["s"] - DF) / b.error("s"))
+dev_odr, dev_wls, dev_eq14 = map(np.array, (dev_odr, dev_wls, dev_eq14))
+check("orthogonal distance" in f.note, f"fit_series with x errors uses ODR ({f.note!r})")
+check(np.mean(np.abs(dev_odr) < 3) > 0.9 and 0.40 <= np.mean(np.abs(dev_odr) < 1) <= 0.90,
+      f"d_f' with errors on both axes, through fit_series: recovered within 1 error in {np.mean(np.abs(dev_odr) < 1):.0%}, "
+      f"within 3 in {np.mean(np.abs(dev_odr) < 3):.0%} of {R // 2} studies (mean deviation {dev_odr.mean():+.2f})")
+check(np.median(chi_odr) < 2.0 and np.median(chi_wls) > 10.0,
+      f"chi2/dof: {np.median(chi_odr):.2g} with both errors, {np.median(chi_wls):.2g} with x errors ignored (median over "
+      "studies): weighted least squares in y alone misjudges the points")
+check(dev_eq14.mean() < -2.0,
+      f"eq. (14)'s sub-box bias, growing with xi, lowers d_f' by {-dev_eq14.mean():.1f} errors on average: the "
+      "pooled estimator is the one to fit")
+
+# critical fits: phi_c on the edge of the data is not judged; a fit with
+# phi_c held fixed recovers the exponent.
+x = phi
+y_edge = 0.05 * (0.8004 - x) ** -1.0
+f = sf.critical(x, y_edge * (1 + 0.01 * rng.standard_normal(len(x))), 0.01 * y_edge)
+why = sf.cannot_judge(f, "xc")
+check(why is not None and "edge" in why, f"phi_c {f.p['xc']:.5f}, 0.0004 above the last point: not judged ({why})")
+y_ok = 0.05 * (0.82 - x) ** -2.4
+f = sf.critical(x, y_ok * (1 + 0.01 * rng.standard_normal(len(x))), 0.01 * y_ok)
+check(sf.cannot_judge(f, "xc") is None, f"phi_c 0.02 above the data with a fitting form: judged ({f.p['xc']:.4f})")
+f = sf.critical(x, y_ok * np.exp(0.3 * np.sin(40 * x)), 0.01 * y_ok)
+why = sf.cannot_judge(f, "xc")
+check(why is not None and "does not describe" in why, f"a form that misses the points by 30x their errors: not judged ({why})")
+devs = {"g": []}
+for _ in range(R):
+    yy = y_ok * (1 + S * rng.standard_normal((K, len(x))))
+
+    def one(drop):
+        keep = [k for k in range(K) if k != drop]
+        return sf.critical_fixed(x, yy[keep].mean(axis=0), S * y_ok / math.sqrt(len(keep)), 0.82)
+    f = sf.jackknife_over_seeds(one, list(range(K)))
+    devs["g"].append((f.p["g"] - 2.4) / f.error("g"))
+judge("critical with phi_c held at its true value", {k: np.array(v) for k, v in devs.items()})
 
 print(f"{len(fails)} failed" if fails else "all passed")
 sys.exit(1 if fails else 0)
