@@ -6,6 +6,7 @@ frame_chunk_t headers; no LCM bindings needed).
 
 Usage: lcmlog_runs.py LOG              one line per run: id, N, frames in the log / expected
        lcmlog_runs.py LOG --run-id ID  that run's line; exit 1 if the log does not hold it
+                                       (--whole after it: exit 3 if it lacks frames)
        lcmlog_runs.py LOG --only       the id of the only run; exit 1 (with the list) if there are several
 """
 import struct
@@ -79,8 +80,9 @@ def main():
         if rid not in runs:
             print(f"{sys.argv[1]}: no run {rid}; the log holds: " + ", ".join(map(str, runs)), file=sys.stderr)
             return 1
-        print(line(rid, runs[rid])[2])
-        return 0
+        whole, expected, text = line(rid, runs[rid])
+        print(text)
+        return 3 if args[2:3] == ["--whole"] and expected is not None and whole < expected else 0
     if args[:1] == ["--only"]:
         if len(runs) > 1:
             print(f"{sys.argv[1]} holds {len(runs)} runs; choose one with --run-id:", file=sys.stderr)

@@ -339,9 +339,25 @@ for i in "${!pids[@]}"; do
 done
 pids=()
 if [[ -n $record ]]; then
-  sleep 0.3
+  # Stop the logger once it has written everything: the bus is quiet now
+  # (every process of the run has exited), so the log stops growing when the
+  # logger has caught up; a starved logger on a loaded machine may need
+  # seconds for the last frames, which a fixed 0.3 s could cut off.
+  size=-1 still=0
+  for _ in $(seq 300); do # 30 s at most
+    now=$(stat -c %s "$record" 2>/dev/null || echo 0)
+    if [[ $now == "$size" ]]; then still=$((still + 1)); else still=0 size=$now; fi
+    ((still >= 8)) && break # 0.8 s without growth: 8 of lcm-logger's 0.1 s flushes
+    sleep 0.1
+  done
   kill -INT "$logger_pid" 2>/dev/null || true
   wait "$logger_pid" 2>/dev/null || true
+  # Say so if the log missed frames (lcm-logger takes no part in the flow
+  # control: a starved logger drops): the run itself is whole, its log not.
+  if ((${#resume_cut[@]} == 0)) && [[ $role == all && -z ${stop_signal:-} ]]; then # a segment holds part of the frames by design
+    line=$(/usr/bin/python3 "$root/launch_scripts/lcmlog_runs.py" "$record" --run-id "$run_id" --whole 2>&1) ||
+      echo "run_scene: the log $record is not whole ($line): lcm-logger could not keep up; the run itself is" >&2
+  fi
 fi
 grep -h -E "tau_alpha|frames whole|complete|missing" "$out"/*_node.log "$out/recorder.log" >&2 || true
 

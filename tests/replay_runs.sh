@@ -48,5 +48,5 @@ PY
 check 'grep -q "the log lacks 2 of 56 frames of run 222" "$tmp/rh.log"' "a log lacking frames is said to before the replay"
 check '[[ $rc != 0 ]] && /usr/bin/python3 -c "import h5py, sys; sys.exit(0 if int(h5py.File(sys.argv[1], \"r\").attrs[\"complete\"]) == 0 else 1)" "$tmp/rh/run.h5"' \
   "its replay is marked incomplete and exits non-zero (exit $rc)"
-((fail == 0)) || tail -20 "$tmp"/r*.log
+((fail == 0)) || { cat "$tmp/list.txt"; for f in "$tmp"/r*.log "$tmp"/live*.log; do echo "== $f"; tail -n 12 "$f"; done; }
 exit $fail

@@ -10,7 +10,7 @@ tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 fail=0 n=0
 for s in "$root"/launch_scripts/*.sh "$root"/launch_scripts/*.py; do
-  [[ $s == *.py ]] && ! grep -q '__name__ == "__main__"' "$s" && continue # a library (plot_common, study_fits)
+  [[ $s == *.py ]] && ! grep -q '__name__ == "__main__"' "$s" && continue # a library (plot_common)
   name=$(basename "$s")
   if [[ $s == *.py ]]; then cmd=(/usr/bin/python3 "$s" --help); else cmd=(bash "$s" --help); fi
   mkdir "$tmp/$name"

@@ -13,14 +13,14 @@ the sub-box bias of eq. (14), which the pooled estimator does not have;
 critical fits on the edge of the data not judged, and with phi_c held
 fixed. Also: the ln t interpolation is exact for a line in
 ln t and its error estimate is zero there; fits with too few points say so.
-Usage: test_study_fits.py LAUNCH_SCRIPTS_DIR"""
+Usage: test_study_fits.py PYTHON_DIR (the repository's python/)"""
 import math
 import sys
 
 import numpy as np
 
-sys.path.insert(0, sys.argv[1] if len(sys.argv) > 1 else "launch_scripts")
-import study_fits as sf  # noqa: E402
+sys.path.insert(0, sys.argv[1] if len(sys.argv) > 1 else "python")
+from dynhet import fits as sf  # noqa: E402
 
 K, R, S = 6, 60, 0.03
 fails = []
@@ -113,7 +113,7 @@ check(all(math.isnan(x) for x in sf.interp_ln_t(t, t, 1000.0)), "interp_ln_t out
 
 # --- The analysis path itself (analyse_study.fit_series on Points of runs):
 # chi4 ~ xi^d_f with errors on both axes and a known sub-box bias.
-import analyse_study as an  # noqa: E402
+from dynhet.analysis import config, points  # noqa: E402
 
 DF, XI_S, CHI_S = 1.6, 0.25, 0.03   # true d_f'; relative error of one run's xi and chi4
 xi_true = np.geomspace(1.2, 12.0, 10)
@@ -131,7 +131,7 @@ def eq14_factor(xi):
 def synthetic_points(rng):
     pts = []
     for i, x in enumerate(xi_true):
-        pt = an.Point(("neighbours", 0.9, 0.7 + 0.01 * i, 4096))
+        pt = points.Point(("neighbours", 0.9, 0.7 + 0.01 * i, 4096))
         for k in range(K):
             xv = x * (1 + XI_S * rng.standard_normal())
             c = 0.5 * x ** DF * (1 + CHI_S * rng.standard_normal())
@@ -144,14 +144,14 @@ def synthetic_points(rng):
 dev_odr, dev_wls, dev_eq14, chi_odr, chi_wls = [], [], [], [], []
 for _ in range(R // 2):
     pts = synthetic_points(rng)
-    f = an.fit_series(pts, lambda r: r["chi4"], sf.power, xrun=lambda r: r["xi"], x_range=(an.XI_MIN_DF, math.inf))
+    f = points.fit_series(pts, lambda r: r["chi4"], sf.power, xrun=lambda r: r["xi"], x_range=(config.XI_MIN_DF, math.inf))
     dev_odr.append((f.p["s"] - DF) / f.error("s"))
     chi_odr.append(f.chi2_dof())
-    w = an.fit_series(pts, lambda r: r["chi4"], sf.power, xpoint=lambda p: p.mean(lambda r: r["xi"])[0],
-                      x_range=(an.XI_MIN_DF, math.inf))  # x errors ignored: weighted least squares in y
+    w = points.fit_series(pts, lambda r: r["chi4"], sf.power, xpoint=lambda p: p.mean(lambda r: r["xi"])[0],
+                      x_range=(config.XI_MIN_DF, math.inf))  # x errors ignored: weighted least squares in y
     dev_wls.append((w.p["s"] - DF) / w.error("s"))
     chi_wls.append(w.chi2_dof())
-    b = an.fit_series(pts, lambda r: r["chi4_eq14"], sf.power, xrun=lambda r: r["xi"], x_range=(an.XI_MIN_DF, math.inf))
+    b = points.fit_series(pts, lambda r: r["chi4_eq14"], sf.power, xrun=lambda r: r["xi"], x_range=(config.XI_MIN_DF, math.inf))
     dev_eq14.append((b.p["s"] - DF) / b.error("s"))
 dev_odr, dev_wls, dev_eq14 = map(np.array, (dev_odr, dev_wls, dev_eq14))
 check("orthogonal distance" in f.note, f"fit_series with x errors uses ODR ({f.note!r})")

@@ -1,0 +1,74 @@
+"""The appendix: chi0 of the OZ fits against chi4, and the fit range."""
+import math
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from .config import A_MAIN
+from .quantities import chi4_at_tau, cut, oz_fit, s4_at_tau, whole_box_s4
+
+
+def appendix_results(A):
+    """chi0 of the whole box's S4 fits (fit 2: OZ, fit 3: with A^2; the finest
+    q) against chi4 of the same whole box (N var(Q) over origins, the s4
+    node's at t_s4): estimators of one box on both sides (until session 14
+    the 455-particle sub-box's eq. (14) chi4, biased low, stood against the
+    whole box's chi0); the largest proper sub-box's pooled chi4 is drawn
+    beside them. And the OZ refit at tau_alpha over 0 < q <= q_m for
+    several q_m, against the same whole-box chi4."""
+    pts = A.series()
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
+    rat = []
+    qms = (0.1, 0.2, 0.3, 0.5, 1.0)
+    x, c4, c4s, oz, a2 = [], [], [], [], []
+    for p in pts:
+        c = cut(p.runs[0])
+        gw = whole_box_s4(c)
+        x.append(p.phi)
+        c4.append(p.mean(lambda r: (cut(r)["s4_chi4"][gw], cut(r)["s4_chi4_err"][gw])))
+        c4s.append(p.mean(lambda r: chi4_at_tau(r)))
+        oz.append(p.mean(lambda r: (cut(r)["s4_oz_chi0"][gw], cut(r)["s4_oz_chi0_err"][gw])))
+        a2.append(p.mean(lambda r: (cut(r)["s4_a2_chi0"][gw], cut(r)["s4_a2_chi0_err"][gw])))
+        row = []
+        per_run = [(s4_at_tau(r, A_MAIN, gw), cut(r)["s4_chi4"][gw]) for r in p.runs]  # once, for every q_m
+        for qm in qms:
+            vals = []
+            for (q, s), ref in per_run:
+                ch0, _ = oz_fit(q, s, qm)
+                vals.append(ch0 / ref if np.isfinite(ch0) and ref > 0 else math.nan)
+            row.append(np.nanmean(vals) if np.any(np.isfinite(vals)) else math.nan)
+        rat.append(row)
+    x = np.array(x)
+    for arr, m, lab in ((c4, "-", "χ4, whole box (N var Q)"), (c4s, ":", "χ4 (pooled), largest proper sub-box"),
+                        (oz, "^", "χ0, fit 2 (OZ), whole box"),
+                        (a2, "o", "χ0, fit 3 (with A²), whole box")):
+        arr = np.array([v[:2] for v in arr])
+        ax[0].errorbar(x, arr[:, 0], arr[:, 1], fmt=m, label=lab, mfc="none")
+    ax[0].set_yscale("log")
+    ax[0].set_xlabel("φ")
+    ax[0].set_ylabel("χ at the s4 node's t_s4 (= its τ_α)")
+    ax[0].legend(fontsize=8)
+    ax[0].set_title("Fig. fitting")
+    rat = np.array(rat)
+    for k, qm in enumerate(qms):
+        ax[1].plot(x, rat[:, k], "o-", ms=3, label=f"q_m = {qm:g}")
+    ax[1].axhline(1, color="k", lw=0.6)
+    ax[1].set_xlabel("φ")
+    ax[1].set_ylabel("χ0 (OZ over 0 < q ≤ q_m) / χ4(τ_α), whole box")
+    ax[1].legend(fontsize=8)
+    ax[1].set_title("robustness to the fit range [0, q_m]")
+    f = A.save(fig, "appendix_chi0.png")
+    oz_r = np.array([o[0] / c[0] for o, c in zip(oz, c4) if np.isfinite(o[0]) and c[0] > 0])
+    a2_r = np.array([o[0] / c[0] for o, c in zip(a2, c4) if np.isfinite(o[0]) and c[0] > 0])
+    med = lambda v: f"median {np.median(v):.3g} (range {v.min():.3g}-{v.max():.3g}, {len(v)} φ)" if len(v) else "not determined"
+    A.row("appendix: χ0 (fit 2, OZ) / χ4, both of the whole box", "appendix, fig. fitting", "≈ 1 for all φ", med(oz_r),
+          ("agrees" if abs(np.median(oz_r) - 1) < 0.15 else "differs") if len(oz_r) else "not determined", f, pts,
+          "criterion: the median within 15% of 1")
+    A.row("appendix: χ0 (fit 3, with A²) / χ4, both of the whole box", "appendix, fig. fitting", "≈ 1 for all φ", med(a2_r),
+          ("agrees" if abs(np.median(a2_r) - 1) < 0.15 else "differs") if len(a2_r) else "not determined", f, pts,
+          "criterion: the median within 15% of 1")
+    spread = np.nanmax(rat, axis=1) - np.nanmin(rat, axis=1) if rat.size else np.array([])
+    spread = spread[np.isfinite(spread)]
+    A.row("appendix: χ0 robust to the fit range q_m", "appendix, fig. fitting", "robust",
+          f"max - min of χ0/χ4 over q_m = {', '.join(f'{q:g}' for q in qms)}: median {np.median(spread):.2g} over φ" if len(spread) else "not determined",
+          "figure", f, pts)

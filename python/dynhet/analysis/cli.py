@@ -1,0 +1,104 @@
+"""The paper's results from a study's runs (issue: the paper from our own runs).
+
+Usage: analyse_study.py STUDY_DIR [--table FILE] [--quiet]
+
+Reads STUDY_DIR/index.toml and every complete run's run.h5 and writes
+  STUDY_DIR/study.h5         every per-run and per-point quantity used, every
+                             fit with its error, range and quality
+  STUDY_DIR/figures/*.png    one figure per result of the paper (sec. 3)
+  STUDY_DIR/reproduction.md  one row per result: the paper's number, ours
+                             with its error, agreement, the CPU time behind it
+(--table FILE writes the table there as well, e.g. docs/reproduction.md).
+"""
+import argparse
+import math
+import os
+import sys
+import time
+
+import matplotlib
+
+matplotlib.use("Agg")  # a batch tool: figures to files
+
+from .. import fits as sf
+from .config import A_MAIN, CONVENTIONS, EPS_MAIN, say
+from .study import Analysis
+from .overlap import ageing_results, overlap_results, tau_results
+from .transport import d_results, pdx_results
+from .clusters import cluster_results
+from .chi4_s4 import chi4_results, fss_results, joint_fit, s4_results
+from .size import d_n_results, tau_n_results
+from .cutoff import cutoff_results
+from .restitution import restitution_results
+from .appendix import appendix_results
+from .driving import driving_results, driving_rows
+from .output import write_h5, write_table
+
+
+DOC = __doc__.rstrip("\n") + "\n\nConventions " + CONVENTIONS
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=DOC.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter,
+                                 epilog=DOC.split("\n\n", 1)[1])
+    ap.add_argument("study_dir")
+    ap.add_argument("--table", help="also write the reproduction table here (e.g. docs/reproduction.md)")
+    ap.add_argument("--discussion", help="a Markdown file appended to the table (what we found about each disagreement)")
+    ap.add_argument("--also", action="append", default=[], metavar="STUDY_DIR",
+                    help="another study whose runs add points: tau_alpha against N where it ran other N, and the "
+                         "cutoff figure from whichever study's lags reach furthest")
+    a = ap.parse_args(argv)
+    t0 = time.time()
+    A = Analysis(a.study_dir, a.also)
+    if not A.points:
+        raise SystemExit(f"analyse_study: no complete run with a = {A_MAIN} in {a.study_dir}"
+                         + (f" ({len(A.skipped)} left out: {A.skipped[0][0]}: {A.skipped[0][1]}, ...)" if A.skipped else ""))
+    say(f"analyse_study: {sum(len(p.runs) for p in A.points.values())} runs at {len(A.points)} points"
+        + (f"; {len(A.skipped)} runs left out (not complete)" if A.skipped else ""))
+    failed = []
+
+    def step(name, fn, *args):
+        say(f"  {name}")
+        if not A.series():
+            A.row(name, "—", "—", f"no run of the main series (pairs = neighbours, ε = {EPS_MAIN:g})", "not determined", "", [])
+            return None
+        try:
+            return fn(A, *args)
+        except Exception as e:  # one result that cannot be made must not cost the others
+            import traceback
+            traceback.print_exc()
+            failed.append(name)
+            A.row(name, "—", "—", f"analysis failed: {type(e).__name__}: {e}", "failed", "", [])
+            return None
+
+    for name, fn in (("overlap", overlap_results), ("ageing", ageing_results), ("D", d_results), ("P(dx)", pdx_results)):
+        step(name, fn)
+    # The joint fit first: the critical fits are also given with its phi_c.
+    joint = step("joint fit of tau_alpha, chi4, xi", joint_fit)
+    res = step("tau_alpha(phi)", tau_results, joint)
+    phi_c = res[0].p["xc"] if res and res[0].ok else math.nan
+    phi_c_why = sf.cannot_judge(res[0], "xc") if res and res[0].ok else None
+    step("clusters", cluster_results, phi_c, phi_c_why, joint)
+    step("chi4", chi4_results, phi_c, joint)
+    step("S4 and xi", s4_results, joint)
+    step("finite size", fss_results, joint)
+    step("tau_alpha against N", tau_n_results)
+    step("D against N", d_n_results)
+    step("cutoff a", cutoff_results)
+    step("restitution", restitution_results)
+    step("appendix", appendix_results)
+    A.driving = ({}, "")
+    step("driving rules", driving_results)
+    driving_rows(A)
+    write_h5(A, os.path.join(A.dir, "study.h5"))
+    cmd = "launch_scripts/analyse_study.sh " + " ".join(argv if argv is not None else sys.argv[1:])
+    write_table(A, os.path.join(A.dir, "reproduction.md"), cmd, a.discussion)
+    if a.table:
+        write_table(A, a.table, cmd, a.discussion)
+    differ = [r["item"] for r in A.rows if r["verdict"].startswith("differs")]
+    say(f"analyse_study: {len(A.rows)} rows, {len(differ)} differ from the paper; {len(A.fits)} fits; "
+        f"study.h5, reproduction.md and {len(os.listdir(A.figdir))} figures in {A.dir} ({time.time() - t0:.1f} s)")
+    if failed:
+        say(f"analyse_study: FAILED: {', '.join(failed)} (the rest is written)")
+        return 1
+    return 0

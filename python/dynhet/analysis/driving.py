@@ -1,0 +1,72 @@
+"""The two kick-pair rules side by side."""
+import matplotlib.pyplot as plt
+
+from .. import fits as sf
+from .points import fit_series, series_arrays
+from .quantities import chi4_at_tau, cut, tau, xi_at_tau
+from .verdicts import fmt
+from .overlap import better, tau_fits
+
+
+def driving_results(A):
+    """The eps = 0.9 series under both kick-pair rules, side by side."""
+    rules = [r for r in ("neighbours", "any") if A.series(pairs=r)]
+    out = {}
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    for rule, col in zip(rules, ("C0", "C3")):
+        pts = A.series(pairs=rule)
+        fp, fv = tau_fits(A, pts, f"{rule}")
+        x, y, e = series_arrays(pts, tau)
+        ax.errorbar(x, y, e, fmt="o", color=col, label=f"pairs = {rule}")
+        res = {"fp": fp, "fv": fv, "pts": pts}
+        if all("s4_N" in cut(r) for p in pts for r in p.runs):
+            res["fc"] = A.fit(f"chi4_phi_{rule}", fit_series(pts, chi4_at_tau, sf.critical))
+            res["fx"] = A.fit(f"xi_phi_{rule}", fit_series(pts, xi_at_tau, sf.critical))
+            res["fd"] = A.fit(f"chi4_xi_{rule}", fit_series(pts, chi4_at_tau, sf.power, xrun=xi_at_tau))
+        dfs = lambda r: (cut(r)["cl_slow_d_f"], cut(r)["cl_slow_d_f_err"])
+        res["df_lo"], res["df_hi"] = (pts[0].mean(dfs), pts[-1].mean(dfs)) if pts else (None, None)
+        out[rule] = res
+    ax.set_yscale("log")
+    ax.set_xlabel("φ")
+    ax.set_ylabel("τ_α (ε = 0.9)")
+    ax.legend()
+    ax.set_title("the driving rule: which kick pairs")
+    f = A.save(fig, "driving_rules.png")
+    A.driving = (out, f)
+
+
+def driving_rows(A):
+    out, f = A.driving
+    if len(out) < 2:
+        A.row("both kick-pair rules side by side (ε = 0.9)", "2 (driving)", "—",
+              f"only pairs = {', '.join(out) or 'none'} in this study", "not run", f, [])
+        return
+    def cell(res, what):
+        if what == "phi_c":
+            return fmt(res["fp"].p["xc"], res["fp"].error("xc"), 4)
+        if what == "gamma":
+            return fmt(res["fp"].p["g"], res["fp"].error("g"))
+        if what == "phi_0":
+            return fmt(res["fv"].p["x0"], res["fv"].error("x0"), 4)
+        if what == "B":
+            return fmt(res["fv"].p["B"], res["fv"].error("B"))
+        if what == "better":
+            return better(res["fp"], res["fv"]).split(" (")[0]
+        if what in ("fc", "fx", "fd"):
+            f_ = res.get(what)
+            k = "s" if what == "fd" else "g"
+            return fmt(f_.p[k], f_.error(k)) if f_ is not None else "not determined"
+        if what == "tau_range":
+            t = [p.mean(tau)[0] for p in res["pts"]]
+            return f"{min(t):.3g} to {max(t):.3g} (φ {res['pts'][0].phi:g}-{res['pts'][-1].phi:g})" if t else "—"
+        if what in ("df_lo", "df_hi"):
+            m = res[what]
+            return fmt(m[0], m[1]) if m else "—"
+    A.driving_table = []
+    for what, lab, paper in (("tau_range", "τ_α range", "grows ~100-fold to φ = 0.805 (fig. Q-t)"),
+                             ("phi_c", "τ_α power law φ_c", "0.82"), ("gamma", "τ_α power law γ", "—"),
+                             ("phi_0", "τ_α VFT φ_0", "0.83"), ("B", "τ_α VFT B", "—"), ("better", "better form", "VFT"),
+                             ("fc", "γχ (χ4(τ_α), own φ_c)", "2.5"), ("fx", "γξ (ξ(τ_α), own φ_c)", "1.6"),
+                             ("fd", "d_f' (χ4 ∝ ξ^d_f')", "1.6"), ("df_lo", "d_f slow, lowest φ", "1.65 (0.60)"),
+                             ("df_hi", "d_f slow, highest φ", "1.91 (0.805)")):
+        A.driving_table.append((lab, paper, cell(out["neighbours"], what), cell(out["any"], what)))

@@ -1,0 +1,140 @@
+"""Per-run quantities at tau_alpha: chi4, xi, chi0, S4, tau4, N*, kappa, and the OZ refit."""
+import math
+
+import numpy as np
+from scipy.optimize import least_squares
+
+from .. import fits as sf
+from .config import A_MAIN
+
+
+def cut(r, a=A_MAIN):
+    return r["cut"][a]
+
+
+def tau(r, a=A_MAIN):
+    c = cut(r, a)
+    return c["tau_alpha"], c["tau_alpha_err"]
+
+
+def proper_subbox(c, N):
+    """Index of the largest sub-box grid smaller than the whole box (or the largest)."""
+    ns = np.asarray(c["chi4_N"], float)
+    ok = np.where(ns < 0.999 * N)[0]
+    return int(ok[np.argmax(ns[ok])]) if len(ok) else int(np.argmax(ns))
+
+
+def tau4_of(r, g):
+    """tau4 of sub-box grid g with its error; NaN where the peak is not
+    interior (the largest chi4 at the first or last lag: a bound, which
+    scales with the lag window, not a peak)."""
+    c = cut(r)
+    if not c["tau4_interior"][g]:
+        return math.nan, math.nan
+    return c["tau4"][g], c["tau4_err"][g]
+
+
+def interior_note(points, g_of):
+    """How many points' runs have an interior tau4 peak (all of their seeds)."""
+    ok = sum(all(cut(r)["tau4_interior"][g_of(r)] for r in p.runs) for p in points)
+    return f"{ok} of {len(points)} points with an interior χ4 peak (the others left out)"
+
+
+def whole_box_s4(c):
+    return int(np.argmax(np.asarray(c["s4_N"], float)))
+
+
+XI_MIN = 0.3   # below this OZ xi, S4 varies by less than 10% over q <= 1: not determined
+
+
+def chi4_at_tau(r, a=A_MAIN, g=None, own=False):
+    """chi4 of cutoff a at tau_alpha of a = 0.6 (own: at cutoff a's own tau_alpha)."""
+    c = cut(r, a)
+    t = tau(r, a if own else A_MAIN)[0]
+    if g is None:
+        g = proper_subbox(c, r["N"])
+    v, ie = sf.interp_ln_t(c["chi4_lag"], c["chi4"][g], t)
+    _, e = sf.interp_ln_t(c["chi4_lag"], c["chi4_err"][g], t)
+    return v, math.hypot(e, ie if np.isfinite(ie) else 0.0)
+
+
+def xi_at_tau(r, a=A_MAIN, own=False):
+    """The whole box's OZ xi of cutoff a at tau_alpha (of a = 0.6, or own);
+    NaN where it is below XI_MIN (S4 flat over the q range) or longer than
+    the box."""
+    c = cut(r, a)
+    t = tau(r, a if own else A_MAIN)[0]
+    g = whole_box_s4(c)
+    off = int(np.sum(c["s4_nshells"][:g]))
+    q = c["s4_q"][off:off + int(c["s4_nshells"][g])]
+    box = 2 * math.pi / q[q > 0].min()   # the box: no longer xi can be measured in it
+    xi = c["xi_t"][:, g]
+    xs = np.where((xi >= XI_MIN) & (xi <= box), xi, np.nan)
+    v, ie = sf.interp_ln_t(c["s4_lag"], xs, t)
+    rel = c["s4_oz_xi_err"][g] / c["s4_oz_xi"][g] if np.isfinite(c["s4_oz_xi"][g]) and c["s4_oz_xi"][g] > 0 else math.nan
+    return v, math.hypot(abs(v) * rel if np.isfinite(rel) else math.nan, ie if np.isfinite(ie) else 0.0)
+
+
+def chi0_at_tau(r, a=A_MAIN, g=None):
+    c = cut(r, a)
+    t = tau(r)[0]
+    if g is None:
+        g = whole_box_s4(c)
+    v, ie = sf.interp_ln_t(c["s4_lag"], c["chi0_t"][:, g], t)
+    rel = c["s4_oz_chi0_err"][g] / c["s4_oz_chi0"][g] if c["s4_oz_chi0"][g] > 0 else math.nan
+    return v, math.hypot(abs(v) * rel if np.isfinite(rel) else math.nan, ie if np.isfinite(ie) else 0.0)
+
+
+def s4_at_tau(r, a=A_MAIN, g=None):
+    """(q, S4) of grid g (default the whole box) at tau_alpha, q = 0 left out."""
+    c = cut(r, a)
+    if g is None:
+        g = whole_box_s4(c)
+    off = int(np.sum(c["s4_nshells"][:g]))
+    n = int(c["s4_nshells"][g])
+    q = c["s4_q"][off:off + n]
+    t = tau(r)[0]
+    s = np.array([sf.interp_ln_t(c["s4_lag"], c["s4_t"][:, off + k], t)[0] for k in range(n)])
+    m = q > 0
+    return q[m], s[m]
+
+
+def n_star(r, a=A_MAIN):
+    """The slow-cluster cutoff size: <N_c^2>/<N_c> of P(N_c)."""
+    c = cut(r, a)
+    p, n, w = c["cl_p_slow"], c["cl_size"], c["cl_width"]
+    m = np.isfinite(p)
+    s1, s2 = np.sum((p * n * w)[m]), np.sum((p * n * n * w)[m])
+    return (s2 / s1 if s1 > 0 else math.nan), math.nan
+
+
+KAPPA_LO = (1.0, 3.0, 10.0)   # lower bounds of the kappa fit scanned (monomers in or out)
+
+
+def kappa_of(r, lo=3.0, a=A_MAIN):
+    """kappa of slow clusters: P(N_c) ~ N_c^-kappa fitted to the bins with
+    lo <= N_c <= N* (the run's cutoff size <N_c^2>/<N_c>: beyond it the
+    scaling function cuts the power law off), weighted by the bins' errors;
+    NaN with fewer than 3 bins."""
+    c = cut(r, a)
+    if "cl_size" not in c:
+        return math.nan, math.nan
+    p, pe, n = c["cl_p_slow"], c["cl_p_slow_err"], c["cl_size"]
+    ns = n_star(r, a)[0]
+    m = np.isfinite(p) & (p > 0) & np.isfinite(pe) & (pe > 0) & (n >= lo) & (n <= ns)
+    if m.sum() < 3:
+        return math.nan, math.nan
+    f = sf.power(n[m], p[m], pe[m])
+    return (-f.p["s"], f.err["s"]) if f.ok else (math.nan, math.nan)
+
+
+def oz_fit(q, s, q_max):
+    """S4 = chi0/(1 + (q xi)^2) over 0 < q <= q_max, relative residuals (as the node)."""
+    from scipy.optimize import least_squares
+    m = (q > 0) & (q <= q_max) & np.isfinite(s) & (s > 0)
+    if m.sum() < 3:
+        return math.nan, math.nan
+    qq, ss = q[m], s[m]
+    res = least_squares(lambda p: (p[0] / (1 + (qq * p[1]) ** 2) - ss) / ss, [ss[0] * 1.2, 2.0],
+                        bounds=([0, 0], [np.inf, 1e4]))
+    return float(res.x[0]), float(res.x[1])

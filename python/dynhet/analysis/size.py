@@ -1,0 +1,104 @@
+"""Finite size: tau_alpha and D (with theta) against N at densities run at several N."""
+import math
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from .. import fits as sf
+from .config import EPS_MAIN
+from .points import fit_series, point_error
+from .quantities import tau
+from .verdicts import fmt
+from .plotting import colours, log_axes
+
+
+def points_by_phi_n(A, has=lambda p: True):
+    """{phi: {N: Point}} of the main dynamics over this study and the --also
+    studies, the point with most runs where several have the same phi and N;
+    only densities run at more than one N."""
+    allp = [p for p in list(A.points.values()) + list(A.extra.values())
+            if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p)]
+    by_phi = {}
+    for p in allp:
+        by_phi.setdefault(p.phi, {})
+        q = by_phi[p.phi].get(p.N)
+        if q is None or len(p.runs) > len(q.runs):
+            by_phi[p.phi][p.N] = p
+    return {phi: d for phi, d in sorted(by_phi.items()) if len(d) > 1}
+
+
+def d_n_results(A):
+    """D against N at each density run at several N, and theta of
+    D ~ tau_alpha^-theta at each N over the densities it has (studies/d_size.toml):
+    in two dimensions box-scale flows carry part of D and may make both
+    depend on the box (issue 31, item 8)."""
+    dD = lambda r: (r.get("D", math.nan), r.get("D_err", math.nan))
+    multi = points_by_phi_n(A, lambda p: np.isfinite(p.mean(dD)[0]))
+    if not multi:
+        A.row("D against N (box-scale flows)", "3.2 (D, θ)", "not studied",
+              "one N per density (add studies/d_size.toml with --also)", "not run", "", [])
+        return
+    fig, ax = plt.subplots(1, 2, figsize=(11, 4.2))
+    cells, used = [], []
+    for (phi, d), col in zip(multi.items(), colours(len(multi))):
+        ns = sorted(d)
+        vals = [d[n].mean(dD) for n in ns]
+        ax[0].errorbar(ns, [v[0] for v in vals], [point_error(v) for v in vals], fmt="o-", color=col, label=f"φ = {phi:g}")
+        cells.append(f"φ {phi:g}: " + ", ".join(f"{fmt(v[0], point_error(v))} (N {n})" for n, v in zip(ns, vals)))
+        used += list(d.values())
+    log_axes(ax[0], "N", "D", "D against the number of particles")
+    # theta at each N from the densities that N has
+    per_n = {}
+    for d in multi.values():
+        for n, p in d.items():
+            per_n.setdefault(n, []).append(p)
+    th = {}
+    for n, pts in sorted(per_n.items()):
+        if len(pts) >= 3:
+            f = A.fit(f"D_tau_N{n}", fit_series(sorted(pts, key=lambda p: p.phi), dD, sf.power, xrun=tau))
+            if f.ok:
+                th[n] = (-f.p["s"], f.error("s"), len(pts))
+    if th:
+        ns = sorted(th)
+        ax[1].errorbar(ns, [th[n][0] for n in ns], [th[n][1] for n in ns], fmt="o-", color="k")
+    ax[1].set_xscale("log")
+    ax[1].set_xlabel("N")
+    ax[1].set_ylabel("θ (D ∝ τ_α^-θ over the densities run)")
+    ax[1].set_title("θ against N")
+    f = A.save(fig, "D_N.png")
+    A.row("D against N (box-scale flows)", "3.2 (D, θ)", "not studied", "; ".join(cells), "figure", f, used)
+    if len(th) >= 2:
+        ns = sorted(th)
+        lo, hi = th[ns[0]], th[ns[-1]]
+        z = abs(hi[0] - lo[0]) / math.hypot(lo[1], hi[1]) if np.isfinite(math.hypot(lo[1], hi[1])) else math.nan
+        A.row("θ against N (D ∝ τ_α^-θ at each N)", "3.2, fig. D-vs-tau", "not studied",
+              ", ".join(f"N {n}: {fmt(th[n][0], th[n][1])} ({th[n][2]} φ)" for n in ns),
+              ("moves with N" if z > 2 else "no change with N resolved") + f" ({z:.1f} σ from N {ns[0]} to {ns[-1]})"
+              if np.isfinite(z) else "not determined", f, used)
+
+
+def tau_n_results(A):
+    """tau_alpha against N at each density run at several N (this study's
+    points and those of --also studies with the same dynamics)."""
+    multi = points_by_phi_n(A)
+    if not multi:
+        A.row("τ_α against N (finite size)", "2 (N = 3.6 x 10^5 to 4 x 10^6)", "not studied",
+              "one N per density in this study (add one with --also, e.g. studies/finite_size.toml)", "not run", "", [])
+        return
+    fig, ax = plt.subplots(figsize=(6, 4.5))
+    cells, used = [], []
+    for (phi, d), col in zip(multi.items(), colours(len(multi))):
+        ns = sorted(d)
+        vals = [d[n].mean(tau) for n in ns]
+        ax.errorbar(ns, [v[0] for v in vals], [v[1] for v in vals], fmt="o-", color=col, label=f"φ = {phi:g}")
+        cells.append(f"φ {phi:g}: " + ", ".join(f"{fmt(v[0], v[1])} (N {n}, {d[n].mean(tau)[3]} seed{'s' if d[n].mean(tau)[3] > 1 else ''})"
+                                                 for n, v in zip(ns, vals)))
+        used += list(d.values())
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("N")
+    ax.set_ylabel("τ_α (ε = 0.9, a = 0.6)")
+    ax.legend(fontsize=8)
+    ax.set_title("τ_α against the number of particles")
+    f = A.save(fig, "tau_alpha_N.png")
+    A.row("τ_α against N (finite size)", "2 (N = 3.6 x 10^5 to 4 x 10^6)", "not studied", "; ".join(cells), "figure", f, used)

@@ -1,0 +1,106 @@
+"""A study's complete runs as points (and those of --also studies), with the table rows and fits made of them."""
+import os
+import tomllib
+
+import matplotlib.pyplot as plt
+
+from .config import A_MAIN, EPS_MAIN
+from .runs import read_run
+from .points import Point
+
+
+class Analysis:
+    def __init__(self, d, also=()):
+        """d: the study; also: other study directories whose runs add points
+        (finite size, longer lags) without entering the study's own series."""
+        self.dir = os.path.abspath(d)
+        self.points = {}      # the study's own points: (pairs, eps, phi, N) -> Point
+        self.extra = {}       # the other studies' points: (study, pairs, eps, phi, N) -> Point
+        self.skipped = []
+        self.cpu = {}
+        self.pilot_cpu = 0.0
+        self.also = [os.path.abspath(x) for x in also]
+        for k, sd in enumerate([d] + list(also)):
+            self.read_study(sd, primary=(k == 0))
+        self.fits = {}
+        self.rows = []
+        self.figdir = os.path.join(self.dir, "figures")
+        os.makedirs(self.figdir, exist_ok=True)
+
+    def read_study(self, d, primary):
+        sdir = os.path.abspath(d)
+        idx = os.path.join(sdir, "index.toml")
+        if not os.path.exists(idx):
+            raise SystemExit(f"analyse_study: {idx} does not exist: is {d} a study directory (run_study.sh --out)?")
+        with open(idx, "rb") as fh:
+            runs = tomllib.load(fh).get("runs", {})
+        study = os.path.basename(sdir.rstrip("/"))
+        for name, m in sorted(runs.items()):
+            path = os.path.join(sdir, m["path"], "run.h5")
+            if m.get("state") != "complete" or not os.path.exists(path):
+                self.skipped.append((name, m.get("state", "?")))
+                continue
+            try:
+                r = read_run(path, m)
+            except (OSError, KeyError, ValueError) as e:
+                self.skipped.append((name, f"unreadable: {e}"))
+                continue
+            if r["complete"] != 1 or A_MAIN not in r["cut"]:
+                self.skipped.append((name, "run.h5 not complete" if r["complete"] != 1 else f"no cutoff a = {A_MAIN}"))
+                continue
+            r["name"], r["path"], r["study"] = name, path, study
+            key = (m.get("pairs", "neighbours"), float(m["restitution"]), float(m["packing_fraction"]), int(m["n_particles"]))
+            if primary:
+                self.points.setdefault(key, Point(key)).runs.append(r)
+                self.cpu[key] = self.cpu.get(key, 0.0) + float(m.get("cpu_s", 0.0))
+            else:
+                pt = self.extra.setdefault((study,) + key, Point(key))
+                pt.study = study
+                pt.runs.append(r)
+                self.cpu[(study,) + key] = self.cpu.get((study,) + key, 0.0) + float(m.get("cpu_s", 0.0))
+        if primary:
+            for root, _, files in os.walk(os.path.join(sdir, "pilots")):
+                if "status.toml" in files:
+                    with open(os.path.join(root, "status.toml"), "rb") as fh:
+                        self.pilot_cpu += float(tomllib.load(fh).get("cpu_s", 0.0))
+        self.study_name = getattr(self, "study_name", study)
+
+    # -- selections
+    def series(self, pairs="neighbours", eps=EPS_MAIN, N=None):
+        """The points of one (pairs, eps) series, one per density: at a density
+        run at several N, the largest (or N if given)."""
+        by_phi = {}
+        for k, p in self.points.items():
+            if k[0] == pairs and abs(k[1] - eps) < 1e-9 and (N is None or k[3] == N):
+                if p.phi not in by_phi or p.N > by_phi[p.phi].N:
+                    by_phi[p.phi] = p
+        return [by_phi[phi] for phi in sorted(by_phi)]
+
+    def restitutions(self, pairs="neighbours"):
+        return sorted({k[1] for k in self.points if k[0] == pairs}, reverse=True)
+
+    def cpu_of(self, pts):
+        return sum(self.cpu.get(((p.study,) if getattr(p, "study", None) else ()) + (p.pairs, p.eps, p.phi, p.N), 0.0)
+                   for p in pts)
+
+    def nearest(self, pts, phi):
+        return min(pts, key=lambda p: abs(p.phi - phi)) if pts else None
+
+    def save(self, fig, name):
+        path = os.path.join(self.figdir, name)
+        for ax in fig.axes:
+            if not ax.has_data():
+                ax.set_xscale("linear")
+                ax.set_yscale("linear")
+                ax.text(0.5, 0.5, "no data in this study", ha="center", transform=ax.transAxes)
+        fig.savefig(path, dpi=110, bbox_inches="tight")
+        plt.close(fig)
+        return os.path.relpath(path, self.dir)
+
+    def row(self, item, section, paper, ours, verdict, figure, pts, note=""):
+        self.rows.append(dict(item=item, section=section, paper=paper, ours=ours, verdict=verdict, figure=figure,
+                              cpu=self.cpu_of(pts), note=note))
+
+    def fit(self, name, f):
+        self.fits[name] = f
+        return f
