@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Each cross-run fit of the study analysis (launch_scripts/study_fits.py)
+"""Each cross-run fit of the study analysis (python/dynhet/fits.py)
 against synthetic studies with known parameters: K seeds per point, each
 seed's value the true one times (1 + s * gaussian noise), its quoted error
 s * true value, as a run reports it. The fit with its jackknife error over
