@@ -178,3 +178,9 @@ set_tests_properties(logplayer_full_log PROPERTIES LABELS process TIMEOUT 120)
 add_test(NAME tcpq_hub_death_ends_every_process_cleanly
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/tcpq_hub_death.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(tcpq_hub_death_ends_every_process_cleanly PROPERTIES LABELS process TIMEOUT 120)
+
+# The Python package's own unit tests (pytest, Debian's python3-pytest):
+# the run reader, the study model.
+add_test(NAME python_unit
+  COMMAND /usr/bin/python3 -m pytest -q -p no:cacheprovider ${CMAKE_CURRENT_SOURCE_DIR}/python)
+set_tests_properties(python_unit PROPERTIES LABELS unit TIMEOUT 120)

@@ -1,4 +1,4 @@
-"""The fits a study analysis makes across runs (analyse_study.py), each with
+"""The fits a study analysis makes across runs (dynhet.analysis), each with
 its range, its quality and an error from independent runs.
 
 Every fit takes points x with values y and standard errors sy (the error of

@@ -97,7 +97,7 @@ def main(argv=None):
         write_table(A, a.table, cmd, a.discussion)
     differ = [r["item"] for r in A.rows if r["verdict"].startswith("differs")]
     say(f"analyse_study: {len(A.rows)} rows, {len(differ)} differ from the paper; {len(A.fits)} fits; "
-        f"study.h5, reproduction.md and {len(os.listdir(A.figdir))} figures in {A.dir} ({time.time() - t0:.1f} s)")
+        f"study.h5, reproduction.md and {(len(os.listdir(A.figdir)) if os.path.isdir(A.figdir) else 0)} figures in {A.dir} ({time.time() - t0:.1f} s)")
     if failed:
         say(f"analyse_study: FAILED: {', '.join(failed)} (the rest is written)")
         return 1

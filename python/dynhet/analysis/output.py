@@ -1,12 +1,11 @@
 """study.h5 and the reproduction table."""
-import math
 import os
 import time
 
 import h5py
 import numpy as np
 
-from .quantities import chi0_at_tau, chi4_at_tau, cut, kappa_of, n_star, tau, xi_at_tau
+from .quantities import PER_RUN, chi4_at_tau, cut, tau, xi_at_tau
 from .verdicts import fmt
 from .config import CONVENTIONS
 
@@ -18,23 +17,12 @@ def write_h5(A, path):
         f.attrs["created"] = time.strftime("%Y-%m-%dT%H:%M:%S")
         f.attrs["conventions"] = CONVENTIONS.strip()
         pg = f.create_group("points")
-        per_run = {"tau_alpha": tau, "beta": lambda r: (cut(r)["beta"], cut(r)["beta_err"]),
-                   "tau0": lambda r: (cut(r)["tau0"], cut(r)["tau0_err"]), "D": lambda r: (r["D"], r["D_err"]),
-                   "Z": lambda r: (r["Z"], r["Z_err"]), "chi4_tau_alpha": chi4_at_tau, "xi_tau_alpha": xi_at_tau,
-                   "chi0_tau_alpha": chi0_at_tau,
-                   "d_f_slow": lambda r: (cut(r)["cl_slow_d_f"], cut(r)["cl_slow_d_f_err"]),
-                   "d_f_fast": lambda r: (cut(r)["cl_fast_d_f"], cut(r)["cl_fast_d_f_err"]),
-                   "kappa_slow": kappa_of,
-                   "kappa_slow_node": lambda r: (cut(r)["cl_slow_kappa"], cut(r)["cl_slow_kappa_err"]),
-                   "n_star_slow": n_star,
-                   "cluster_lag_over_tau_alpha": lambda r: (cut(r)["cl_lag"] / cut(r)["tau_alpha"], math.nan),
-                   "s4_lag_over_tau_alpha": lambda r: (cut(r)["s4_t_s4"] / cut(r)["tau_alpha"], math.nan)}
         for key, p in sorted(A.points.items()):
             g = pg.create_group(f"{p.pairs}_eps{p.eps:g}_phi{p.phi:g}_n{p.N}")
             g.attrs.update(pairs=p.pairs, restitution=p.eps, packing_fraction=p.phi, n_particles=p.N,
                            seeds=np.array([r["seed"] for r in p.runs]), runs=",".join(r["name"] for r in p.runs),
                            cpu_s=A.cpu.get(key, 0.0))
-            for name, fn in per_run.items():
+            for name, fn in PER_RUN.items():
                 vals = p.values(fn)
                 m, e, sem, n = p.mean(fn)
                 d = g.create_dataset(name, data=np.array([[v, q] for _, v, q in vals], float))

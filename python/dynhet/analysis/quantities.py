@@ -138,3 +138,18 @@ def oz_fit(q, s, q_max):
     res = least_squares(lambda p: (p[0] / (1 + (qq * p[1]) ** 2) - ss) / ss, [ss[0] * 1.2, 2.0],
                         bounds=([0, 0], [np.inf, 1e4]))
     return float(res.x[0]), float(res.x[1])
+
+
+# The per-run quantities by name, each run -> (value, error): what study.h5
+# records per point and what Analysis.against_phi gives.
+PER_RUN = {"tau_alpha": tau, "beta": lambda r: (cut(r)["beta"], cut(r)["beta_err"]),
+           "tau0": lambda r: (cut(r)["tau0"], cut(r)["tau0_err"]), "D": lambda r: (r["D"], r["D_err"]),
+           "Z": lambda r: (r["Z"], r["Z_err"]), "chi4_tau_alpha": chi4_at_tau, "xi_tau_alpha": xi_at_tau,
+           "chi0_tau_alpha": chi0_at_tau,
+           "d_f_slow": lambda r: (cut(r)["cl_slow_d_f"], cut(r)["cl_slow_d_f_err"]),
+           "d_f_fast": lambda r: (cut(r)["cl_fast_d_f"], cut(r)["cl_fast_d_f_err"]),
+           "kappa_slow": kappa_of,
+           "kappa_slow_node": lambda r: (cut(r)["cl_slow_kappa"], cut(r)["cl_slow_kappa_err"]),
+           "n_star_slow": n_star,
+           "cluster_lag_over_tau_alpha": lambda r: (cut(r)["cl_lag"] / cut(r)["tau_alpha"], math.nan),
+           "s4_lag_over_tau_alpha": lambda r: (cut(r)["s4_t_s4"] / cut(r)["tau_alpha"], math.nan)}

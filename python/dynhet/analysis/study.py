@@ -3,10 +3,12 @@ import os
 import tomllib
 
 import matplotlib.pyplot as plt
+import numpy as np
 
 from .config import A_MAIN, EPS_MAIN
 from .runs import read_run
-from .points import Point
+from .points import Point, point_error
+from .quantities import PER_RUN
 
 
 class Analysis:
@@ -24,8 +26,7 @@ class Analysis:
             self.read_study(sd, primary=(k == 0))
         self.fits = {}
         self.rows = []
-        self.figdir = os.path.join(self.dir, "figures")
-        os.makedirs(self.figdir, exist_ok=True)
+        self.figdir = os.path.join(self.dir, "figures")  # made by the first figure saved
 
     def read_study(self, d, primary):
         sdir = os.path.abspath(d)
@@ -86,7 +87,20 @@ class Analysis:
     def nearest(self, pts, phi):
         return min(pts, key=lambda p: abs(p.phi - phi)) if pts else None
 
+    def against_phi(self, quantity, pairs="neighbours", eps=EPS_MAIN, N=None):
+        """A per-run quantity (a name of quantities.PER_RUN: tau_alpha, D,
+        chi4_tau_alpha, xi_tau_alpha, d_f_slow, ...) against phi over one
+        series: arrays (phi, mean over seeds, its error, seeds)."""
+        if quantity not in PER_RUN:
+            raise KeyError(f"no quantity {quantity!r}; known: {', '.join(PER_RUN)}")
+        pts = self.series(pairs, eps, N)
+        ms = [p.mean(PER_RUN[quantity]) for p in pts]
+        return (np.array([p.phi for p in pts]), np.array([m[0] for m in ms]), np.array([point_error(m) if m[3] else np.nan
+                                                                                     for m in ms]),
+                np.array([m[3] for m in ms]))
+
     def save(self, fig, name):
+        os.makedirs(self.figdir, exist_ok=True)
         path = os.path.join(self.figdir, name)
         for ax in fig.axes:
             if not ax.has_data():

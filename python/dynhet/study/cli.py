@@ -1,0 +1,107 @@
+"""dynhet studies: a sweep of scenes, run on this machine or on a Slurm
+cluster, resumable. launch_scripts/run_study.sh is the command; this is its
+engine. A run stays what it is (launch_scripts/run_scene.sh: one scene, its
+processes on a private bus, one run.h5); a study only writes scenes, starts
+runs, reads their files and keeps their status on disk.
+
+  study.py run STUDY.toml [--executor local|slurm] [--jobs K] [--out DIR] [--dry-run]
+                          [--partition P] [--time T] [--mem M] [--sbatch ARG]...
+  study.py task DIR NAME      one run of a study directory (what a Slurm task runs)
+  study.py index DIR          write DIR/index.toml from the runs' status files
+
+The study file format is in studies/README.md."""
+import argparse
+import os
+import signal
+import subprocess
+import sys
+
+from .paths import ROOT, SIM
+from .toml_io import toml_dump, write_atomic
+from .model import Study, StudyError
+from .rundir import StudyDir
+from .index import dry_run, plan, write_index
+from .local import analyse, run_local
+from .slurm import run_slurm, task
+
+
+def raise_interrupt(*_):
+    raise KeyboardInterrupt
+
+
+def main():
+    signal.signal(signal.SIGTERM, raise_interrupt)
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    r = sub.add_parser("run")
+    r.add_argument("study")
+    r.add_argument("--executor", choices=["local", "slurm"], default="local")
+    r.add_argument("--jobs", type=int, default=0, help="runs at once (local: default the cores / 2, at least 1; "
+                                                       "slurm: array tasks at once, default no limit)")
+    r.add_argument("--out", help="study directory (default runs/study-<name>)")
+    r.add_argument("--dry-run", action="store_true")
+    r.add_argument("--partition")
+    r.add_argument("--time")
+    r.add_argument("--mem")
+    r.add_argument("--signal-lead", type=float, default=300,
+                   help="slurm: seconds before the time limit at which a task is told to checkpoint and stop "
+                        "(sbatch --signal; a cut needs the sim to reach its next synchronised time), default 300")
+    r.add_argument("--max-requeues", type=int, default=20,
+                   help="slurm: a task interrupted by its time limit goes back in the queue at most this often")
+
+    r.add_argument("--sbatch", action="append", default=[], help="extra sbatch flag, e.g. --sbatch=--qos=long")
+    t = sub.add_parser("task")
+    t.add_argument("dir")
+    t.add_argument("name")
+    i = sub.add_parser("index")
+    i.add_argument("dir")
+    i.add_argument("--analyse", action="store_true", help="then, if every run is complete, the study analysis")
+    a = ap.parse_args()
+    try:
+        if a.cmd == "run":
+            study = Study(a.study)
+            sd = StudyDir(study, a.out or os.path.join(ROOT, "runs", f"study-{study.name}"))
+            if a.dry_run:
+                if os.path.exists(os.path.join(sd.dir, "study.toml")):
+                    sd.claim()
+                check_scenes(sd)
+                dry_run(sd)
+                return 0
+            check_scenes(sd)
+            sd.claim()
+            if a.executor == "local":
+                return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2))
+            return run_slurm(sd, a)
+        sd = StudyDir(Study(os.path.join(a.dir, "study.toml"), os.path.join(a.dir, "base_scene.toml")), a.dir)
+        if a.cmd == "task":
+            return task(sd, a.name)
+        rows = write_index(sd)
+        states = {}
+        for row in rows.values():
+            states[row["state"]] = states.get(row["state"], 0) + 1
+        print(f"study {sd.study.name}: " + ", ".join(f"{v} {k}" for k, v in sorted(states.items())))
+        if set(states) != {"complete"}:
+            return 1
+        return analyse(sd) if a.analyse else 0
+    except StudyError as e:
+        print(f"run_study: {e}", file=sys.stderr)
+        return 2
+
+
+def check_scenes(sd):
+    """Every point's scene through sim_node --check, before anything runs."""
+    problems = []
+    tmp = os.path.join("/tmp", f"dynhet-study-check-{os.getpid()}.toml")
+    try:
+        for p, sc, *_ in plan(sd):
+            write_atomic(tmp, toml_dump(sc))
+            r = subprocess.run([SIM, tmp, "--check"], capture_output=True, text=True)
+            if r.returncode != 0:
+                msg = " ".join(r.stderr.strip().replace(tmp, "scene").split())
+                problems.append(f"{sd.study.run_name(p)}: {msg}")
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+    if problems:
+        raise StudyError(f"{sd.study.path}: {len(problems)} of the study's scenes would be refused:\n  " +
+                         "\n  ".join(problems))

@@ -1,0 +1,70 @@
+"""The study's index (index.toml), its plan and the dry run."""
+import os
+
+from .toml_io import toml_value, write_atomic
+from .model import AXES
+from .estimates import estimate, fmt_time
+from .rundir import read_status
+
+
+def write_index(sd):
+    rows = {}
+    for p in sd.study.points():
+        st = read_status(sd.run_dir(p))
+        row = {a: p[a] for a in AXES}
+        row["path"] = os.path.relpath(sd.run_dir(p), sd.dir)
+        row["state"] = st.get("state", "pending")
+        for k in ("tau_estimate", "tau_source", "tau_alpha", "wall_s", "cpu_s", "attempts", "requeues", "message"):
+            if k in st:
+                row[k] = st[k]
+        rows[sd.study.run_name(p)] = row
+    text = [f"# dynhet study index: {sd.study.name} ({sd.study.path}); one table per run", ""]
+    for name, row in rows.items():
+        text.append(f'[runs."{name}"]')
+        text += [f"{k} = {toml_value(v)}" for k, v in row.items()]
+        text.append("")
+    write_atomic(os.path.join(sd.dir, "index.toml"), "\n".join(text))
+    return rows
+
+
+def plan(sd):
+    """[(point, scene, tau, source, state)] with times from the estimates known now (nothing started)."""
+    out = []
+    for p in sd.study.points():
+        st = read_status(sd.run_dir(p))
+        if sd.study.run_length["tau_alpha"] == "scene":
+            tau, src = None, "scene"
+        elif st.get("tau_estimate") and st.get("state") != "too_short":
+            tau, src = st["tau_estimate"], st.get("tau_source", "?")
+        else:
+            tau, src = sd.guess(p)
+            src = f"guess: {src}" + ("; a pilot will measure it" if sd.study.run_length["tau_alpha"] == "pilot" else "")
+        out.append((p, sd.study.scene(p, tau), tau, src, st.get("state", "pending")))
+    return out
+
+
+def nodes_of(sc):
+    comp = sc.get("observables", {}).get("compute", ["overlap"])
+    return len({("overlap" if c in ("chi4", "msd", "displacement") else c) for c in comp})
+
+
+def dry_run(sd):
+    rows = plan(sd)
+    print(f"# study {sd.study.name}: {len(rows)} runs; times from the tau_alpha estimates known now; "
+          "CPU time from the engine's measured speed (docs/engine.md)")
+    print(f"{'run':44s} {'state':9s} {'N':>8s} {'tau_est':>9s} {'t_equil':>9s} {'t_prod':>9s} "
+          f"{'cpu':>9s} {'memory':>8s}  tau from")
+    tot_cpu = left_cpu = 0.0
+    peak = 0.0
+    for p, sc, tau, src, state in rows:
+        cpu, mem = estimate(sc, nodes_of(sc))
+        sch = sc.get("schedule", {})
+        prod = (int(sch.get("origins", 10)) - 1) * float(sch.get("origin_spacing", 10)) + float(sch.get("lag_max", 100))
+        tot_cpu += cpu
+        left_cpu += 0 if state == "complete" else cpu
+        peak = max(peak, mem)
+        print(f"{sd.study.run_name(p):44s} {state:9s} {sc['system']['n_particles']:8d} "
+              f"{(f'{tau:.4g}' if tau else '-'):>9s} {sc.get('run', {}).get('equilibration_time', 100):9.4g} "
+              f"{prod:9.4g} {fmt_time(cpu):>9s} {mem / 2**20:7.0f}M  {src}")
+    print(f"# total CPU {fmt_time(tot_cpu)} ({tot_cpu / 3600:.2f} CPU-hours), left {fmt_time(left_cpu)}; "
+          f"largest run {peak / 2**20:.0f} MiB (pilots not counted)")

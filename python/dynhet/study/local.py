@@ -1,0 +1,119 @@
+"""The local executor: a pool of runs on this machine, with progress; the analysis when all are done."""
+import os
+import subprocess
+import sys
+import threading
+import time
+
+from .paths import ROOT
+from .model import AXES, StudyError, StudyInterrupted
+from .estimates import estimate, fmt_time
+from .rundir import read_status, write_status
+from .children import STOPPING, stop_children
+from .runner import do_run
+from .index import nodes_of, plan, write_index
+
+
+def run_local(sd, jobs):
+    points = [p for p in sd.study.points()]
+    todo = [p for p in points if read_status(sd.run_dir(p)).get("state") != "complete"]
+    done0 = len(points) - len(todo)
+    if done0:
+        print(f"study {sd.study.name}: {done0} of {len(points)} runs complete already (skipped)", flush=True)
+    if sd.study.run_length["tau_alpha"] == "interpolate":  # low phi first: the rest interpolate from them
+        todo.sort(key=lambda p: p["packing_fraction"])
+    est = {sd.study.run_name(p): estimate(sc, nodes_of(sc))[0] for p, sc, *_ in plan(sd)}
+    lock = threading.Lock()
+    state = {"done": done0, "failed": 0, "running": 0, "left": len(todo), "cpu_done": 0.0, "est_done": 0.0}
+    queue = list(todo)
+    failures = []
+    t_start = time.time()
+
+    def say(msg):
+        with lock:
+            print(msg, flush=True)
+
+    def progress():
+        with lock:
+            left_est = sum(est[sd.study.run_name(p)] for p in queue)
+            ratio = state["cpu_done"] / state["est_done"] if state["est_done"] > 0 else 1.0
+            eta = ratio * left_est / max(1, jobs)
+            print(f"[{fmt_time(time.time() - t_start)}] study {sd.study.name}: {state['done']} done, "
+                  f"{state['running']} running, {state['left']} left, {state['failed']} failed; "
+                  f"ETA {fmt_time(eta)} (queued runs, estimated)", flush=True)
+
+    def worker():
+        while True:
+            with lock:
+                if not queue or STOPPING.is_set():
+                    return
+                p = queue.pop(0)
+                state["left"] -= 1
+                state["running"] += 1
+            name = sd.study.run_name(p)
+            try:
+                st = do_run(sd, p, say)
+            except StudyError as e:
+                st = {"state": "failed", "message": str(e)}
+                write_status(sd.run_dir(p), dict(st, **{a: p[a] for a in AXES}))
+            except StudyInterrupted as e:
+                st = {"state": "interrupted", "message": str(e)}
+                write_status(sd.run_dir(p), dict(st, **{a: p[a] for a in AXES}))
+            except OSError as e:
+                # A program that cannot be started (a build replacing it
+                # meanwhile, a full disk): this run failed, the study goes on
+                # (the same command again reruns it).
+                st = {"state": "failed", "message": f"{type(e).__name__}: {e}"}
+                write_status(sd.run_dir(p), dict(st, **{a: p[a] for a in AXES}))
+            with lock:
+                state["running"] -= 1
+                if st.get("state") == "complete":
+                    state["done"] += 1
+                    state["cpu_done"] += st.get("cpu_s", 0.0)
+                    state["est_done"] += est.get(name, 0.0)
+                elif st.get("state") == "interrupted":
+                    state["left"] += 1
+                    continue
+                else:
+                    state["failed"] += 1
+                    failures.append((name, st.get("message", "")))
+            say(f"{name}: {st.get('state')}" + (f", tau_alpha {st['tau_alpha']:.4g}" if st.get("tau_alpha") else "")
+                + (f" ({st.get('message')})" if st.get("state") != "complete" else ""))
+            write_index(sd)
+            progress()
+
+    progress()
+    threads = [threading.Thread(target=worker, daemon=True) for _ in range(max(1, jobs))]
+    for t in threads:
+        t.start()
+    try:
+        while any(t.is_alive() for t in threads):
+            time.sleep(0.5)
+    except KeyboardInterrupt:
+        say(f"study {sd.study.name}: stopping the runs (each writes a checkpoint)")
+        stop_children()
+        for t in threads:
+            t.join(timeout=30)
+        write_index(sd)
+        say(f"study {sd.study.name}: interrupted; run the same command again to resume")
+        return 130
+    write_index(sd)
+    print(f"study {sd.study.name}: {state['done']} of {len(points)} runs complete, {state['failed']} failed "
+          f"in {fmt_time(time.time() - t_start)} -> {sd.dir}/index.toml", flush=True)
+    for name, msg in failures:
+        print(f"  failed: {name}: {msg}", flush=True)
+    if state["failed"]:
+        return 1
+    return analyse(sd)
+
+
+def analyse(sd):
+    """The study analysis (analyse_study.py) once every run is complete:
+    study.h5, figures/ and reproduction.md in the study directory."""
+    script = os.path.join(ROOT, "launch_scripts", "analyse_study.py")
+    print(f"study {sd.study.name}: analysing ({os.path.relpath(script, ROOT)} {sd.dir})", flush=True)
+    rc = subprocess.run([sys.executable, script, sd.dir]).returncode
+    if rc:
+        print(f"study {sd.study.name}: the analysis failed (exit {rc}); the runs are complete, "
+              f"run launch_scripts/analyse_study.sh {sd.dir} again after a fix", flush=True)
+    return 1 if rc else 0

@@ -1,0 +1,126 @@
+"""A study directory on disk: status files, a run's result, the lock, tau_alpha from finished runs."""
+import math
+import os
+import subprocess
+import threading
+import tomllib
+
+from .toml_io import read_toml, toml_dump, write_atomic
+from .model import StudyError
+
+
+def read_status(d):
+    p = os.path.join(d, "status.toml")
+    if not os.path.exists(p):
+        return {}
+    try:
+        return read_toml(p)
+    except tomllib.TOMLDecodeError:
+        return {"state": "unknown"}
+
+
+def write_status(d, st):
+    write_atomic(os.path.join(d, "status.toml"), toml_dump(st, "# dynhet study run status (run_study.sh reads it)"))
+
+
+def run_h5_result(path, cutoff):
+    """(complete, tau_alpha) of a run.h5."""
+    out = subprocess.run(
+        ["/usr/bin/python3", "-c",
+         "import h5py,sys,math\n"
+         "f=h5py.File(sys.argv[1],'r')\n"
+         "c=int(f.attrs.get('complete',0))\n"
+         "g=f.get('observables/overlap/a'+sys.argv[2])\n"
+         "t=float(g['tau_alpha/value'][-1]) if g is not None else float('nan')\n"
+         "print(c, t)", path, f"{cutoff:g}"],
+        capture_output=True, text=True)
+    if out.returncode != 0:
+        return 0, float("nan")
+    c, t = out.stdout.split()
+    return int(c), float(t)
+
+
+class StudyDir:
+    def __init__(self, study, out):
+        self.study = study
+        self.dir = os.path.abspath(out)
+        self.runs_dir = os.path.join(self.dir, "runs")
+        self.lock = threading.Lock()
+
+    def claim(self):
+        """Create the directory or check it holds this very study."""
+        os.makedirs(self.runs_dir, exist_ok=True)
+        copy_path = os.path.join(self.dir, "study.toml")
+        base_path = os.path.join(self.dir, "base_scene.toml")
+        base_text = toml_dump(self.study.base, "# the study's base scene, as read when the study started")
+        if os.path.exists(copy_path):
+            if open(copy_path, "rb").read() != self.study.text:
+                raise StudyError(f"{self.study.path} differs from the study that {self.dir} holds "
+                                 f"({copy_path}): a changed study is never mixed into old runs; "
+                                 "give another --out, or restore the study file")
+            if os.path.exists(base_path) and open(base_path).read() != base_text:
+                raise StudyError(f"the base scene of {self.study.path} changed since {self.dir} was started "
+                                 f"({base_path} holds the old one): give another --out, or restore the scene")
+        else:
+            with open(copy_path, "wb") as f:
+                f.write(self.study.text)
+        if not os.path.exists(base_path):
+            write_atomic(base_path, base_text)
+
+    def run_dir(self, p):
+        return os.path.join(self.runs_dir, self.study.run_name(p))
+
+    def finished_taus(self, p):
+        """(phi, tau_alpha) of complete runs and pilots of p's series."""
+        pts = []
+        key = self.study.series_key(p)
+        for q in self.study.points():
+            if self.study.series_key(q) != key:
+                continue
+            st = read_status(self.run_dir(q))
+            if st.get("state") == "complete" and math.isfinite(st.get("tau_alpha", float("nan"))):
+                pts.append((q["packing_fraction"], st["tau_alpha"]))
+        pdir = os.path.join(self.dir, "pilots")
+        if os.path.isdir(pdir):
+            for name in os.listdir(pdir):
+                st = read_status(os.path.join(pdir, name))
+                if st.get("state") == "complete" and tuple(st.get("series", [])) == (
+                        key[0], key[1], key[2]):
+                    pts.append((st["packing_fraction"], st["tau_alpha"]))
+        by_phi = {}
+        for ph, t in pts:
+            by_phi.setdefault(ph, []).append(t)
+        return sorted((ph, math.exp(sum(map(math.log, ts)) / len(ts))) for ph, ts in by_phi.items())
+
+    @staticmethod
+    def interpolate(pts, phi):
+        """ln tau linear in phi between the nearest points (or from the nearest two at the ends)."""
+        if len(pts) < 2:
+            return None
+        for ph, t in pts:
+            if abs(ph - phi) < 1e-12:
+                return t
+        below = [x for x in pts if x[0] < phi]
+        above = [x for x in pts if x[0] > phi]
+        if below and above:
+            a, b = below[-1], above[0]
+        elif below:
+            a, b = below[-2] if len(below) > 1 else below[-1], below[-1]
+        else:
+            a, b = above[0], above[1]
+        if a[0] == b[0]:
+            return None
+        s = (math.log(b[1]) - math.log(a[1])) / (b[0] - a[0])
+        return math.exp(math.log(a[1]) + s * (phi - a[0]))
+
+    def guess(self, p, finished=True):
+        """A prior guess of tau_alpha: finished points, then the study's tau_guess table, then 1."""
+        t = self.interpolate(self.finished_taus(p), p["packing_fraction"]) if finished else None
+        if t:
+            return t, "interpolated from finished points"
+        g = self.study.run_length["tau_guess"]
+        if len(g) >= 2:
+            return self.interpolate(g, p["packing_fraction"]), "the study's tau_guess"
+        if len(g) == 1:
+            return g[0][1], "the study's tau_guess"
+        return 1.0, "no estimate (1.0)"

@@ -1,0 +1,130 @@
+"""One run of a study: its scene from the run lengths, resumed where it stopped, its status recorded."""
+import math
+import os
+import socket
+import time
+
+from .toml_io import read_toml, toml_dump, write_atomic
+from .model import AXES
+from .rundir import read_status, run_h5_result, write_status
+from .children import RESUMABLE, STOPPING, newest_whole_cut, run_scene
+from .states import equilibrated_state, pid_alive, pilot, prepared_state
+
+
+def do_run(sd, p, log=print):
+    """Runs (or resumes) one run to the end; returns its final status."""
+    st = sd.study
+    d = sd.run_dir(p)
+    os.makedirs(d, exist_ok=True)
+    old = read_status(d)
+    if old.get("state") == "complete":
+        return old
+    rl = st.run_length
+    attempts = int(old.get("attempts", 0))
+    resume = None
+    tau_est, source = old.get("tau_estimate"), old.get("tau_source")
+    if old.get("state") == "running" and old.get("host") == socket.gethostname() and pid_alive(old.get("pid")):
+        return dict(old, state="running", message=f"still running in process {old.get('pid')}")
+    if old.get("state") in ("running", "queued", "interrupted"):
+        ck = os.path.join(d, "checkpoint_before_frames.h5")
+        cut = newest_whole_cut(d)
+        if cut is not None and os.path.exists(os.path.join(d, "scene.toml")):
+            # run_scene.sh on the same directory resumes from the cut itself.
+            resume = "cut"
+            log(f"{st.run_name(p)}: was interrupted; resuming mid-production from checkpoint cut {cut}")
+        elif os.path.exists(ck) and os.path.exists(os.path.join(d, "scene.toml")):
+            resume = ck
+            log(f"{st.run_name(p)}: was interrupted; resuming from {ck}")
+        elif old.get("state") != "queued" or old.get("started"):
+            log(f"{st.run_name(p)}: was interrupted before its first checkpoint; starting again")
+    elif old.get("state") in ("failed", "too_short", "unknown"):
+        log(f"{st.run_name(p)}: {old.get('state')} before ({old.get('message', '')}); running it again")
+    if resume is None:
+        if rl["tau_alpha"] == "scene":
+            tau_est, source = None, "scene"
+        elif old.get("state") == "too_short" and old.get("tau_alpha"):
+            tau_est, source = 1.3 * old["tau_alpha"], "1.3 x the tau_alpha of the previous, too short attempt"
+        elif rl["tau_alpha"] == "interpolate" and len(sd.finished_taus(p)) >= 2:
+            tau_est, source = sd.guess(p)
+        else:
+            # A short, small pilot scatters by some 10% from the run (seen in
+            # studies/quick.toml): a margin spares most runs a second attempt.
+            tau_est = rl["pilot_margin"] * pilot(sd, p)
+            source = "pilot" if rl["pilot_margin"] == 1.0 else f"pilot x {rl['pilot_margin']:g}"
+        sc = st.scene(p, tau_est)
+        # A lag at the best tau_alpha estimate (the pilot's, or the previous
+        # attempt's, without the margin), for what the paper takes at
+        # tau_alpha (clusters, S4). Measured in studies/seeds.toml it does not
+        # bring them closer: the pilot scatters by as much as the lag spacing
+        # (clusters and S4 at a median 6%, at most 15%, from the run's
+        # tau_alpha either way); a better estimate would.
+        if tau_est is not None:
+            best = tau_est / (rl["pilot_margin"] if source.startswith("pilot") else
+                              1.3 if source.startswith("1.3 x") else 1.0)
+            sch = sc["schedule"]
+            if sch["lag_min"] <= best <= sch["lag_max"]:
+                sch["extra_lags"] = [round(best, 6)]
+        prepared_state(sd, sc)
+        equilibrated_state(sd, sc)
+        write_atomic(os.path.join(d, "scene.toml"),
+                     toml_dump(sc, f"# {st.name}: {st.run_name(p)}; tau_alpha estimate {tau_est} ({source})"))
+    sc = read_toml(os.path.join(d, "scene.toml"))
+    status = {"state": "running", "host": socket.gethostname(), "pid": os.getpid(),
+              "started": time.strftime("%Y-%m-%dT%H:%M:%S"), "attempts": attempts + 1,
+              "tau_source": source or "scene"}
+    if tau_est is not None:
+        status["tau_estimate"] = tau_est
+    for a in AXES:
+        status[a] = p[a]
+    write_status(d, status)
+    if os.environ.get("SLURM_RESTART_COUNT"):
+        status["requeues"] = int(os.environ["SLURM_RESTART_COUNT"])
+    scene_path = os.path.join(d, "scene.toml")
+    cut0 = newest_whole_cut(d)
+    rc, wall, cpu = run_scene(scene_path, d, os.path.join(d, "run_scene.log"), None if resume == "cut" else resume)
+    # A process of the run died (exit 75: resumable): again from the last
+    # whole cut, a few times, before the run counts as failed; twice in a row
+    # without a new whole cut is no transient (a resume that fails the same
+    # way each time) and the run fails, with its log, rather than loop.
+    stuck = 0
+    for _ in range(3):
+        if rc != RESUMABLE or STOPPING.is_set():
+            break
+        cut1 = newest_whole_cut(d)
+        stuck = stuck + 1 if cut1 == cut0 else 0
+        if stuck >= 2:
+            break
+        cut0 = cut1
+        log(f"{st.run_name(p)}: interrupted (a process died); resuming from its last checkpoint cut")
+        rc2, wall2, cpu2 = run_scene(scene_path, d, os.path.join(d, "run_scene.log"))
+        rc, wall, cpu = rc2, wall + wall2, cpu + cpu2
+    if rc == RESUMABLE and not STOPPING.is_set() and newest_whole_cut(d) == cut0:
+        rc = 1  # no progress: a failure, not an interruption
+    complete, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc)) if rc == 0 else (0, float("nan"))
+    status.update({"exit": rc, "wall_s": wall, "cpu_s": cpu, "finished": time.strftime("%Y-%m-%dT%H:%M:%S"),
+                   "tau_alpha": tau})
+    status.pop("pid", None)
+    # A run that finished before the stop reached it is complete: a signal
+    # late in a Slurm task's time must not cost the run its result.
+    if rc == RESUMABLE or (STOPPING.is_set() and rc != 0):
+        status["state"] = "interrupted"
+        status["message"] = ("the study was stopped; run it again to resume" if STOPPING.is_set() else
+                             f"interrupted; run the study again to resume (log {d}/run_scene.log)")
+        status["resumable"] = newest_whole_cut(d) is not None
+        write_status(d, status)
+        return status
+    if rc != 0 or not complete:
+        status["state"] = "failed"
+        status["message"] = f"run_scene exit {rc}, complete {complete}; log {d}/run_scene.log"
+    elif tau_est is not None and not (math.isfinite(tau) and
+                                      sc["run"]["equilibration_time"] >= 0.9 * rl["equilibration_tau"] * tau):
+        status["state"] = "too_short"
+        status["message"] = (f"tau_alpha {tau:.4g} against the estimate {tau_est:.4g}: the equilibration was "
+                             f"under {0.9 * rl['equilibration_tau']:g} tau_alpha")
+    else:
+        status["state"] = "complete"
+    write_status(d, status)
+    if status["state"] == "too_short" and status["attempts"] < rl["max_attempts"] and not STOPPING.is_set():
+        log(f"{st.run_name(p)}: {status['message']}; again with 1.3 tau_alpha")
+        return do_run(sd, p, log)
+    return status

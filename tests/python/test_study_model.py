@@ -1,0 +1,69 @@
+"""dynhet.study.model on study files written here: the points of the
+series with their overrides, each run's scene with run lengths in units of
+its tau_alpha, and every problem of a bad file named at once."""
+import os
+
+import pytest
+
+from dynhet.study.model import Study, StudyError
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+
+GOOD = """
+[study]
+name = "t"
+[scene.system]
+n_particles = 300
+[[series]]
+restitution = [0.9]
+packing_fraction = [0.60, 0.70]
+seed = [1, 2]
+[[series]]
+restitution = [0.8]
+packing_fraction = [0.70]
+seed = [1]
+[[override]]
+when = { packing_fraction = 0.70, restitution = 0.8 }
+set = { system = { n_particles = 1024 } }
+[run_length]
+tau_alpha = "pilot"
+equilibration_tau = 10.0
+origin_spacing_tau = 1.0
+origins = 8
+lag_min_tau = 0.02
+lag_max_tau = 30.0
+"""
+
+
+def study(tmp_path, text):
+    p = tmp_path / "s.toml"
+    p.write_text(text)
+    return Study(str(p), base_scene=os.path.join(ROOT, "scenes", "tiny.toml"))
+
+
+def test_points_overrides_and_run_lengths(tmp_path):
+    s = study(tmp_path, GOOD)
+    pts = s.points()
+    assert len(pts) == 5
+    big = [p for p in pts if p["restitution"] == 0.8]
+    assert len(big) == 1 and big[0]["n_particles"] == 1024          # the override shows in the point
+    assert len({s.run_name(p) for p in pts}) == 5                    # names are unique
+    p = [q for q in pts if q["packing_fraction"] == 0.6 and q["seed"] == 2][0]
+    sc = s.scene(p, tau=2.0)
+    assert sc["system"]["packing_fraction"] == 0.6 and sc["system"]["seed"] == 2
+    assert sc["run"]["equilibration_time"] == 20.0
+    sch = sc["schedule"]
+    assert (sch["origins"], sch["origin_spacing"], sch["lag_min"], sch["lag_max"]) == (8, 2.0, 0.04, 60.0)
+
+
+def test_every_problem_is_named(tmp_path):
+    bad = GOOD.replace('tau_alpha = "pilot"', 'tau_alpha = "guess"').replace("lag_max_tau = 30.0", "lag_max_tau = 0.01") \
+              .replace("[study]", "[study]\ncolour = 1").replace("packing_fraction = 0.70, restitution = 0.8",
+                                                               "packing_fraction = 0.75, restitution = 0.8")
+    with pytest.raises(StudyError) as e:
+        study(tmp_path, bad)
+    msg = str(e.value)
+    assert 'run_length.tau_alpha: value \'guess\' is not allowed' in msg
+    assert "run_length.lag_min_tau: must be smaller than run_length.lag_max_tau" in msg
+    assert "override[0].when.packing_fraction: value 0.75 is not on axis" in msg
+    assert "colour" in msg
