@@ -4,50 +4,15 @@ one curve per sub-box size N, the peak chi4^P at tau4 marked.
 
 Usage: plot_chi4.py RUN.h5 OUT.png
 """
-import math
+import os
 import sys
 
-import h5py
-from plot_common import cli, legend_right, save, tidy_log
-import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
-import numpy as np
+import matplotlib
 
-
-def main(path, png):
-    with h5py.File(path, "r") as f:
-        if "observables/chi4" not in f:
-            print(f"plot_chi4: {path} has no chi4 results", file=sys.stderr)
-            return 1
-        groups = sorted(f["observables/chi4"].items())
-        fig, axes = plt.subplots(1, len(groups), figsize=(7.6 * len(groups), 4.8), squeeze=False,
-                                 layout="constrained")
-        for ax, (name, g) in zip(axes[0], groups):
-            t = g["lag_time"][()]
-            sizes = g["subbox_particles"][()]
-            chi, err = g["chi4"]["value"][-1], g["chi4_err"]["value"][-1]  # [grid][lag]
-            peak, tau4 = g["chi4_peak"]["value"][-1], g["tau4"]["value"][-1]
-            for i, n in enumerate(sizes):
-                line = ax.errorbar(t, chi[i], yerr=np.nan_to_num(err[i]), marker="o", ms=2.5, capsize=2,
-                                   label=f"N = {n:.0f}")
-                if math.isfinite(tau4[i]):
-                    ax.plot([tau4[i]], [peak[i]], "*", ms=10, color=line[0].get_color())
-            ax.set_xscale("log")
-            ax.set_yscale("log")
-            # The data's range down to 1e-3 of the peak: a value near zero
-            # (chi4 of a few origins can nearly vanish) would squash the rest.
-            top = np.nanmax(chi) if np.isfinite(chi).any() else 1.0
-            low = chi[np.isfinite(chi) & (chi > 0)]
-            if low.size and top > 0:
-                ax.set_ylim(max(low.min(), top * 1e-3) / 1.5, top * 2)
-            ax.set_xlabel("t")
-            ax.set_ylabel(r"$\chi_4(t)$")
-            ax.set_title(f"a = {g.attrs.get('cutoff_a', name)} (star: peak at $\\tau_4$)")
-            tidy_log(ax)
-            legend_right(ax, title="sub-boxes of")
-        save(fig, f, png, 110)
-    print(f"plot_chi4: wrote {png}", file=sys.stderr)
-    return 0
-
+matplotlib.use("Agg")  # figures to files: no display needed
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from dynhet.figures.common import cli  # noqa: E402
+from dynhet.figures.chi4 import main  # noqa: E402
 
 if __name__ == "__main__":
     cli(main, __doc__)

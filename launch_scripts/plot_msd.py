@@ -6,48 +6,15 @@ its fit range, and the MSD of the instantaneous fastest (red) and slowest
 
 Usage: plot_msd.py RUN.h5 OUT.png
 """
-import math
+import os
 import sys
 
-import h5py
-from plot_common import cli, legend_right, save, tidy_log
-import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
-import numpy as np
+import matplotlib
 
-
-def main(path, png):
-    with h5py.File(path, "r") as f:
-        if "observables/msd" not in f:
-            print(f"plot_msd: {path} has no MSD results", file=sys.stderr)
-            return 1
-        g = f["observables/msd"]
-        t = g["lag_time"][()]
-        fig, ax = plt.subplots(figsize=(9.6, 5.0), layout="constrained")
-        fractions = {k: float(g.attrs.get(f"fraction_{k}", math.nan)) for k in ("all", "small")}
-        for name, ls in (("all", "-"), ("small", "--")):
-            curves = [(f"msd_{name}", "green", name)]
-            if f"msd_fast_{name}" in g:
-                curves += [(f"msd_{kind}_{name}", colour, f"{kind}est {fractions[name]:.0%} of {name}")
-                           for kind, colour in (("fast", "red"), ("slow", "blue"))]
-            for key, colour, label in curves:
-                ax.errorbar(t, g[key]["value"][-1], yerr=np.nan_to_num(g[key + "_err"]["value"][-1]), ls=ls,
-                            color=colour, marker="o" if name == "all" else "s", ms=2.5, capsize=2, lw=1,
-                            label=label)
-        D = float(g["diffusion"]["value"][-1])
-        t0, t1 = float(g["fit_t_min"]["value"][-1]), float(g["fit_t_max"]["value"][-1])
-        if math.isfinite(D):
-            tt = np.geomspace(t0, t1, 50)
-            ax.plot(tt, 4 * D * tt, "k--", lw=1, label=f"4Dt, D = {D:.4g} (fit {t0:.3g}..{t1:.3g})")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("t")
-        ax.set_ylabel(r"$\Delta(t)$")
-        tidy_log(ax)
-        legend_right(ax)
-        save(fig, f, png, 110)
-    print(f"plot_msd: wrote {png}", file=sys.stderr)
-    return 0
-
+matplotlib.use("Agg")  # figures to files: no display needed
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from dynhet.figures.common import cli  # noqa: E402
+from dynhet.figures.msd import main  # noqa: E402
 
 if __name__ == "__main__":
     cli(main, __doc__)

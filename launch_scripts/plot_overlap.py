@@ -5,64 +5,15 @@ per cutoff a; beside it tau_alpha against the waiting time t0 (aging check).
 
 Usage: plot_overlap.py RUN.h5 OUT.png
 """
-import math
+import os
 import sys
 
-import h5py
-from plot_common import cli, last, legend_below, save, tidy_log
-import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
-import numpy as np
+import matplotlib
 
-
-def main(path, png):
-    with h5py.File(path, "r") as f:
-        if "observables/overlap" not in f:
-            print(f"plot_overlap: {path} has no overlap results", file=sys.stderr)
-            return 1
-        fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 6.0), gridspec_kw={"width_ratios": [3, 2]},
-                                      layout="constrained")
-        for name, g in sorted(f["observables/overlap"].items()):
-            t = g["lag_time"][()]
-            q, err = last(g, "q"), last(g, "q_err")
-            tau, tau_err = last(g, "tau_alpha"), last(g, "tau_alpha_err")
-            a = g.attrs.get("cutoff_a", name)
-            label = f"a = {a}"
-            if math.isfinite(tau):
-                label += rf", $\tau_\alpha$ = {tau:.4g}" + (f" ± {tau_err:.2g}" if math.isfinite(tau_err) else "")
-            line = ax.errorbar(t, q, yerr=np.nan_to_num(err), marker="o", ms=3, capsize=2, label=label)
-            color = line[0].get_color()
-            if math.isfinite(tau):
-                ax.axvline(tau, color=color, ls=":", lw=1)
-            if "beta" in g and math.isfinite(last(g, "beta")):
-                beta, tau0 = last(g, "beta"), last(g, "tau0")
-                tt = np.geomspace(t[0], t[-1], 200)
-                ax.plot(tt, 1 / ((tt / tau0) ** beta + 1), "--", color=color, lw=1,
-                        label=rf"fit $\beta$ = {beta:.3g}, $\tau_0$ = {tau0:.3g}")
-            if "tau_alpha_t0" in g:
-                ax2.plot(g["t0"][()], last(g, "tau_alpha_t0"), "o-", ms=3, color=color, label=label.split(",")[0])
-                if math.isfinite(tau):
-                    ax2.axhline(tau, color=color, ls=":", lw=1)
-        ax.axhline(math.exp(-1), color="gray", ls="--", lw=1, label="1/e")
-        ax.set_xscale("log")
-        ax.set_xlabel("t")
-        ax.set_ylabel("Q(t)")
-        ax.set_ylim(0, 1.05)
-        title = "overlap"
-        if "parameters/system" in f:
-            p = f["parameters/system"].attrs
-            bits = [f"{k}={p[k]}" for k in ("n_particles", "packing_fraction", "restitution") if k in p]
-            title += " (" + ", ".join(bits) + ")"
-        ax.set_title(title)
-        tidy_log(ax)
-        legend_below(ax, ncol=2)
-        ax2.set_xlabel("waiting time $t_0$")
-        ax2.set_ylabel(r"$\tau_\alpha(t_0)$")
-        ax2.set_title("aging check: flat if stationary")
-        ax2.legend()
-        save(fig, f, png, 110)
-    print(f"plot_overlap: wrote {png}", file=sys.stderr)
-    return 0
-
+matplotlib.use("Agg")  # figures to files: no display needed
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from dynhet.figures.common import cli  # noqa: E402
+from dynhet.figures.overlap import main  # noqa: E402
 
 if __name__ == "__main__":
     cli(main, __doc__)

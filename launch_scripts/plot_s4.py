@@ -8,98 +8,15 @@ last panel with xi(t) of the OZ fit of every grid at every computed lag.
 
 Usage: plot_s4.py RUN.h5 OUT.png
 """
-import math
+import os
 import sys
 
-import h5py
-from plot_common import cli, last, legend_below, save, tidy_log
-import matplotlib.pyplot as plt  # after plot_common, which sets the Agg backend
-import numpy as np
+import matplotlib
 
-
-def plot_grid(ax, g, gi, start):
-    """S4(q) of grid gi at t_s4 with both fits and chi4 at the same t."""
-    sizes, sides = g["subbox_particles"][()], g["subbox_per_side"][()]
-    q_all, s4, s4_err = g["q"][()], last(g, "s4"), last(g, "s4_err")
-    sl = slice(start[gi], start[gi + 1])
-    q, s, e = q_all[sl], s4[sl], s4_err[sl]
-    ok = (q > 0) & np.isfinite(s) & (s > 0)
-    ax.errorbar(q[ok], s[ok], yerr=np.nan_to_num(e[ok]), fmt="o", ms=3.5, capsize=2, label="$S_4(q)$")
-    chi4, chi4_err = last(g, "chi4")[gi], last(g, "chi4_err")[gi]
-    qmin = q[ok].min() if ok.any() else 0.1
-    if math.isfinite(chi4):
-        ax.errorbar([qmin / 2], [chi4], yerr=[np.nan_to_num(chi4_err)], fmt="s", color="k", ms=5,
-                    capsize=2, label=rf"$\chi_4$ = {chi4:.3g} at q = 0")
-    missing = []
-    for form, color in (("oz", "C1"), ("a2", "C2")):
-        chi0, xi = last(g, f"{form}_chi0")[gi], last(g, f"{form}_xi")[gi]
-        xi_err, chi0_err = last(g, f"{form}_xi_err")[gi], last(g, f"{form}_chi0_err")[gi]
-        qf = last(g, f"{form}_q_fit_max")[gi]
-        name = "OZ" if form == "oz" else "OZ + $A^2(q\\xi)^4$"
-        if not (math.isfinite(xi) and math.isfinite(chi0)):
-            missing.append(name)
-            continue
-        a = last(g, "a2_a")[gi] if form == "a2" else 0.0
-        qq = np.geomspace(qmin / 2, q.max() if len(q) else 1.0, 100)
-        x2 = (qq * xi) ** 2
-        extra = f", A = {a:.2g}" if form == "a2" else ""
-        ax.plot(qq, chi0 / (1 + x2 + a * a * x2 * x2), "-" if form == "oz" else "--", color=color,
-                label=rf"{name}: $\xi$ = {xi:.3g} ± {xi_err:.2g}, $\chi_0$ = {chi0:.3g} ± {chi0_err:.2g}{extra}")
-        ax.axvline(qf, color=color, lw=0.8, ls=":")
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_xlabel("q")
-    ax.set_ylabel(r"$S_4(q, t_{s4})$")
-    title = f"a = {g.attrs['cutoff_a']:g}: sub-boxes of N = {sizes[gi]:.0f} (m = {sides[gi]})"
-    if missing:
-        title += "\nno fit: " + ", ".join(missing)
-    ax.set_title(title)
-    tidy_log(ax)
-    legend_below(ax)
-
-
-def plot_xi(ax, g):
-    """OZ xi(t) of every grid at every computed lag, t_s4 marked."""
-    sizes, lags = g["subbox_particles"][()], g["lag_time"][()]
-    t_s4, tau_alpha = float(last(g, "t_s4")), float(last(g, "tau_alpha"))
-    xi_lag = last(g, "xi_lag")  # [lag][grid]
-    for gi in range(len(sizes)):
-        ax.plot(lags, xi_lag[:, gi], "o-", ms=3, label=f"sub-boxes of N = {sizes[gi]:.0f}")
-    ax.axvline(t_s4, color="k", lw=0.8, ls=":", label=rf"$t_{{s4}}$ = {t_s4:.3g} ($\tau_\alpha$ = {tau_alpha:.3g})")
-    ax.set_xscale("log")
-    ax.set_xlabel("t")
-    ax.set_ylabel(r"OZ $\xi(t)$")
-    ax.set_title(f"a = {g.attrs['cutoff_a']:g}: OZ $\\xi$ against the lag")
-    tidy_log(ax)
-    legend_below(ax)
-
-
-def main(path, png):
-    with h5py.File(path, "r") as f:
-        if "observables/s4" not in f or len(f["observables/s4"]) == 0:
-            print(f"plot_s4: {path} has no s4 results", file=sys.stderr)
-            return 1
-        groups = sorted(f["observables/s4"].values(), key=lambda g: float(g.attrs["cutoff_a"]))
-        # Per cutoff its grids' panels and the xi(t) panel, at most three a
-        # row (two when there are four): a grid of panels, not a strip.
-        panels = max(len(g["subbox_per_side"]) for g in groups) + 1
-        cols = min(panels, 2 if panels == 4 else 3)
-        rows_per = math.ceil(panels / cols)
-        fig, axes = plt.subplots(rows_per * len(groups), cols, figsize=(5.2 * cols, 5.0 * rows_per * len(groups)),
-                                 squeeze=False, layout="constrained")
-        for k, g in enumerate(groups):
-            block = axes[k * rows_per:(k + 1) * rows_per].ravel()
-            ng = len(g["subbox_per_side"])
-            start = np.concatenate([[0], np.cumsum(g["n_shells"][()])])
-            for gi in range(ng):
-                plot_grid(block[gi], g, gi, start)
-            plot_xi(block[ng], g)
-            for ax in block[ng + 1:]:
-                ax.set_visible(False)
-        save(fig, f, png, 100)
-    print(f"plot_s4: wrote {png}", file=sys.stderr)
-    return 0
-
+matplotlib.use("Agg")  # figures to files: no display needed
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from dynhet.figures.common import cli  # noqa: E402
+from dynhet.figures.s4 import main  # noqa: E402
 
 if __name__ == "__main__":
     cli(main, __doc__)

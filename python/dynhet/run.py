@@ -80,7 +80,10 @@ class Run:
 
     def __init__(self, path):
         self.path = str(path)
-        self._f = h5py.File(self.path, "r")
+        try:
+            self._f = h5py.File(self.path, "r")
+        except OSError as e:
+            raise OSError(f"{self.path}: cannot be read as a run file ({e})") from None
         a = self._f.attrs
         self.complete = int(a.get("complete", 0)) == 1
         self.missing = _text(a.get("missing", ""))

@@ -95,3 +95,10 @@ def test_incomplete_run_says_what_is_missing(tmp_path):
     assert not run.complete and run.missing == "s4 results" and run.observables() == []
     assert math.isnan(run.packing_fraction) and "incomplete: s4 results" in repr(run)
     run.close()
+
+
+def test_a_file_that_is_no_run_is_named(tmp_path):
+    bad = tmp_path / "nothing.h5"
+    bad.write_text("not hdf5")
+    with pytest.raises(OSError, match="nothing.h5: cannot be read as a run file"):
+        dynhet.open_run(bad)

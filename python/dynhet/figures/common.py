@@ -1,13 +1,13 @@
-"""What every plot_<observable>.py shares: matplotlib without a display,
-type sizes legible at 100% (10 pt text, 9 pt ticks and legends, at the
-100-120 dpi the plots are written with), log axes labelled legibly, legends
-below their panel instead of over the data, the newest record of an H5MD
-time series, and the command line (plot_<observable>.py RUN.h5 OUT.png)."""
+"""What every figure of one run shares: type sizes legible at 100% (10 pt
+text, 9 pt ticks and legends, at the 100-120 dpi the plots are written
+with), log axes labelled legibly, legends below their panel instead of over
+the data, saving with an incomplete run marked, and the command line of
+launch_scripts/plot_<observable>.py (RUN.h5 OUT.png)."""
+import os
 import sys
 
 import matplotlib
 
-matplotlib.use("Agg")
 matplotlib.rcParams.update({"font.size": 10, "axes.titlesize": 10, "axes.labelsize": 10, "legend.fontsize": 9,
                             "xtick.labelsize": 9, "ytick.labelsize": 9, "legend.framealpha": 0.9})
 
@@ -46,12 +46,7 @@ def legend_right(ax, **kw):
     return ax.legend(loc="center left", bbox_to_anchor=(1.02, 0.5), frameon=False, **kw)
 
 
-def last(group, name):
-    """The newest record of the time series group/name."""
-    return group[name]["value"][-1]
-
-
-def save(fig, f, png, dpi):
+def save(fig, run, png, dpi):
     """Saves the figure; an incomplete run (the file's `complete` is not 1)
     says so in red across the top, with what is missing. A log axis with
     nothing positive on it (an incomplete run's empty panel) turns linear
@@ -61,9 +56,8 @@ def save(fig, f, png, dpi):
         for scale, hi, setter in ((ax.get_xscale(), lim.x1, ax.set_xscale), (ax.get_yscale(), lim.y1, ax.set_yscale)):
             if scale == "log" and not (np.isfinite(hi) and hi > 0):
                 setter("linear")
-    if int(f.attrs.get("complete", 0)) != 1:
-        missing = f.attrs.get("missing", "")
-        missing = missing.decode() if isinstance(missing, bytes) else str(missing)
+    if not run.complete:
+        missing = run.missing
         text = "INCOMPLETE RUN" + (": " + missing[:150] if missing else "")
         fig.suptitle(text, color="red", fontsize=12, y=1.03)
         fig.savefig(png, dpi=dpi, bbox_inches="tight")
@@ -73,11 +67,17 @@ def save(fig, f, png, dpi):
 
 def cli(main, doc):
     """Runs main(RUN.h5, OUT.png) from the command line and exits with its
-    status; -h or --help prints the usage (the script's docstring)."""
+    status; -h or --help prints the usage (the script's docstring). Figures
+    go to files: no display needed."""
+    matplotlib.use("Agg")
     if len(sys.argv) == 2 and sys.argv[1] in ("-h", "--help"):
         print(doc)
         sys.exit(0)
     if len(sys.argv) != 3:
         print(doc, file=sys.stderr)
         sys.exit(2)
-    sys.exit(main(sys.argv[1], sys.argv[2]))
+    try:
+        sys.exit(main(sys.argv[1], sys.argv[2]))
+    except (OSError, KeyError) as e:  # a file that is no run, or lacks what the figure needs
+        print(f"{os.path.basename(sys.argv[0])}: {e}", file=sys.stderr)
+        sys.exit(1)

@@ -1,0 +1,64 @@
+"""The figure of the overlap Q(t) of a dynhet run (HDF5, H5MD layout) with its error
+bars, the 1/e line, tau_alpha and the fit 1/((t/tau0)^beta + 1), one curve
+per cutoff a; beside it tau_alpha against the waiting time t0 (aging check).
+
+"""
+import math
+import sys
+
+from .common import legend_below, save, tidy_log
+import matplotlib.pyplot as plt
+import numpy as np
+
+from ..run import open_run
+
+
+def main(path, png):
+    with open_run(path) as run:
+        if "overlap" not in run.observables():
+            print(f"plot_overlap: {path} has no overlap results", file=sys.stderr)
+            return 1
+        fig, (ax, ax2) = plt.subplots(1, 2, figsize=(12, 6.0), gridspec_kw={"width_ratios": [3, 2]},
+                                      layout="constrained")
+        for name, g in ((a, run.overlap(a)) for a in run.cutoffs("overlap")):
+            t = g["lag_time"][()]
+            q, err = g["q"], g["q_err"]
+            tau, tau_err = float(g["tau_alpha"]), float(g["tau_alpha_err"])
+            a = g.attrs.get("cutoff_a", name)
+            label = f"a = {a}"
+            if math.isfinite(tau):
+                label += rf", $\tau_\alpha$ = {tau:.4g}" + (f" ± {tau_err:.2g}" if math.isfinite(tau_err) else "")
+            line = ax.errorbar(t, q, yerr=np.nan_to_num(err), marker="o", ms=3, capsize=2, label=label)
+            color = line[0].get_color()
+            if math.isfinite(tau):
+                ax.axvline(tau, color=color, ls=":", lw=1)
+            if "beta" in g and math.isfinite(g["beta"]):
+                beta, tau0 = float(g["beta"]), float(g["tau0"])
+                tt = np.geomspace(t[0], t[-1], 200)
+                ax.plot(tt, 1 / ((tt / tau0) ** beta + 1), "--", color=color, lw=1,
+                        label=rf"fit $\beta$ = {beta:.3g}, $\tau_0$ = {tau0:.3g}")
+            if "tau_alpha_t0" in g:
+                ax2.plot(g["t0"], g["tau_alpha_t0"], "o-", ms=3, color=color, label=label.split(",")[0])
+                if math.isfinite(tau):
+                    ax2.axhline(tau, color=color, ls=":", lw=1)
+        ax.axhline(math.exp(-1), color="gray", ls="--", lw=1, label="1/e")
+        ax.set_xscale("log")
+        ax.set_xlabel("t")
+        ax.set_ylabel("Q(t)")
+        ax.set_ylim(0, 1.05)
+        title = "overlap"
+        if "system" in run.parameters:
+            p = run.parameters["system"]
+            bits = [f"{k}={p[k]}" for k in ("n_particles", "packing_fraction", "restitution") if k in p]
+            title += " (" + ", ".join(bits) + ")"
+        ax.set_title(title)
+        tidy_log(ax)
+        legend_below(ax, ncol=2)
+        ax2.set_xlabel("waiting time $t_0$")
+        ax2.set_ylabel(r"$\tau_\alpha(t_0)$")
+        ax2.set_title("aging check: flat if stationary")
+        ax2.legend()
+        save(fig, run, png, 110)
+    print(f"plot_overlap: wrote {png}", file=sys.stderr)
+    return 0
+
