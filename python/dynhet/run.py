@@ -146,6 +146,10 @@ class Run:
     def displacement(self):
         return self.observable("displacement")
 
+    def has_frames(self):
+        """Whether the run kept its frames (observables.keep_frames)."""
+        return "particles" in self._f and "position" in self._f["particles/all"]
+
     def tau_alpha(self, a=A_DEFAULT):
         """tau_alpha of cutoff a with its error: (value, error)."""
         v, e = self.overlap(a).value_error("tau_alpha")

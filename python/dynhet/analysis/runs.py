@@ -4,36 +4,33 @@ import math
 import h5py
 import numpy as np
 
+from ..run import open_run
+
 
 def last(g, name):
-    if name not in g:
-        return None
-    v = g[name]["value"]
-    return v[-1] if v.shape[0] else None
+    """The final record of a dataset of an Observable (dynhet.run), None if
+    the group lacks it."""
+    return g[name] if name in g else None
 
 
 def fnum(v):
     return float(v) if v is not None else math.nan
 
 
-def cutoff_groups(obs, kind):
-    out = {}
-    if kind in obs:
-        for k in obs[kind]:
-            if k.startswith("a"):
-                out[float(k[1:])] = obs[kind][k]
-    return out
+def cutoff_groups(run, kind):
+    """{a: Observable} of an observable family (empty where the run lacks it)."""
+    return {a: run.observable(kind, a) for a in run.cutoffs(kind)}
 
 
 def read_run(path, meta):
     """Everything the analysis uses from one run.h5, as plain numpy."""
     r = dict(meta)
-    with h5py.File(path, "r") as f:
-        r["complete"] = int(f.attrs.get("complete", 0))
-        obs = f["observables"]
+    with open_run(path) as run:
+        r["complete"] = int(run.complete)
+        obs = run.observables()
         r["N"] = int(meta["n_particles"])
         r["cut"] = {}
-        ov, ch, s4g, cl = (cutoff_groups(obs, k) for k in ("overlap", "chi4", "s4", "clusters"))
+        ov, ch, s4g, cl = (cutoff_groups(run, k) for k in ("overlap", "chi4", "s4", "clusters"))
         for a, g in ov.items():
             c = {"lag": g["lag_time"][:], "q": last(g, "q"), "q_err": last(g, "q_err")}
             for k in ("tau_alpha", "tau_alpha_err", "beta", "beta_err", "tau0", "tau0_err"):
@@ -81,22 +78,22 @@ def read_run(path, meta):
                           "fast_sigma", "fast_n_sigma", "fast_p0", "lag"):
                     c["cl_" + k] = fnum(last(g2, k))
             r["cut"][a] = c
-        m = obs["msd"] if "msd" in obs else None
+        m = run.msd() if "msd" in obs else None
         if m is not None:
             r["D"], r["D_err"] = fnum(last(m, "diffusion")), fnum(last(m, "diffusion_err"))
             r["D_t"] = (fnum(last(m, "fit_t_min")), fnum(last(m, "fit_t_max")))
             r["msd_lag"], r["msd"] = m["lag_time"][:], last(m, "msd_all")
         if "displacement" in obs:
-            d = obs["displacement"]
+            d = run.displacement()
             x = d["x"][:]
             lt = last(d, "lag_time")
             r["pdx_x"], r["pdx_lag"] = x, lt
             r["pdx"] = last(d, "p").reshape(-1, len(lt), len(x))
             r["pdx_target"] = last(d, "target_tau_alpha")
         if "sim" in obs:
-            s = obs["sim"]
+            s = run.observable("sim")
             r["Z"], r["Z_err"] = fnum(last(s, "reduced_pressure")), fnum(last(s, "reduced_pressure_err"))
-        r["has_frames"] = "particles" in f and "position" in f["particles/all"]
+        r["has_frames"] = run.has_frames()
     return r
 
 
