@@ -5,9 +5,10 @@
 # chi2), STUDY_DIR/figures/*.png and STUDY_DIR/reproduction.md (the table
 # against the paper). run_study.sh runs it when a study's runs are done.
 #
-# Usage: launch_scripts/analyse_study.sh STUDY_DIR [--table docs/reproduction.md] [--discussion FILE]
+# Usage: launch_scripts/analyse_study.sh STUDY_DIR [--table docs/reproduction.md] [--discussion FILE] [--restate OLD.md]
 #   --table FILE       write the reproduction table there as well
 #   --discussion FILE  append this Markdown (what we found about each disagreement)
+#   --restate OLD.md   append, for each row an earlier table judged "differs", its verdict now
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 case "${1:-}" in

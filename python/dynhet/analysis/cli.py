@@ -47,7 +47,11 @@ def main(argv=None):
     ap.add_argument("--also", action="append", default=[], metavar="STUDY_DIR",
                     help="another study whose runs add points: tau_alpha against N where it ran other N, and the "
                          "cutoff figure from whichever study's lags reach furthest")
+    ap.add_argument("--restate", metavar="OLD_TABLE",
+                    help="an earlier reproduction.md: append, for each row it judged \"differs\", the verdict now")
     a = ap.parse_args(argv)
+    if a.restate and not os.path.isfile(a.restate):
+        raise SystemExit(f"analyse_study: --restate {a.restate}: no such file")
     t0 = time.time()
     A = Analysis(a.study_dir, a.also)
     if not A.points:
@@ -92,9 +96,9 @@ def main(argv=None):
     driving_rows(A)
     write_h5(A, os.path.join(A.dir, "study.h5"))
     cmd = "launch_scripts/analyse_study.sh " + " ".join(argv if argv is not None else sys.argv[1:])
-    write_table(A, os.path.join(A.dir, "reproduction.md"), cmd, a.discussion)
+    write_table(A, os.path.join(A.dir, "reproduction.md"), cmd, a.discussion, a.restate)
     if a.table:
-        write_table(A, a.table, cmd, a.discussion)
+        write_table(A, a.table, cmd, a.discussion, a.restate)
     differ = [r["item"] for r in A.rows if r["verdict"].startswith("differs")]
     say(f"analyse_study: {len(A.rows)} rows, {len(differ)} differ from the paper; {len(A.fits)} fits; "
         f"study.h5, reproduction.md and {(len(os.listdir(A.figdir)) if os.path.isdir(A.figdir) else 0)} figures in {A.dir} ({time.time() - t0:.1f} s)")

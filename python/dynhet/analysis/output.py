@@ -8,6 +8,7 @@ import numpy as np
 from .quantities import PER_RUN, chi4_at_tau, cut, tau, xi_at_tau
 from .verdicts import fmt
 from .config import CONVENTIONS
+from .restate import restate
 
 
 def write_h5(A, path):
@@ -59,7 +60,7 @@ def hms(s):
     return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
 
 
-def write_table(A, path, command, discussion=None):
+def write_table(A, path, command, discussion=None, restate_from=None):
     n_runs = sum(len(p.runs) for p in A.points.values())
     total = sum(A.cpu.values())
     L = ["# The paper from our own runs", "",
@@ -95,6 +96,8 @@ def write_table(A, path, command, discussion=None):
             m, e, _, _ = p.mean(fn)
             cells.append(fmt(m, e))
         L.append(f"| {p.pairs} | {p.eps:g} | {p.phi:g} | {p.N} | {len(p.runs)} | " + " | ".join(cells) + " |")
+    if restate_from:
+        L += restate(restate_from, A.rows)
     L.append("")
     with open(path + ".tmp", "w") as fh:
         fh.write("\n".join(L))
