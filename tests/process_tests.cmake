@@ -180,7 +180,7 @@ add_test(NAME tcpq_hub_death_ends_every_process_cleanly
 set_tests_properties(tcpq_hub_death_ends_every_process_cleanly PROPERTIES LABELS process TIMEOUT 120)
 
 # The Python package's own unit tests (pytest, Debian's python3-pytest):
-# the run reader, the study model.
+# the run reader, the study model, the fits, the row-by-row restatement.
 add_test(NAME python_unit
   COMMAND /usr/bin/python3 -m pytest -q -p no:cacheprovider ${CMAKE_CURRENT_SOURCE_DIR}/python)
 set_tests_properties(python_unit PROPERTIES LABELS unit TIMEOUT 120)

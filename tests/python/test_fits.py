@@ -1,0 +1,55 @@
+"""dynhet.fits on exact data (each form recovers its parameters to
+rounding) and on the cases where a fit must refuse or decline to judge.
+The statistical checks (errors that match the spread of synthetic studies)
+are tests/test_study_fits.py (ctest study_fits_synthetic)."""
+import math
+
+import numpy as np
+
+from dynhet import fits as sf
+
+PHI = np.array([0.60, 0.65, 0.70, 0.72, 0.74, 0.76, 0.77, 0.78])
+
+
+def test_exact_forms_are_recovered():
+    x = np.geomspace(1, 50, 8)
+    f = sf.power(x, 0.3 * x ** -1.47, 0.01 * x ** -1.47)
+    assert abs(f.p["s"] + 1.47) < 1e-10 and abs(f.p["A"] - 0.3) < 1e-10 and f.chi2 < 1e-16
+    y = 0.05 * (0.82 - PHI) ** -2.4
+    f = sf.critical(PHI, y, 0.01 * y)
+    assert abs(f.p["xc"] - 0.82) < 1e-5 and abs(f.p["g"] - 2.4) < 1e-3
+    f = sf.critical_fixed(PHI, y, 0.01 * y, 0.82)
+    assert abs(f.p["g"] - 2.4) < 1e-10 and f.err["xc"] == 0.0 and f.dof == len(PHI) - 2
+
+
+def test_odr_with_exact_data_and_x_errors_is_the_line():
+    x = np.geomspace(2, 20, 7)
+    y = 0.5 * x ** 1.6
+    f = sf.power(x, y, 0.03 * y, sx=0.2 * x)
+    assert "orthogonal distance" in f.note and abs(f.p["s"] - 1.6) < 1e-8
+
+
+def test_refusals_say_why():
+    f = sf.power([1, 2], [1, 2], [0.1, 0.1])
+    assert not f.ok and "needs 3" in f.note
+    f = sf.critical_fixed(PHI, np.ones_like(PHI), 0.1 * np.ones_like(PHI), math.nan)
+    assert not f.ok and "no phi_c" in f.note
+    f = sf.critical_fixed(PHI, np.ones_like(PHI), 0.1 * np.ones_like(PHI), 0.69)
+    assert not f.ok and "below xc" in f.note                      # 2 points below 0.69 only
+
+
+def test_cannot_judge_an_edge_or_an_improbable_chi2():
+    y = 0.05 * (0.7804 - PHI) ** -1.0
+    edge = sf.critical(PHI, y, 0.01 * y)
+    assert "edge of the data" in (sf.cannot_judge(edge, "xc") or "")
+    y = 0.05 * (0.82 - PHI) ** -2.4
+    good = sf.critical(PHI, y * (1 + 0.005 * np.sin(7 * np.arange(len(PHI)))), 0.01 * y)
+    assert sf.cannot_judge(good, "xc") is None
+    bad = sf.critical(PHI, y * np.exp(0.3 * np.sin(40 * PHI)), 0.01 * y)
+    assert "does not describe the points" in (sf.cannot_judge(bad, "xc") or "")
+
+
+def test_jackknife_over_identical_seeds_has_no_spread():
+    x = np.geomspace(1, 50, 8)
+    f = sf.jackknife_over_seeds(lambda drop: sf.power(x, 2 * x, 0.1 * x), [1, 2, 3])
+    assert f.jk["s"] < 1e-12 and f.jk["A"] < 1e-12  # zero but for rounding
