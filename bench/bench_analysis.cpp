@@ -21,6 +21,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "dynhet/analysis/cage.hpp"
 #include "dynhet/analysis/clusters.hpp"
 #include "dynhet/analysis/displacement.hpp"
 #include "dynhet/analysis/displacement_distribution.hpp"
@@ -359,17 +360,34 @@ void bench_clusters(const Frames& f, int reps) {
 
 } // namespace
 
+// Cages (issue 26): the Voronoi neighbours of an origin frame (once per
+// origin) and the cage-relative displacements of one (origin, lag) pair.
+void bench_cage(const Frames& f, int reps) {
+  std::printf("\n# cages: Voronoi neighbours of one frame (CGAL periodic Delaunay), cage-relative displacements "
+              "of one (origin, lag)\n");
+  std::printf("%8s %-52s %9s %9s %12s\n", "N", "what", "ms_min", "ms_med", "mean_nb");
+  an::Neighbours v;
+  const Timing tv = time_calls(reps, [&] { v = an::voronoi_neighbours(f.p0.data(), f.n, f.box); });
+  const double mean_nb = double(v.list.size()) / f.n;
+  std::printf("%8ld %-52s %9.2f %9.2f %12.3f\n", f.n, "voronoi_neighbours", 1e3 * tv.min, 1e3 * tv.median, mean_nb);
+  std::vector<double> dr(2 * f.n), cr(2 * f.n);
+  for (long i = 0; i < 2 * f.n; ++i) dr[i] = f.pt[i] - f.p0[i];
+  const Timing tc = time_calls(reps, [&] { an::cage_relative(dr.data(), v, cr.data()); });
+  std::printf("%8ld %-52s %9.2f %9.2f %12.3f\n", f.n, "cage_relative (one origin, lag)", 1e3 * tc.min, 1e3 * tc.median,
+              mean_nb);
+}
+
 int main(int argc, char** argv) {
   CLI::App app{"dynhet analysis kernel benchmark"};
   long n = 100000;
   double phi = 0.76, q_max = 1.0;
   int reps = 20;
-  std::string sections = "pass,s4,clusters";
+  std::string sections = "pass,s4,clusters,cage";
   app.add_option("--n", n, "particles");
   app.add_option("--phi", phi, "packing fraction (sets the box)");
   app.add_option("--reps", reps, "repetitions per timing (median)");
   app.add_option("--q-max", q_max, "largest |q| of S4");
-  app.add_option("--sections", sections, "which tables: pass,s4,clusters (s4: the spacing table and s4_node's "
+  app.add_option("--sections", sections, "which tables: pass,s4,clusters,cage (s4: the spacing table and s4_node's "
                                          "cost; s4_node: the latter only)");
   CLI11_PARSE(app, argc, argv);
   const Frames f = make_frames(n, phi, 1);
@@ -381,5 +399,6 @@ int main(int argc, char** argv) {
   if (wanted("s4")) bench_s4(f, q_max, std::max(3, reps / 4));
   if (wanted("s4") || wanted("s4_node")) bench_s4_node(f, q_max, std::max(3, reps / 4));
   if (wanted("clusters")) bench_clusters(f, std::max(3, reps / 4));
+  if (wanted("cage")) bench_cage(f, std::max(3, reps / 4));
   return 0;
 }

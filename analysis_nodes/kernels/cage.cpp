@@ -1,0 +1,106 @@
+// Voronoi neighbours in a periodic box by CGAL's periodic Delaunay
+// triangulation, and cage-relative displacements (dynhet/analysis/cage.hpp).
+#include "dynhet/analysis/cage.hpp"
+
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Periodic_2_Delaunay_triangulation_2.h>
+#include <CGAL/Periodic_2_Delaunay_triangulation_traits_2.h>
+#include <CGAL/Periodic_2_triangulation_face_base_2.h>
+#include <CGAL/Periodic_2_triangulation_vertex_base_2.h>
+#include <CGAL/Triangulation_data_structure_2.h>
+#include <CGAL/Triangulation_vertex_base_with_info_2.h>
+#include <CGAL/spatial_sort.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <numeric>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace dynhet::analysis {
+namespace {
+
+using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+using Gt = CGAL::Periodic_2_Delaunay_triangulation_traits_2<K>;
+using Vb0 = CGAL::Periodic_2_triangulation_vertex_base_2<Gt>;
+using Vb = CGAL::Triangulation_vertex_base_with_info_2<std::int32_t, Gt, Vb0>;
+using Fb = CGAL::Periodic_2_triangulation_face_base_2<Gt>;
+using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
+using Triangulation = CGAL::Periodic_2_Delaunay_triangulation_2<Gt, Tds>;
+using Point = Triangulation::Point;
+
+double fold(double x, double box) {
+  x = std::fmod(x, box);
+  if (x < 0) x += box;
+  return x < box ? x : 0.0; // fmod of -tiny + box can round to box
+}
+
+} // namespace
+
+Neighbours voronoi_neighbours(const double* pos, long n, double box) {
+  if (!(box > 0) || !std::isfinite(box)) throw std::invalid_argument("voronoi_neighbours: box must be finite and > 0");
+  if (n < 0 || n > std::numeric_limits<std::int32_t>::max())
+    throw std::invalid_argument("voronoi_neighbours: particle count out of range");
+  std::vector<Point> points(n);
+  for (long i = 0; i < n; ++i) {
+    if (!std::isfinite(pos[2 * i]) || !std::isfinite(pos[2 * i + 1]))
+      throw std::invalid_argument("voronoi_neighbours: position of particle " + std::to_string(i) + " not finite");
+    points[i] = Point(fold(pos[2 * i], box), fold(pos[2 * i + 1], box));
+  }
+  // Insert in spatial (Hilbert) order, each from the last as a hint: what
+  // CGAL's range insertion does, keeping each vertex's particle index.
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  using Map = CGAL::Pointer_property_map<Point>::type;
+  using SortTraits = CGAL::Spatial_sort_traits_adapter_2<K, Map>;
+  CGAL::spatial_sort(order.begin(), order.end(), SortTraits(CGAL::make_property_map(points)));
+  Triangulation t(Gt::Iso_rectangle_2(0, 0, box, box));
+  Triangulation::Vertex_handle hint;
+  for (const std::size_t i : order) {
+    const auto before = t.number_of_vertices();
+    hint = hint == Triangulation::Vertex_handle() ? t.insert(points[i]) : t.insert(points[i], hint->face());
+    if (t.number_of_vertices() == before)
+      throw std::invalid_argument("voronoi_neighbours: particle " + std::to_string(i) + " coincides with another");
+    hint->info() = static_cast<std::int32_t>(i);
+  }
+  if (!t.is_triangulation_in_1_sheet())
+    throw std::invalid_argument("voronoi_neighbours: " + std::to_string(n) +
+                                " particles are too few for a periodic triangulation of one box");
+  std::vector<std::vector<std::int32_t>> adj(n);
+  for (auto e = t.edges_begin(); e != t.edges_end(); ++e) {
+    const auto f = e->first;
+    const int k = e->second;
+    const std::int32_t a = f->vertex(Triangulation::cw(k))->info(), b = f->vertex(Triangulation::ccw(k))->info();
+    if (a == b) continue;
+    adj[a].push_back(b), adj[b].push_back(a);
+  }
+  Neighbours v;
+  v.offset.assign(n + 1, 0);
+  for (long i = 0; i < n; ++i) {
+    auto& l = adj[i];
+    std::sort(l.begin(), l.end());
+    l.erase(std::unique(l.begin(), l.end()), l.end());
+    v.offset[i + 1] = v.offset[i] + static_cast<std::int64_t>(l.size());
+  }
+  v.list.reserve(v.offset[n]);
+  for (const auto& l : adj) v.list.insert(v.list.end(), l.begin(), l.end());
+  return v;
+}
+
+void cage_relative(const double* dr, const Neighbours& v, double* out) {
+  const long n = v.size();
+  for (long i = 0; i < n; ++i) {
+    const long c = v.count(i);
+    double mx = 0, my = 0;
+    for (std::int64_t k = v.offset[i]; k < v.offset[i + 1]; ++k) {
+      const std::int32_t j = v.list[k];
+      mx += dr[2 * j], my += dr[2 * j + 1];
+    }
+    out[2 * i] = dr[2 * i] - (c > 0 ? mx / c : 0.0);
+    out[2 * i + 1] = dr[2 * i + 1] - (c > 0 ? my / c : 0.0);
+  }
+}
+
+} // namespace dynhet::analysis
