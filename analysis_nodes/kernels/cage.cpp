@@ -68,24 +68,27 @@ Neighbours voronoi_neighbours(const double* pos, long n, double box) {
   if (!t.is_triangulation_in_1_sheet())
     throw std::invalid_argument("voronoi_neighbours: " + std::to_string(n) +
                                 " particles are too few for a periodic triangulation of one box");
-  std::vector<std::vector<std::int32_t>> adj(n);
-  for (auto e = t.edges_begin(); e != t.edges_end(); ++e) {
-    const auto f = e->first;
-    const int k = e->second;
-    const std::int32_t a = f->vertex(Triangulation::cw(k))->info(), b = f->vertex(Triangulation::ccw(k))->info();
-    if (a == b) continue;
-    adj[a].push_back(b), adj[b].push_back(a);
-  }
+  // Compressed rows straight from the edges: count, place, then sort each
+  // row (no vector per particle).
   Neighbours v;
   v.offset.assign(n + 1, 0);
-  for (long i = 0; i < n; ++i) {
-    auto& l = adj[i];
-    std::sort(l.begin(), l.end());
-    l.erase(std::unique(l.begin(), l.end()), l.end());
-    v.offset[i + 1] = v.offset[i] + static_cast<std::int64_t>(l.size());
+  auto ends = [](const Triangulation::Edge& e) {
+    return std::pair<std::int32_t, std::int32_t>(e.first->vertex(Triangulation::cw(e.second))->info(),
+                                                 e.first->vertex(Triangulation::ccw(e.second))->info());
+  };
+  for (auto e = t.edges_begin(); e != t.edges_end(); ++e) {
+    const auto [a, b] = ends(*e);
+    if (a != b) ++v.offset[a + 1], ++v.offset[b + 1];
   }
-  v.list.reserve(v.offset[n]);
-  for (const auto& l : adj) v.list.insert(v.list.end(), l.begin(), l.end());
+  for (long i = 0; i < n; ++i) v.offset[i + 1] += v.offset[i];
+  v.list.resize(v.offset[n]);
+  std::vector<std::int64_t> fill(v.offset.begin(), v.offset.end() - 1);
+  for (auto e = t.edges_begin(); e != t.edges_end(); ++e) {
+    const auto [a, b] = ends(*e);
+    if (a != b) v.list[fill[a]++] = b, v.list[fill[b]++] = a;
+  }
+  // In one sheet every periodic edge is stored once: no duplicates to remove.
+  for (long i = 0; i < n; ++i) std::sort(v.list.begin() + v.offset[i], v.list.begin() + v.offset[i + 1]);
   return v;
 }
 
