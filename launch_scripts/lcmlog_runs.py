@@ -57,10 +57,16 @@ def scan(path):
 
 
 def line(run_id, r):
-    whole = sum(1 for f, c in r["chunks"].items() if len(c) == r["count"][f])
+    whole_frames = {f for f, c in r["chunks"].items() if len(c) == r["count"][f]}
+    whole = len(whole_frames)
     expected = r.get("frames")
-    return whole, expected, (f"run {run_id}: N = {r.get('n', '?')}, {whole} of "
-                             f"{expected if expected is not None else '?'} frames whole in the log")
+    text = (f"run {run_id}: N = {r.get('n', '?')}, {whole} of "
+            f"{expected if expected is not None else '?'} frames whole in the log")
+    if expected is not None and whole < expected:  # which, for whoever wonders why (a starved lcm-logger drops)
+        lacking = [f for f in range(expected) if f not in whole_frames]
+        text += " (lacking frame" + ("s " if len(lacking) > 1 else " ") + ", ".join(map(str, lacking[:10])) + \
+            (", ..." if len(lacking) > 10 else "") + ")"
+    return whole, expected, text
 
 
 def main():

@@ -355,8 +355,13 @@ if [[ -n $record ]]; then
   # Say so if the log missed frames (lcm-logger takes no part in the flow
   # control: a starved logger drops): the run itself is whole, its log not.
   if ((${#resume_cut[@]} == 0)) && [[ $role == all && -z ${stop_signal:-} ]]; then # a segment holds part of the frames by design
-    line=$(/usr/bin/python3 "$root/launch_scripts/lcmlog_runs.py" "$record" --run-id "$run_id" --whole 2>&1) ||
-      echo "run_scene: the log $record is not whole ($line): lcm-logger could not keep up; the run itself is" >&2
+    if ! line=$(/usr/bin/python3 "$root/launch_scripts/lcmlog_runs.py" "$record" --run-id "$run_id" --whole 2>&1); then
+      # The UDP counters of this network namespace say whether the kernel
+      # dropped datagrams (RcvbufErrors: a socket buffer full).
+      udp=$(awk '/^Udp:/ { if (h) { for (i = 2; i <= NF; i++) printf "%s %s ", k[i], $i } else { h = 1; for (i = 2; i <= NF; i++) k[i] = $i } }' /proc/net/snmp 2>/dev/null)
+      echo "run_scene: the log $record is not whole ($line): lcm-logger could not keep up; the run itself is" \
+        "(UDP here: ${udp:-unknown})" >&2
+    fi
   fi
 fi
 grep -h -E "tau_alpha|frames whole|complete|missing" "$out"/*_node.log "$out/recorder.log" >&2 || true
