@@ -9,44 +9,54 @@ Usage: lcmlog_runs.py LOG              one line per run: id, N, frames in the lo
                                        (--whole after it: exit 3 if it lacks frames)
        lcmlog_runs.py LOG --only       the id of the only run; exit 1 (with the list) if there are several
 """
+import mmap
+import os
 import struct
 import sys
 
 SYNC = 0xEDA1DA01
 
 
+HEAD = 128  # the bytes of a message its headers need (run_info_t: 92, frame_chunk_t: 60)
+
+
 def events(path):
+    """(channel, the message's first HEAD bytes, its length) per event. The log
+    is mapped, not read: a log of a large run holds gigabytes of frames, and
+    only their headers are looked at."""
     with open(path, "rb") as f:
-        data = f.read()
-    pos, n = 0, len(data)
-    while pos + 28 <= n:
-        sync, _event, _utime, clen, dlen = struct.unpack_from(">IqqII", data, pos)
-        if sync != SYNC:  # resynchronise on damage
-            nxt = data.find(struct.pack(">I", SYNC), pos + 1)
-            if nxt < 0:
-                return
-            pos = nxt
-            continue
-        pos += 28
-        if pos + clen + dlen > n:
+        if os.fstat(f.fileno()).st_size == 0:
             return
-        channel = data[pos:pos + clen].decode("latin-1")
-        yield channel, data[pos + clen:pos + clen + dlen]
-        pos += clen + dlen
+        with mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as data:
+            pos, n = 0, len(data)
+            while pos + 28 <= n:
+                sync, _event, _utime, clen, dlen = struct.unpack_from(">IqqII", data, pos)
+                if sync != SYNC:  # resynchronise on damage
+                    nxt = data.find(struct.pack(">I", SYNC), pos + 1)
+                    if nxt < 0:
+                        return
+                    pos = nxt
+                    continue
+                pos += 28
+                if pos + clen + dlen > n:
+                    return
+                channel = data[pos:pos + clen].decode("latin-1")
+                yield channel, data[pos + clen:pos + clen + min(dlen, HEAD)], dlen
+                pos += clen + dlen
 
 
 def scan(path):
     """{run_id: {"n": N, "frames": n_frames, "chunks": {frame: set(chunk)}, "count": {frame: chunk_count}}}"""
     runs = {}
-    for channel, d in events(path):
-        if channel == "DYNHET_RUN" and len(d) >= 92:
+    for channel, d, size in events(path):
+        if channel == "DYNHET_RUN" and size >= 92:
             # hash utime run_id n_particles box phi eps radius[2] mass[2] n_small n_frames
             run_id, n = struct.unpack_from(">qi", d, 16)
             n_frames = struct.unpack_from(">i", d, 88)[0]
             r = runs.setdefault(run_id, {"chunks": {}, "count": {}})
             r.setdefault("n", n)
             r.setdefault("frames", n_frames)
-        elif channel == "DYNHET_FRAME" and len(d) >= 60:
+        elif channel == "DYNHET_FRAME" and size >= 60:
             # hash utime run_id frame_index time n_particles chunk_index chunk_count
             run_id, frame = struct.unpack_from(">qi", d, 16)
             chunk, count = struct.unpack_from(">ii", d, 40)
