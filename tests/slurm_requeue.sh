@@ -40,14 +40,28 @@ export DYNHET_TEST_SIM_DELAY=1.5
 bash "$root/launch_scripts/run_study.sh" "$tmp/requeue.toml" --no-build --executor slurm --out "$tmp/s" --time=1 \
   --signal-lead 45 >"$tmp/s.out" 2>&1 || { cat "$tmp/s.out"; tail -20 "$d"/*.log; exit 1; }
 ( # the administrator: a requeued task waiting out its hold may start now,
-  # once the node has let go of its previous allocation (released at once,
-  # Slurm kills it: "Job credential revoked").
-  while sleep 2; do
-    sinfo -h -o %T 2>/dev/null | grep -qx idle || continue
-    for j in $(squeue -h -t PENDING -o "%i %r" 2>/dev/null | awk '$2 == "BeginTime" { print $1 }'); do
-      sleep 3
-      scontrol update JobId="$j" StartTime=now 2>/dev/null && echo "$(date '+%T') released $j" >>"$tmp/released.out"
-    done
+  # once the node has let go of its previous allocation. A task that
+  # requeues itself shows as PENDING while its script still ends, and a
+  # start within the second its credential was revoked is killed ("Job
+  # credential revoked", seen in CI 0.2 s after the requeue): release a job
+  # only after it and an idle node have been seen for 4 s on end.
+  declare -A since
+  while sleep 1; do
+    now=$(date +%s)
+    declare -A seen=()
+    if sinfo -h -o %T 2>/dev/null | grep -qx idle; then
+      for j in $(squeue -h -t PENDING -o "%i %r" 2>/dev/null | awk '$2 == "BeginTime" { print $1 }'); do
+        scontrol show job -o "$j" 2>/dev/null | grep -q "JobState=PENDING " || continue
+        seen[$j]=1
+        since[$j]=${since[$j]:-$now}
+        if ((now - since[$j] >= 4)); then
+          scontrol update JobId="$j" StartTime=now 2>/dev/null && echo "$(date '+%T') released $j" >>"$tmp/released.out"
+          unset "seen[$j]"
+        fi
+      done
+    fi
+    for j in "${!since[@]}"; do [[ -n ${seen[$j]:-} ]] || unset "since[$j]"; done
+    unset seen
   done
 ) &
 pids+=($!)
