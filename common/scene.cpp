@@ -119,12 +119,18 @@ std::string known_keys(const Table& t) {
 } // namespace
 
 const std::vector<std::string>& known_observables() {
-  static const std::vector<std::string> v{"overlap", "chi4", "msd", "displacement", "clusters", "s4"};
+  static const std::vector<std::string> v{"overlap", "chi4", "msd", "displacement", "clusters", "s4", "bond_breaking"};
   return v;
 }
 
+bool has_cage_relative(const std::string& o) {
+  return o == "overlap" || o == "chi4" || o == "msd" || o == "displacement";
+}
+
 std::string node_of(const std::string& observable) {
-  return observable == "chi4" || observable == "msd" || observable == "displacement" ? "overlap" : observable;
+  std::string o = observable;
+  if (o.size() > 3 && o.compare(o.size() - 3, 3, "_cr") == 0) o.resize(o.size() - 3);
+  return o == "chi4" || o == "msd" || o == "displacement" || o == "bond_breaking" ? "overlap" : o;
 }
 
 std::vector<std::string> nodes_for(const std::vector<std::string>& observables) {
@@ -148,6 +154,14 @@ double scene_kick_rate(const Scene& s) {
 
 bool Scene::wants(const std::string& o) const {
   return std::find(observables.begin(), observables.end(), o) != observables.end();
+}
+
+std::vector<std::string> Scene::computed_observables() const {
+  std::vector<std::string> v = observables;
+  if (cage_relative)
+    for (const auto& o : observables)
+      if (has_cage_relative(o)) v.push_back(o + "_cr");
+  return v;
 }
 
 Scene parse_scene_text(const std::string& text, const std::string& origin) {
@@ -347,6 +361,8 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
        }},
       {"keep_frames",
        [&](const std::string& key, const toml::node& n) { c.get_bool(key, n, s.keep_frames); }},
+      {"cage_relative",
+       [&](const std::string& key, const toml::node& n) { c.get_bool(key, n, s.cage_relative); }},
   };
   schema["overlap"] = {
       {"subbox_particles", int_in(s.overlap_subbox_particles, 1, std::numeric_limits<int32_t>::max())},
@@ -446,11 +462,6 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
       out = v;
     };
   };
-  schema["msd"] = {
-      {"fraction_all", subset_fraction(s.msd.fraction_all)},
-      {"fraction_small", subset_fraction(s.msd.fraction_small)},
-  };
-  auto& dp = s.displacement;
   auto positive_list = [&](std::vector<double>& out) {
     return [&c, &out](const std::string& key, const toml::node& n) {
       const auto* arr = n.as_array();
@@ -465,6 +476,17 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
       out = v;
     };
   };
+  schema["msd"] = {
+      {"fraction_all", subset_fraction(s.msd.fraction_all)},
+      {"fraction_small", subset_fraction(s.msd.fraction_small)},
+      {"fs", [&](const std::string& key, const toml::node& n) { c.get_bool(key, n, s.msd.fs); }},
+      {"fs_q", positive_list(s.msd.fs_q)},
+  };
+  schema["bond_breaking"] = {
+      {"a1", [&](const std::string& key, const toml::node& n) { c.get_double(key, n, s.bond_breaking.a1); }},
+      {"a2", [&](const std::string& key, const toml::node& n) { c.get_double(key, n, s.bond_breaking.a2); }},
+  };
+  auto& dp = s.displacement;
   schema["displacement"] = {
       {"lags_tau_alpha", positive_list(dp.lags_tau_alpha)},
       {"lags", positive_list(dp.lags)},
@@ -606,6 +628,15 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
     c.fail("displacement.bin_width", "value " + num(dp.bin_width) + ": " + std::to_string(targets) +
                                          " lags x " + std::to_string(dp.bins()) +
                                          " bins is more than 4096 (the message would not survive UDP)");
+  if (s.cage_relative && std::none_of(s.observables.begin(), s.observables.end(), has_cage_relative))
+    c.fail("observables.cage_relative", "is true, but no observable named has a cage-relative version (overlap, "
+                                        "chi4, msd and displacement have; clusters and s4 not yet)");
+  if (const auto& bb = s.bond_breaking; !(bb.a1 > 0 && bb.a2 > bb.a1 && bb.a2 < 10))
+    c.fail("bond_breaking.a2", "with a1 = " + num(bb.a1) + ", a2 = " + num(bb.a2) +
+                                   " is not allowed; allowed: 0 < a1 < a2 < 10 (a bond forms below a1 sigma_ij "
+                                   "and breaks beyond a2 sigma_ij)");
+  if (s.msd.fs_q.size() > 16)
+    c.fail("msd.fs_q", "lists " + std::to_string(s.msd.fs_q.size()) + " wave numbers; at most 16");
   if (s.observables.empty())
     c.fail("observables.compute", "is empty; name at least one of the known observables");
   c.throw_if_failed();

@@ -8,6 +8,7 @@ Usage: lcmlog_runs.py LOG              one line per run: id, N, frames in the lo
        lcmlog_runs.py LOG --run-id ID  that run's line; exit 1 if the log does not hold it
                                        (--whole after it: exit 3 if it lacks frames)
        lcmlog_runs.py LOG --only       the id of the only run; exit 1 (with the list) if there are several
+       lcmlog_runs.py LOG --channels   the messages per channel, one 'CHANNEL COUNT' a line
 """
 import mmap
 import os
@@ -86,8 +87,15 @@ def main():
     if len(sys.argv) < 2:
         print(__doc__, file=sys.stderr)
         return 2
-    runs = {k: v for k, v in scan(sys.argv[1]).items() if "frames" in v}
     args = sys.argv[2:]
+    if args[:1] == ["--channels"]:
+        counts = {}
+        for channel, _d, _size in events(sys.argv[1]):
+            counts[channel] = counts.get(channel, 0) + 1
+        for channel in sorted(counts):
+            print(channel, counts[channel])
+        return 0
+    runs = {k: v for k, v in scan(sys.argv[1]).items() if "frames" in v}
     if not runs:
         print(f"{sys.argv[1]}: no dynhet run info in the log", file=sys.stderr)
         return 1

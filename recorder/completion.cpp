@@ -10,7 +10,9 @@ namespace {
 // Observables whose result messages the recorder knows how to write.
 bool recordable(const std::string &observable) {
   return observable == "overlap" || observable == "chi4" || observable == "msd" || observable == "displacement" ||
-         observable == "clusters" || observable == "s4";
+         observable == "clusters" || observable == "s4" || observable == "bond_breaking" ||
+         (observable.size() > 3 && observable.compare(observable.size() - 3, 3, "_cr") == 0 &&
+          has_cage_relative(observable.substr(0, observable.size() - 3)));
 }
 } // namespace
 

@@ -27,10 +27,12 @@ public:
   void node_frames(const std::string &node, int whole, int lost, int expected);
   // A final result of `observable` ("overlap", "chi4", "clusters", "s4") for
   // one cutoff, or of one with a single final result ("msd" and
-  // "displacement", which do not depend on the cutoff; cutoff ignored).
+  // "displacement", which do not depend on the cutoff; cutoff ignored);
+  // "<name>_cr" for the cage-relative results.
   void final_result(const std::string &observable, double cutoff_a) { finals_.insert(final_label(observable, cutoff_a)); }
   static std::string final_label(const std::string &observable, double cutoff_a) {
-    return observable == "msd" || observable == "displacement"
+    return observable == "msd" || observable == "displacement" || observable == "msd_cr" ||
+                   observable == "displacement_cr" || observable == "bond_breaking"
                ? observable
                : observable + " " + cutoff_label(cutoff_a);
   }

@@ -30,6 +30,7 @@
 #include <csignal>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -74,15 +75,20 @@ std::string channel_of(const dynhet::frame_chunk_t &) { return dynhet::kChanFram
 std::string channel_of(const dynhet::node_status_t &m) { return dynhet::node_status_channel(m.node); }
 using dynhet::cutoff_channel;
 std::string channel_of(const dynhet::overlap_t &m) {
-  return cutoff_channel(dynhet::kChanOverlap, m.cutoff_a);
+  return cutoff_channel(dynhet::kChanOverlap, m.cutoff_a, m.cage_relative);
 }
-std::string channel_of(const dynhet::chi4_t &m) { return cutoff_channel(dynhet::kChanChi4, m.cutoff_a); }
+std::string channel_of(const dynhet::chi4_t &m) {
+  return cutoff_channel(dynhet::kChanChi4, m.cutoff_a, m.cage_relative);
+}
 std::string channel_of(const dynhet::s4_t &m) { return cutoff_channel(dynhet::kChanS4, m.cutoff_a); }
 std::string channel_of(const dynhet::clusters_t &m) {
   return cutoff_channel(dynhet::kChanClusters, m.cutoff_a);
 }
-std::string channel_of(const dynhet::msd_t &) { return dynhet::kChanMsd; }
-std::string channel_of(const dynhet::displacement_t &) { return dynhet::kChanDisplacement; }
+std::string channel_of(const dynhet::bond_breaking_t &) { return dynhet::kChanBondBreaking; }
+std::string channel_of(const dynhet::msd_t &m) { return dynhet::result_channel(dynhet::kChanMsd, m.cage_relative); }
+std::string channel_of(const dynhet::displacement_t &m) {
+  return dynhet::result_channel(dynhet::kChanDisplacement, m.cage_relative);
+}
 
 // The bus (and optionally a log) on one side, the RunRecorder on the
 // other, and the clocks that decide when to stop waiting.
@@ -113,6 +119,13 @@ private:
                                    : "this recorder saved no cut";
   }
   std::optional<Clock::time_point> signalled_;
+  // Messages taken from the bus per channel (said at the end: what a log of
+  // the same run should hold). Bounded: any process may invent channels.
+  std::map<std::string, long long> received_;
+  void count_received(const std::string &ch) {
+    if (received_.size() < 256 || received_.count(ch)) ++received_[ch];
+    else ++received_["(other channels)"];
+  }
   bool start_cuts(); // the journal, new or resumed; false: fatal_ says why
   void dispatch(const std::string &ch, const void *data, int size);
   void take_checkpoint(const lcm::ReceiveBuffer *rb, const std::string &ch);
@@ -148,6 +161,7 @@ private:
   }
   template <class Msg, void (Session::*Take)(const Msg &)>
   void take_bytes(const void *data, int size, const std::string &ch) {
+    if (!replaying_) count_received(ch);
     if (cuts_ && !replaying_) cuts_->journal().append(ch, data, static_cast<uint32_t>(size));
     Msg m;
     std::string why;
@@ -211,6 +225,11 @@ void Session::subscribe() {
          &Session::raw<dynhet::displacement_t, &Session::take_result<dynhet::displacement_t, &R::on_displacement>>,
          this)
       ->setQueueCapacity(1000);
+  lcm_.subscribe(
+         channel_family(dynhet::kChanBondBreaking),
+         &Session::raw<dynhet::bond_breaking_t, &Session::take_result<dynhet::bond_breaking_t, &R::on_bond_breaking>>,
+         this)
+      ->setQueueCapacity(10000);
   // The launch scripts wait for this line before starting the sim.
   std::fprintf(stderr, "recorder: ready, waiting for run info%s%s\n", log_ ? " in " : "",
                log_ ? opt_.from_log.c_str() : "");
@@ -279,6 +298,8 @@ void Session::dispatch(const std::string &ch, const void *d, int n) {
     take_bytes<dh::clusters_t, &Session::take_result<dh::clusters_t, &R::on_clusters>>(d, n, ch);
   else if (in(dh::kChanDisplacement))
     take_bytes<dh::displacement_t, &Session::take_result<dh::displacement_t, &R::on_displacement>>(d, n, ch);
+  else if (in(dh::kChanBondBreaking))
+    take_bytes<dh::bond_breaking_t, &Session::take_result<dh::bond_breaking_t, &R::on_bond_breaking>>(d, n, ch);
 }
 
 bool Session::start_cuts() {
@@ -419,6 +440,10 @@ int Session::finish(const std::string &reason) {
   const std::vector<std::string> missing = rec_.finish(reason);
   if (paced_run) publish_own_status(missing.empty() ? "done" : "failed", missing.empty() ? "" : missing.front());
   const long long id = rec_.run_id();
+  std::string counts;
+  for (const auto &[ch, n] : received_) counts += " " + ch + " " + std::to_string(n) + ",";
+  if (!counts.empty()) counts.pop_back();
+  std::fprintf(stderr, "recorder: messages received per channel:%s\n", counts.c_str());
   if (missing.empty()) {
     std::fprintf(stderr, "recorder: run %lld complete -> %s\n", id, opt_.out.c_str());
     return 0;

@@ -12,6 +12,9 @@ namespace dynhet {
 
 namespace {
 
+constexpr const char *kCageRelative =
+    "cage-relative: dr_i less the mean dr of i's Voronoi neighbours in the origin frame";
+
 // A node's name as a path component.
 std::string node_key(const std::string &node) {
   std::string key = node.empty() ? "unnamed" : node;
@@ -229,17 +232,19 @@ void RunRecorder::write_node(const node_status_t &m) {
 bool RunRecorder::on_overlap(const overlap_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
   if (const std::string bad = frame_problem(m.frame_index); !bad.empty())
-    return rejected(cutoff_channel(kChanOverlap, m.cutoff_a), bad);
+    return rejected(cutoff_channel(kChanOverlap, m.cutoff_a, m.cage_relative), bad);
   guarded("overlap", [&] { write_overlap(m); });
-  if (m.is_final) completion_.final_result("overlap", m.cutoff_a);
+  if (m.is_final) completion_.final_result(result_group("overlap", m.cage_relative), m.cutoff_a);
   return true;
 }
 
 bool RunRecorder::on_msd(const msd_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
-  if (const std::string bad = frame_problem(m.frame_index); !bad.empty()) return rejected(kChanMsd, bad);
+  std::string bad = frame_problem(m.frame_index);
+  if (bad.empty() && m.n_fs > 0) bad = size_problem("F_s", m.n_fs, m.n_q, m.n_lags);
+  if (!bad.empty()) return rejected(result_channel(kChanMsd, m.cage_relative), bad);
   guarded("msd", [&] { write_msd(m); });
-  if (m.is_final) completion_.final_result("msd", 0.0);
+  if (m.is_final) completion_.final_result(result_group("msd", m.cage_relative), 0.0);
   return true;
 }
 
@@ -247,11 +252,13 @@ bool RunRecorder::on_msd(const msd_t &m) {
 // (records, lags), the subsets' fractions as attributes; diffusion,
 // diffusion_err, fit_t_min, fit_t_max: one number per record.
 void RunRecorder::write_msd(const msd_t &m) {
-  if (!msd_started_) {
-    writer_->write_fixed("msd/lag_time", m.lag_time);
-    writer_->set_attribute("observables/msd", "fraction_all", m.fraction_all);
-    writer_->set_attribute("observables/msd", "fraction_small", m.fraction_small);
-    msd_started_ = true;
+  const std::string group = result_group("msd", m.cage_relative);
+  if (started_.insert(group).second) {
+    writer_->write_fixed(group + "/lag_time", m.lag_time);
+    writer_->set_attribute("observables/" + group, "fraction_all", m.fraction_all);
+    writer_->set_attribute("observables/" + group, "fraction_small", m.fraction_small);
+    if (m.cage_relative) writer_->set_attribute("observables/" + group, "displacements", kCageRelative);
+    if (m.n_q > 0) writer_->write_fixed(group + "/fs_q", m.fs_q);
   }
   if (m.n_lags <= 0) return;
   if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
@@ -269,13 +276,26 @@ void RunRecorder::write_msd(const msd_t &m) {
       {"msd_fast_small_err", &m.msd_fast_small_err},
       {"msd_slow_small", &m.msd_slow_small},
       {"msd_slow_small_err", &m.msd_slow_small_err}};
-  for (const auto &[name, v] : per_lag) writer_->append_observable("msd/" + std::string(name), at, *v);
-  writer_->append_scalar("msd/diffusion", at, m.diffusion);
-  writer_->append_scalar("msd/diffusion_err", at, m.diffusion_err);
-  writer_->append_scalar("msd/diffusion_flow", at, m.diffusion_flow);
-  writer_->append_scalar("msd/diffusion_flow_err", at, m.diffusion_flow_err);
-  writer_->append_scalar("msd/fit_t_min", at, m.fit_t_min);
-  writer_->append_scalar("msd/fit_t_max", at, m.fit_t_max);
+  const std::string base = group + "/";
+  for (const auto &[name, v] : per_lag) writer_->append_observable(base + name, at, *v);
+  writer_->append_scalar(base + "diffusion", at, m.diffusion);
+  writer_->append_scalar(base + "diffusion_err", at, m.diffusion_err);
+  writer_->append_scalar(base + "diffusion_flow", at, m.diffusion_flow);
+  writer_->append_scalar(base + "diffusion_flow_err", at, m.diffusion_flow_err);
+  writer_->append_scalar(base + "fit_t_min", at, m.fit_t_min);
+  writer_->append_scalar(base + "fit_t_max", at, m.fit_t_max);
+  for (const auto &[name, v] : {std::pair<const char *, const std::vector<double> *>{"alpha2_all", &m.alpha2_all},
+                                {"alpha2_all_err", &m.alpha2_all_err},
+                                {"alpha2_small", &m.alpha2_small},
+                                {"alpha2_small_err", &m.alpha2_small_err}})
+    writer_->append_observable(base + name, at, *v);
+  if (m.n_fs > 0) {
+    const Shape q_lag{dim(m.n_q), dim(m.n_lags)};
+    writer_->append_observable(base + "fs_all", at, m.fs_all.data(), q_lag);
+    writer_->append_observable(base + "fs_all_err", at, m.fs_all_err.data(), q_lag);
+    writer_->append_observable(base + "fs_small", at, m.fs_small.data(), q_lag);
+    writer_->append_observable(base + "fs_small_err", at, m.fs_small_err.data(), q_lag);
+  }
 }
 
 bool RunRecorder::on_displacement(const displacement_t &m) {
@@ -285,9 +305,9 @@ bool RunRecorder::on_displacement(const displacement_t &m) {
     bad = size_problem("displacement series", m.n_series, m.n_sets, m.n_targets);
   if (bad.empty() && m.n_values > 0)
     bad = size_problem("displacement bins", m.n_values, m.n_sets, m.n_targets, m.n_bins);
-  if (!bad.empty()) return rejected(kChanDisplacement, bad);
+  if (!bad.empty()) return rejected(result_channel(kChanDisplacement, m.cage_relative), bad);
   guarded("displacement", [&] { write_displacement(m); });
-  if (m.is_final) completion_.final_result("displacement", 0.0);
+  if (m.is_final) completion_.final_result(result_group("displacement", m.cage_relative), 0.0);
   return true;
 }
 
@@ -296,10 +316,11 @@ bool RunRecorder::on_displacement(const displacement_t &m) {
 // (records, sets, targets), and per bin p, p_err, count (records, sets,
 // targets, bins); set 0 is all particles, set 1 the small ones.
 void RunRecorder::write_displacement(const displacement_t &m) {
-  const std::string base = "displacement/";
-  if (!displacement_started_) {
+  const std::string group = result_group("displacement", m.cage_relative), base = group + "/";
+  if (started_.insert(group).second) {
     writer_->write_fixed(base + "x", m.x);
-    const std::string g = "observables/displacement";
+    const std::string g = "observables/" + group;
+    if (m.cage_relative) writer_->set_attribute(g, "displacements", kCageRelative);
     writer_->set_attribute(g, "bin_width", m.bin_width);
     writer_->set_attribute(g, "n_sets", m.n_sets);
     writer_->set_attribute(g, "sets", "all,small");
@@ -310,7 +331,6 @@ void RunRecorder::write_displacement(const displacement_t &m) {
     writer_->set_attribute(g, "layout",
                            "per target [record][target]; per series [record][set][target]; "
                            "per bin [record][set][target][bin]");
-    displacement_started_ = true;
   }
   if (m.n_values <= 0) return;
   if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
@@ -501,13 +521,57 @@ void RunRecorder::write_clusters(const clusters_t &m) {
   }
 }
 
+bool RunRecorder::on_bond_breaking(const bond_breaking_t &m) {
+  if (!info_ || m.run_id != info_->run_id) return false;
+  std::string bad = frame_problem(m.frame_index);
+  if (bad.empty()) bad = size_problem("chi_B", m.n_values, m.n_grids, m.n_lags);
+  if (!bad.empty()) return rejected(kChanBondBreaking, bad);
+  guarded("bond_breaking", [&] { write_bond_breaking(m); });
+  if (m.is_final) completion_.final_result("bond_breaking", 0.0);
+  return true;
+}
+
+// bond_breaking/: lag_time, subbox_particles, subbox_per_side once (a1, a2
+// as attributes); per record c_b, c_b_err [lag], tau_b, tau_b_err,
+// bonds_per_particle, chi_b, chi_b_err [grid][lag], chi_b_peak, tau_chi_b
+// and their errors [grid].
+void RunRecorder::write_bond_breaking(const bond_breaking_t &m) {
+  const std::string base = "bond_breaking/";
+  if (started_.insert(base).second) {
+    writer_->write_fixed(base + "lag_time", m.lag_time);
+    writer_->write_fixed(base + "subbox_particles", m.subbox_particles);
+    writer_->write_fixed(base + "subbox_per_side", m.subbox_per_side);
+    writer_->set_attribute("observables/bond_breaking", "a1", m.a1);
+    writer_->set_attribute("observables/bond_breaking", "a2", m.a2);
+    writer_->set_attribute("observables/bond_breaking", "layout",
+                           "c_b, c_b_err [record][lag]; chi_b, chi_b_err [record][grid][lag]; chi_b_peak, "
+                           "tau_chi_b and their errors [record][grid]");
+  }
+  if (m.n_lags <= 0 || m.frame_index < 0) return; // no frame folded in yet: nothing to record
+  const Stamp at = *at_frame(m.frame_index, m.is_final);
+  writer_->append_observable(base + "c_b", at, m.c_b);
+  writer_->append_observable(base + "c_b_err", at, m.c_b_err);
+  writer_->append_scalar(base + "tau_b", at, m.tau_b);
+  writer_->append_scalar(base + "tau_b_err", at, m.tau_b_err);
+  writer_->append_scalar(base + "bonds_per_particle", at, m.bonds_per_particle);
+  if (m.n_values > 0) {
+    const Shape grid_lag{dim(m.n_grids), dim(m.n_lags)};
+    writer_->append_observable(base + "chi_b", at, m.chi_b.data(), grid_lag);
+    writer_->append_observable(base + "chi_b_err", at, m.chi_b_err.data(), grid_lag);
+    writer_->append_observable(base + "chi_b_peak", at, m.chi_b_peak);
+    writer_->append_observable(base + "tau_chi_b", at, m.tau_chi_b);
+    writer_->append_observable(base + "chi_b_peak_err", at, m.chi_b_peak_err);
+    writer_->append_observable(base + "tau_chi_b_err", at, m.tau_chi_b_err);
+  }
+}
+
 bool RunRecorder::on_chi4(const chi4_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
   std::string bad = frame_problem(m.frame_index);
   if (bad.empty() && m.n_values > 0) bad = size_problem("chi4", m.n_values, m.n_grids, m.n_lags);
-  if (!bad.empty()) return rejected(cutoff_channel(kChanChi4, m.cutoff_a), bad);
+  if (!bad.empty()) return rejected(cutoff_channel(kChanChi4, m.cutoff_a, m.cage_relative), bad);
   guarded("chi4", [&] { write_chi4(m); });
-  if (m.is_final) completion_.final_result("chi4", m.cutoff_a);
+  if (m.is_final) completion_.final_result(result_group("chi4", m.cage_relative), m.cutoff_a);
   return true;
 }
 
@@ -515,8 +579,8 @@ bool RunRecorder::on_chi4(const chi4_t &m) {
 // and their errors: (records, grids).
 void RunRecorder::write_chi4(const chi4_t &m) {
   const std::string label = cutoff_label(m.cutoff_a);
-  const std::string base = "chi4/" + label + "/";
-  if (!chi4_started_[label]) {
+  const std::string base = result_group("chi4", m.cage_relative) + "/" + label + "/";
+  if (started_.insert(base).second) {
     writer_->write_fixed(base + "lag_time", m.lag_time);
     writer_->write_fixed(base + "subbox_particles", m.subbox_particles);
     writer_->write_fixed(base + "subbox_per_side", m.subbox_per_side);
@@ -531,7 +595,7 @@ void RunRecorder::write_chi4(const chi4_t &m) {
                            "origin's own mean averaged over origins (low by about chi4 / n_boxes); chi4_peak, "
                            "tau4: the half-maximum peak fit of chi4, tau4_interior 0 where the peak is at "
                            "the first or last lag (a bound)");
-    chi4_started_[label] = true;
+    if (m.cage_relative) writer_->set_attribute("observables/" + base, "displacements", kCageRelative);
   }
   if (m.n_values <= 0) return;
   if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
@@ -551,13 +615,13 @@ void RunRecorder::write_chi4(const chi4_t &m) {
 
 void RunRecorder::write_overlap(const overlap_t &m) {
   const std::string label = cutoff_label(m.cutoff_a);
-  const std::string base = "overlap/" + label + "/";
-  if (!overlap_started_[label]) {
+  const std::string base = result_group("overlap", m.cage_relative) + "/" + label + "/";
+  if (started_.insert(base).second) {
     writer_->write_fixed(base + "lag_time", m.lag_time);
     writer_->set_attribute("observables/" + base, "cutoff_a", m.cutoff_a);
     writer_->set_attribute("observables/" + base, "subbox_per_side", m.subbox_per_side);
     writer_->set_attribute("observables/" + base, "subbox_particles", m.subbox_particles);
-    overlap_started_[label] = true;
+    if (m.cage_relative) writer_->set_attribute("observables/" + base, "displacements", kCageRelative);
   }
   if (m.n_lags <= 0) return;
   if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
@@ -573,8 +637,7 @@ void RunRecorder::write_overlap(const overlap_t &m) {
   writer_->append_scalar(base + "tau0", at, m.tau0);
   writer_->append_scalar(base + "tau0_err", at, m.tau0_err);
   if (m.n_t0 > 0) {
-    if (!overlap_t0_written_[label]) writer_->write_fixed(base + "t0", m.t0);
-    overlap_t0_written_[label] = true;
+    if (started_.insert(base + "t0").second) writer_->write_fixed(base + "t0", m.t0);
     writer_->append_observable(base + "tau_alpha_t0", at, m.tau_alpha_t0);
   }
 }

@@ -28,12 +28,16 @@
 //   clusters/a<cutoff>/<field> likewise, with lag_time, r and the size bins
 //   msd/<field>, displacement/<field> likewise (one each per run), with
 //   lag_time (msd) and x, the bin centres (displacement)
+//   bond_breaking/<field>: C_B, tau_B, chi_B per grid (write_bond_breaking)
+//   overlap_cr/, chi4_cr/, msd_cr/, displacement_cr/  the same of the
+//     cage-relative displacements (attribute displacements), in the same layout
 #pragma once
 
 #include <cstdint>
 #include <map>
 #include <memory>
 #include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -42,6 +46,7 @@
 #include "dynhet/frame_chunk_t.hpp"
 #include "dynhet/h5md.hpp"
 #include "dynhet/node_status_t.hpp"
+#include "dynhet/bond_breaking_t.hpp"
 #include "dynhet/chi4_t.hpp"
 #include "dynhet/clusters_t.hpp"
 #include "dynhet/displacement_t.hpp"
@@ -76,6 +81,7 @@ public:
   bool on_s4(const s4_t &m);
   bool on_clusters(const clusters_t &m);
   bool on_displacement(const displacement_t &m);
+  bool on_bond_breaking(const bond_breaking_t &m);
   bool on_frame_chunk(const frame_chunk_t &m);
   // A message dropped as malformed or inconsistent (by the caller or here):
   // counted, the last reason kept, both written to the file's summary.
@@ -113,12 +119,10 @@ private:
   Completion completion_;
   FrameAssembler assembler_{1};
   std::map<std::string, Node> nodes_;
-  std::map<std::string, bool> overlap_started_; // by cutoff label
-  std::map<std::string, bool> chi4_started_;    // by cutoff label
+  // The groups (and fixed datasets) written once: "msd", "overlap_cr/a0.6/", ...
+  std::set<std::string> started_;
   std::map<std::string, bool> s4_started_;      // by cutoff label
   std::map<std::string, bool> clusters_started_, clusters_r_written_, clusters_bins_written_;
-  std::map<std::string, bool> overlap_t0_written_;
-  bool msd_started_ = false, displacement_started_ = false;
   std::optional<int64_t> node_clock_zero_;      // utime of the first node status
   int write_errors_ = 0;
   int64_t rejected_ = 0;
@@ -146,6 +150,7 @@ private:
   void write_s4(const s4_t &m);
   void write_clusters(const clusters_t &m);
   void write_displacement(const displacement_t &m);
+  void write_bond_breaking(const bond_breaking_t &m);
   void write_summary(const std::vector<std::string> &missing);
   void count_frames();
   template <class F> void guarded(const char *what, F &&write);

@@ -77,7 +77,7 @@ dynhet::run_info_t make_run_info(const dynhet::Scene& sc, const dynhet::engine::
   m.n_pairs = static_cast<int32_t>(m.pair_frame.size());
   m.cutoff_a = sc.cutoff_a;
   m.n_cutoffs = static_cast<int32_t>(m.cutoff_a.size());
-  m.observables = sc.observables;
+  m.observables = sc.computed_observables();
   m.n_observables = static_cast<int32_t>(m.observables.size());
   m.overlap_subbox_particles = sc.overlap_subbox_particles;
   m.chi4_subbox_particles = sc.chi4_subbox_particles;

@@ -38,6 +38,7 @@
 #include "dynhet/checkpoint_t.hpp"
 #include "dynhet/chi4_t.hpp"
 #include "dynhet/clusters_t.hpp"
+#include "dynhet/bond_breaking_t.hpp"
 #include "dynhet/displacement_t.hpp"
 #include "dynhet/frame_chunk_t.hpp"
 #include "dynhet/msd_t.hpp"
@@ -210,6 +211,9 @@ int main(int argc, char** argv) {
     random_after_fingerprint<dynhet::s4_t>(lcm, "DYNHET_S4_a1", gen);
     random_after_fingerprint<dynhet::clusters_t>(lcm, "DYNHET_CLUSTERS_a1", gen);
     random_after_fingerprint<dynhet::displacement_t>(lcm, "DYNHET_DISPLACEMENT", gen);
+    random_after_fingerprint<dynhet::overlap_t>(lcm, "DYNHET_OVERLAP_CR_a0.6", gen);
+    random_after_fingerprint<dynhet::msd_t>(lcm, "DYNHET_MSD_CR", gen);
+    random_after_fingerprint<dynhet::bond_breaking_t>(lcm, "DYNHET_BOND_BREAKING", gen);
     random_after_fingerprint<dynhet::checkpoint_t>(lcm, "DYNHET_CHECKPOINT", gen);
     random_after_fingerprint<dynhet::checkpoint_t>(lcm, "DYNHET_CHECKPOINT_overlap", gen);
     // Checkpoint cuts of this run: forged requests (a huge cut number, a

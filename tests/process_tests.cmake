@@ -5,6 +5,12 @@ add_test(NAME e2e_tiny_scene_live_and_replay
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/e2e_tiny.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(e2e_tiny_scene_live_and_replay PROPERTIES LABELS process TIMEOUT 300)
 
+# Cage-relative measures, F_s, alpha_2 and bond breaking (tests/cage_relative.sh):
+# the tiny scene's against brute force (cages from scipy), resumed bit for bit.
+add_test(NAME cage_relative_tiny
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/cage_relative.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(cage_relative_tiny PROPERTIES LABELS process TIMEOUT 300)
+
 add_test(NAME run_scene_refuses_bad_scene
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/bad_scene.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(run_scene_refuses_bad_scene PROPERTIES LABELS process TIMEOUT 60)

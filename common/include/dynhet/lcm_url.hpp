@@ -35,6 +35,10 @@ inline int64_t utime_now() {
 //   DYNHET_CLUSTERS_<a>, DYNHET_S4_<a>                cutoff a: <a> is cutoff_label
 //                                                     (a0.6), as in run.h5's groups
 //   DYNHET_MSD, DYNHET_DISPLACEMENT                   results of all cutoffs at once
+//   DYNHET_BOND_BREAKING                              bond breaking (no cutoff)
+//   DYNHET_OVERLAP_CR_<a>, ..., DYNHET_MSD_CR          the same of the cage-relative
+//                                                     displacements ([observables]
+//                                                     cage_relative; groups <name>_cr)
 // The names are also LCM subscription patterns (regular expressions): a
 // channel with a cutoff holds a '.', so subscribe to the family
 // (channel_family) and compare names, never subscribe to a name.
@@ -48,6 +52,7 @@ inline constexpr const char* kChanMsd = "DYNHET_MSD";
 inline constexpr const char* kChanS4 = "DYNHET_S4";                   // + "_<a>"
 inline constexpr const char* kChanClusters = "DYNHET_CLUSTERS";       // + "_<a>"
 inline constexpr const char* kChanDisplacement = "DYNHET_DISPLACEMENT";
+inline constexpr const char* kChanBondBreaking = "DYNHET_BOND_BREAKING";
 // Checkpoint cuts (dynhet/cut.hpp): the sim's requests, and each process's
 // answer on DYNHET_CHECKPOINT_<process>.
 inline constexpr const char* kChanCheckpoint = "DYNHET_CHECKPOINT";
@@ -62,9 +67,19 @@ inline std::string cutoff_label(double cutoff_a) {
   std::snprintf(buf, sizeof buf, "a%g", cutoff_a);
   return buf;
 }
-// The channel of one cutoff's results: DYNHET_OVERLAP_a0.6.
-inline std::string cutoff_channel(const char* family, double cutoff_a) {
-  return std::string(family) + "_" + cutoff_label(cutoff_a);
+// The channel of results of all cutoffs: DYNHET_MSD, or DYNHET_MSD_CR for
+// the cage-relative displacements.
+inline std::string result_channel(const char* family, bool cage_relative = false) {
+  return std::string(family) + (cage_relative ? "_CR" : "");
+}
+// The channel of one cutoff's results: DYNHET_OVERLAP_a0.6 (cage-relative:
+// DYNHET_OVERLAP_CR_a0.6).
+inline std::string cutoff_channel(const char* family, double cutoff_a, bool cage_relative = false) {
+  return result_channel(family, cage_relative) + "_" + cutoff_label(cutoff_a);
+}
+// The run.h5 group of an observable's results: "overlap", or "overlap_cr".
+inline std::string result_group(const std::string& observable, bool cage_relative) {
+  return observable + (cage_relative ? "_cr" : "");
 }
 // The channel of one node's status: DYNHET_NODE_STATUS_overlap.
 inline std::string node_status_channel(const std::string& node) {

@@ -82,6 +82,10 @@ struct Scene {
   std::vector<std::string> observables{"overlap"};
   std::vector<double> cutoff_a{0.6};
   bool keep_frames = false;
+  // Also every displacement observable of the cage-relative displacements
+  // dr_i - (mean dr of i's Voronoi neighbours at the origin) (issue 26):
+  // overlap, chi4, msd and displacement, in groups <name>_cr.
+  bool cage_relative = false;
 
   // [overlap]
   int overlap_subbox_particles = 100; // target N = <N_r> per sub-box
@@ -120,6 +124,11 @@ struct Scene {
   struct Msd {
     double fraction_all = 0.1;   // fastest / slowest 10% of all particles
     double fraction_small = 0.2; // fastest / slowest 20% of the small ones
+    // F_s(q, t) at q = 2 pi / sigma_11, 2 pi / sigma_12, 2 pi / sigma_22
+    // (fs = true) and at these wave numbers too (units 1/r1). Each q costs
+    // one Bessel J0 per particle and pair (about 70 ns: docs/analysis.md).
+    bool fs = true;
+    std::vector<double> fs_q;
   } msd;
 
   // [displacement]: P(dx, t) of x displacements with Gaussian and
@@ -137,10 +146,19 @@ struct Scene {
     int bins() const { return static_cast<int>(std::lround(2 * x_max / bin_width)); }
   } displacement;
 
+  // [bond_breaking]: bonds r_ij < a1 sigma_ij at t0, broken at r_ij > a2 sigma_ij
+  struct BondBreaking {
+    double a1 = 1.1;
+    double a2 = 1.5;
+  } bond_breaking;
+
   // [transport]
   int chunk_particles = 8192; // 16 bytes each: 128 KiB of positions
 
   bool wants(const std::string& observable) const;
+  // The observables the run computes: those named, and with cage_relative
+  // the "<name>_cr" of each that has a cage-relative version.
+  std::vector<std::string> computed_observables() const;
 };
 
 // Parse and validate a scene given its text; `origin` names it in errors.
@@ -157,7 +175,10 @@ double scene_kick_rate(const Scene& s);
 // Observables this build knows how to compute.
 const std::vector<std::string>& known_observables();
 
-// The node that computes an observable: Q(t), chi4(t), the MSD and P(dx, t)
+// Whether an observable has a cage-relative version ("overlap" -> "overlap_cr").
+bool has_cage_relative(const std::string& observable);
+
+// The node that computes an observable (a "<name>_cr" too, beside <name>): Q(t), chi4(t), the MSD and P(dx, t)
 // come from the same pass over the displacements of the same (origin, lag)
 // pairs, so one node, "overlap", serves all four (one pass, one copy of the
 // frames). S4(q,t) has its own node, "s4" (an FFT per pair and grid: its own

@@ -1,6 +1,7 @@
 """The figure of the overlap Q(t) of a dynhet run (HDF5, H5MD layout) with its error
 bars, the 1/e line, tau_alpha and the fit 1/((t/tau0)^beta + 1), one curve
-per cutoff a; beside it tau_alpha against the waiting time t0 (aging check).
+per cutoff a (and the cage-relative Q(t), open markers, where the run has
+it); beside it tau_alpha against the waiting time t0 (aging check).
 
 """
 import math
@@ -37,6 +38,14 @@ def main(path, png):
                 tt = np.geomspace(t[0], t[-1], 200)
                 ax.plot(tt, 1 / ((tt / tau0) ** beta + 1), "--", color=color, lw=1,
                         label=rf"fit $\beta$ = {beta:.3g}, $\tau_0$ = {tau0:.3g}")
+            if "overlap_cr" in run.observables() and name in run.cutoffs("overlap_cr"):
+                # The same of the cage-relative displacements (observables.cage_relative).
+                c = run.observable("overlap_cr", name)
+                tau_cr = float(c["tau_alpha"])
+                ax.errorbar(c["lag_time"][()], c["q"], yerr=np.nan_to_num(c["q_err"]), marker="o", ms=3, mfc="none",
+                            capsize=2, color=color, ls="-.", lw=1,
+                            label=f"a = {a}, cage-relative" +
+                            (rf", $\tau_\alpha$ = {tau_cr:.4g}" if math.isfinite(tau_cr) else ""))
             if "tau_alpha_t0" in g:
                 ax2.plot(g["t0"], g["tau_alpha_t0"], "o-", ms=3, color=color, label=label.split(",")[0])
                 if math.isfinite(tau):
