@@ -21,10 +21,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include "dynhet/analysis/bonds.hpp"
 #include "dynhet/analysis/cage.hpp"
 #include "dynhet/analysis/clusters.hpp"
 #include "dynhet/analysis/displacement.hpp"
 #include "dynhet/analysis/displacement_distribution.hpp"
+#include "dynhet/analysis/overlap.hpp"
 #include "dynhet/analysis/s4.hpp"
 
 namespace an = dynhet::analysis;
@@ -375,6 +377,88 @@ void bench_cage(const Frames& f, int reps) {
   const Timing tc = time_calls(reps, [&] { an::cage_relative(dr.data(), v, cr.data()); });
   std::printf("%8ld %-52s %9.2f %9.2f %12.3f\n", f.n, "cage_relative (one origin, lag)", 1e3 * tc.min, 1e3 * tc.median,
               mean_nb);
+
+  // The overlap node's pass of one set per (origin, lag), as it does it:
+  // six nested grids and one cutoff with |dr|^2, the fastest/slowest
+  // subsets; the cage-relative set adds dr, dr^CR and pos0 + dr^CR first.
+  an::DisplacementSpec spec;
+  spec.grids = an::nested_subbox_grids(f.n, f.box, {25, 100, 400, 1600, 6400, int(f.n)});
+  spec.cutoffs = {0.6};
+  spec.hist_lo = -10, spec.hist_width = 0.05, spec.hist_bins = 400;
+  const an::OriginIndex origin(f.p0.data(), f.n, spec);
+  an::DisplacementResult r;
+  std::vector<double> d2(f.n), buffer, pos_cr(2 * f.n);
+  auto standard = [&](const double* pos) {
+    an::displacement_pass(f.p0.data(), pos, f.species.data(), f.n, origin, spec, r, d2.data());
+    an::msd_extremes_all_small(d2.data(), f.species.data(), f.n, 0.1, 0.2, buffer);
+  };
+  auto cage = [&] { // as the overlap node: cage_relative_positions, then the same
+    an::cage_relative_positions(f.p0.data(), f.pt.data(), v, dr, pos_cr.data());
+    standard(pos_cr.data());
+  };
+  std::vector<double> ts, tcr; // alternated, round after round
+  for (int rep = 0; rep < 4 * reps; ++rep) {
+    ts.push_back(time_calls(1, [&] { standard(f.pt.data()); }).min);
+    tcr.push_back(time_calls(1, cage).min);
+  }
+  const Timing a = summary(ts), b = summary(tcr);
+  std::printf("%8ld %-52s %9.2f %9.2f %12s\n", f.n, "standard pass of one set (6 grids, a=0.6, subsets)", 1e3 * a.min,
+              1e3 * a.median, "");
+  std::printf("%8ld %-52s %9.2f %9.2f %12.2f\n", f.n, "cage-relative pass (dr^CR + the same)  [ratio: median]",
+              1e3 * b.min, 1e3 * b.median, b.median / a.median);
+  // All the overlap node does per set and pair with the default scene's
+  // observables: also Q_r on the overlap grid, the waves |n| <= 4 and
+  // F_s at three q.
+  const an::SubboxGrid qgrid = an::make_subbox_grid(f.n, f.box, 64);
+  std::vector<double> q_r;
+  const double qs[3] = {M_PI, 2 * M_PI / 2.43, 2 * M_PI / 2.86};
+  double sink = 0;
+  auto whole = [&](const double* pos) {
+    an::overlap_subboxes(f.p0.data(), pos, f.n, qgrid, spec.cutoffs, q_r);
+    standard(pos);
+    const an::WaveModes w = an::collective_modes(f.p0.data(), pos, f.n, f.box, 4, r.msd_all);
+    sink += w.transverse[0];
+    for (long i = 0; i < f.n; ++i) {
+      const double rr = std::sqrt(d2[i]);
+      for (double q : qs) sink += ::j0(q * rr);
+    }
+  };
+  ts.clear(), tcr.clear();
+  for (int rep = 0; rep < reps; ++rep) {
+    ts.push_back(time_calls(1, [&] { whole(f.pt.data()); }).min);
+    tcr.push_back(time_calls(1, [&] {
+                    an::cage_relative_positions(f.p0.data(), f.pt.data(), v, dr, pos_cr.data());
+                    whole(pos_cr.data());
+                  }).min);
+  }
+  const Timing wa = summary(ts), wb = summary(tcr);
+  std::printf("%8ld %-52s %9.2f %9.2f %12s\n", f.n, "the node's whole set (+Q_r, waves |n|<=4, F_s 3 q)", 1e3 * wa.min,
+              1e3 * wa.median, "");
+  std::printf("%8ld %-52s %9.2f %9.2f %12.2f\n", f.n, "its cage-relative set  [ratio: median]", 1e3 * wb.min,
+              1e3 * wb.median, wb.median / wa.median);
+  // F_s at three q (2 pi / sigma_ab), as the overlap node adds it per set.
+  double fs = 0;
+  const Timing tf = time_calls(reps, [&] {
+    fs = 0;
+    for (long i = 0; i < f.n; ++i) {
+      const double rr = std::sqrt(d2[i]);
+      for (double q : qs) fs += ::j0(q * rr);
+    }
+  });
+  std::printf("%8ld %-52s %9.2f %9.2f %12.3g\n", f.n, "F_s at 3 q (glibc j0), one set [mean F_s]", 1e3 * tf.min,
+              1e3 * tf.median, fs / (3.0 * f.n) + 0 * sink);
+  // Bond breaking: the bonds of an origin (a1 = 1.1), which are intact at t (a2 = 1.5).
+  an::BondSet bonds;
+  const Timing tb = time_calls(reps, [&] {
+    bonds = an::make_bonds(f.p0.data(), f.species.data(), f.n, f.box, {2.0, 2.86}, 1.1, 1.5);
+  });
+  std::printf("%8ld %-52s %9.2f %9.2f %12.3f\n", f.n, "make_bonds (one origin) [bonds per particle]", 1e3 * tb.min,
+              1e3 * tb.median, double(bonds.pairs.pairs.size()) / f.n);
+  std::vector<std::uint8_t> intact(bonds.pairs.pairs.size());
+  long n_intact = 0;
+  const Timing ti = time_calls(reps, [&] { n_intact = an::bonds_intact(bonds, f.species.data(), dr.data(), intact.data()); });
+  std::printf("%8ld %-52s %9.2f %9.2f %12.3f\n", f.n, "bonds_intact (one origin, lag) [C_B]", 1e3 * ti.min,
+              1e3 * ti.median, double(n_intact) / std::max<size_t>(1, intact.size()));
 }
 
 int main(int argc, char** argv) {

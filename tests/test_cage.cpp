@@ -107,6 +107,26 @@ TEST(Cage, UniformTranslationHasNoCageRelativeDisplacement) {
   for (double c : cr) EXPECT_EQ(c, 0.0);
 }
 
+// What the overlap node hands its cage-relative measures: positions whose
+// displacements from pos0 are dr^CR, to rounding; a translation by far
+// more than L/2 leaves every particle where it started.
+TEST(Cage, CageRelativePositionsAreThoseOfTheCageRelativeDisplacements) {
+  const double box = 12.0;
+  const long n = 60;
+  const auto p0 = random_points(n, box, 0.9, 11);
+  const Neighbours v = voronoi_neighbours(p0.data(), n, box);
+  std::mt19937_64 gen(3);
+  std::normal_distribution<double> g(0.0, 0.7);
+  std::vector<double> pos(2 * n), dr(2 * n), cr(2 * n), out(2 * n), buffer;
+  for (long i = 0; i < 2 * n; ++i) pos[i] = p0[i] + 40.0 + g(gen), dr[i] = pos[i] - p0[i];
+  cage_relative(dr.data(), v, cr.data());
+  cage_relative_positions(p0.data(), pos.data(), v, buffer, out.data());
+  for (long i = 0; i < 2 * n; ++i) EXPECT_NEAR(out[i] - p0[i], cr[i], 1e-12) << i;
+  for (long i = 0; i < 2 * n; ++i) pos[i] = p0[i] + 40.0;
+  cage_relative_positions(p0.data(), pos.data(), v, buffer, out.data());
+  for (long i = 0; i < 2 * n; ++i) EXPECT_NEAR(out[i], p0[i], 1e-12) << i;
+}
+
 TEST(Cage, SinusoidalShearOfATriangularLatticeIsKnownExactly) {
   // nx columns a apart, ny rows b apart, odd rows shifted by a/2: every
   // particle has 6 neighbours, 2 in its row and 4 at dy = +-b. For dr_x =

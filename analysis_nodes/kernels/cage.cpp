@@ -106,4 +106,21 @@ void cage_relative(const double* dr, const Neighbours& v, double* out) {
   }
 }
 
+void cage_relative_positions(const double* pos0, const double* pos, const Neighbours& v, std::vector<double>& dr,
+                             double* out) {
+  const long n = v.size();
+  dr.resize(2 * n);
+  for (long i = 0; i < 2 * n; ++i) dr[i] = pos[i] - pos0[i];
+  for (long i = 0; i < n; ++i) {
+    const long c = v.count(i);
+    double mx = 0, my = 0;
+    for (std::int64_t k = v.offset[i]; k < v.offset[i + 1]; ++k) {
+      const std::int32_t j = v.list[k];
+      mx += dr[2 * j], my += dr[2 * j + 1];
+    }
+    out[2 * i] = pos[2 * i] - (c > 0 ? mx / c : 0.0);
+    out[2 * i + 1] = pos[2 * i + 1] - (c > 0 ? my / c : 0.0);
+  }
+}
+
 } // namespace dynhet::analysis
