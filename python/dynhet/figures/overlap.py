@@ -1,7 +1,8 @@
 """The figure of the overlap Q(t) of a dynhet run (HDF5, H5MD layout) with its error
 bars, the 1/e line, tau_alpha and the fit 1/((t/tau0)^beta + 1), one curve
 per cutoff a (and the cage-relative Q(t), open markers, where the run has
-it); beside it tau_alpha against the waiting time t0 (aging check).
+it) and the bond-breaking C_B(t) (where the run has it); beside it
+tau_alpha against the waiting time t0 (aging check).
 
 """
 import math
@@ -50,10 +51,17 @@ def main(path, png):
                 ax2.plot(g["t0"], g["tau_alpha_t0"], "o-", ms=3, color=color, label=label.split(",")[0])
                 if math.isfinite(tau):
                     ax2.axhline(tau, color=color, ls=":", lw=1)
+        if "bond_breaking" in run.observables():  # C_B(t), the other correlator from 1 to 0
+            b = run.observable("bond_breaking")
+            tau_b = float(b["tau_b"])
+            ax.errorbar(b["lag_time"][()], b["c_b"], yerr=np.nan_to_num(b["c_b_err"]), color="black", marker="s",
+                        ms=3, capsize=2, lw=1.2,
+                        label=rf"$C_B$ (bonds {b.attrs.get('a1', '?')}, {b.attrs.get('a2', '?')} $\sigma$)" +
+                        (rf", $\tau_B$ = {tau_b:.4g}" if math.isfinite(tau_b) else ""))
         ax.axhline(math.exp(-1), color="gray", ls="--", lw=1, label="1/e")
         ax.set_xscale("log")
         ax.set_xlabel("t")
-        ax.set_ylabel("Q(t)")
+        ax.set_ylabel("Q(t), $C_B(t)$" if "bond_breaking" in run.observables() else "Q(t)")
         ax.set_ylim(0, 1.05)
         title = "overlap"
         if "system" in run.parameters:
