@@ -28,6 +28,7 @@ from .transport import d_results, pdx_results
 from .clusters import cluster_results
 from .chi4_s4 import chi4_results, fss_results, joint_fit, s4_results
 from .size import d_n_results, tau_n_results
+from .local_measures import local_n_results, local_phi_results
 from .cutoff import cutoff_results
 from .restitution import restitution_results
 from .appendix import appendix_results
@@ -88,6 +89,8 @@ def main(argv=None):
     step("finite size", fss_results, joint)
     step("tau_alpha against N", tau_n_results)
     step("D against N", d_n_results)
+    step("cage-relative tau_alpha and bond breaking against phi", local_phi_results)
+    step("cage-relative tau_alpha and bond breaking against N", local_n_results)
     step("cutoff a", cutoff_results)
     step("restitution", restitution_results)
     step("appendix", appendix_results)

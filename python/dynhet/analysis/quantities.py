@@ -152,4 +152,6 @@ PER_RUN = {"tau_alpha": tau, "beta": lambda r: (cut(r)["beta"], cut(r)["beta_err
            "kappa_slow_node": lambda r: (cut(r)["cl_slow_kappa"], cut(r)["cl_slow_kappa_err"]),
            "n_star_slow": n_star,
            "cluster_lag_over_tau_alpha": lambda r: (cut(r)["cl_lag"] / cut(r)["tau_alpha"], math.nan),
-           "s4_lag_over_tau_alpha": lambda r: (cut(r)["s4_t_s4"] / cut(r)["tau_alpha"], math.nan)}
+           "s4_lag_over_tau_alpha": lambda r: (cut(r)["s4_t_s4"] / cut(r)["tau_alpha"], math.nan),
+           "tau_alpha_cr": lambda r: (cut(r).get("tau_cr", math.nan), cut(r).get("tau_cr_err", math.nan)),
+           "tau_b": lambda r: (r.get("tau_b", math.nan), r.get("tau_b_err", math.nan))}

@@ -31,11 +31,15 @@ def read_run(path, meta):
         r["N"] = int(meta["n_particles"])
         r["cut"] = {}
         ov, ch, s4g, cl = (cutoff_groups(run, k) for k in ("overlap", "chi4", "s4", "clusters"))
+        ov_cr = cutoff_groups(run, "overlap_cr") if "overlap_cr" in obs else {}
         for a, g in ov.items():
             c = {"lag": g["lag_time"][:], "q": last(g, "q"), "q_err": last(g, "q_err")}
             for k in ("tau_alpha", "tau_alpha_err", "beta", "beta_err", "tau0", "tau0_err"):
                 c[k] = fnum(last(g, k))
             c["tau_t0"] = last(g, "tau_alpha_t0")
+            if a in ov_cr:  # the cage-relative overlap (observables.cage_relative)
+                c["tau_cr"], c["tau_cr_err"] = fnum(last(ov_cr[a], "tau_alpha")), fnum(last(ov_cr[a], "tau_alpha_err"))
+                c["q_cr"] = last(ov_cr[a], "q")
             c["t0"] = g["t0"][:] if "t0" in g else None
             if a in ch:
                 h = ch[a]
@@ -90,6 +94,10 @@ def read_run(path, meta):
             r["pdx_x"], r["pdx_lag"] = x, lt
             r["pdx"] = last(d, "p").reshape(-1, len(lt), len(x))
             r["pdx_target"] = last(d, "target_tau_alpha")
+        if "bond_breaking" in obs:
+            b = run.observable("bond_breaking")
+            r["tau_b"], r["tau_b_err"] = fnum(last(b, "tau_b")), fnum(last(b, "tau_b_err"))
+            r["c_b_lag"], r["c_b"] = b["lag_time"][:], last(b, "c_b")
         if "sim" in obs:
             s = run.observable("sim")
             r["Z"], r["Z_err"] = fnum(last(s, "reduced_pressure")), fnum(last(s, "reduced_pressure_err"))

@@ -1,0 +1,94 @@
+"""Cage-relative tau_alpha and bond breaking (issue 26): tau_alpha^CR(phi) and
+tau_B(phi) with the power-law and VFT fits of tau_alpha(phi), and the three
+against N where a density was run at several N (studies/cage.toml). Rows only
+where some run measured them ([observables] cage_relative, "bond_breaking")."""
+import math
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from .config import say
+from .overlap import tau_fits
+from .plotting import colours
+from .points import point_error, series_arrays
+from .quantities import PER_RUN, tau
+from .size import points_by_phi_n
+from .verdicts import fmt
+
+TAU_CR, TAU_B = PER_RUN["tau_alpha_cr"], PER_RUN["tau_b"]
+MEASURES = (("τ_α", tau, "k", "o"), ("τ_α^CR (cage-relative)", TAU_CR, "tab:purple", "s"),
+            ("τ_B (bond breaking)", TAU_B, "tab:green", "^"))
+
+
+def measured(p, fn):
+    return np.isfinite(p.mean(fn)[0])
+
+
+def local_phi_results(A):
+    pts = [p for p in A.series() if measured(p, TAU_CR) or measured(p, TAU_B)]
+    if not pts:
+        say("    no run measured tau_alpha^CR or tau_B: no rows")
+        return
+    fig, ax = plt.subplots(figsize=(6.5, 4.6))
+    for label, fn, col, m in MEASURES:
+        sel = [p for p in pts if measured(p, fn)]
+        x, y, e = series_arrays(sel, fn)
+        ax.errorbar(x, y, e, fmt=m, ms=4, color=col, label=label)
+        if len(sel) < 4 or fn is tau:
+            continue
+        fp, fv = tau_fits(A, sel, "eps0.9_" + ("cr" if fn is TAU_CR else "B"))
+        xx = np.linspace(x.min(), x.max(), 200)
+        if fp.ok:
+            ax.plot(xx, fp.p["A"] * (fp.p["xc"] - xx) ** -fp.p["g"], "--", color=col, lw=0.8)
+        name = label.split(" ")[0]
+        for f, what, key in ((fp, "power law: φ_c", "xc"), (fv, "VFT: φ_0", "x0")):
+            extra = (f", γ {fmt(f.p['g'], f.error('g'))}" if key == "xc" else f", B {fmt(f.p['B'], f.error('B'))}")
+            A.row(f"{name}(φ) {what}", "issue 26 (not in the paper)", "not measured",
+                  fmt(f.p[key], f.error(key), 4) + extra + f", χ²/dof {f.chi2_dof():.2g}", "—", "", sel, f.note)
+    ax.set_yscale("log")
+    ax.set_xlabel("φ")
+    ax.set_ylabel("relaxation time")
+    ax.legend(fontsize=8)
+    ax.set_title("τ_α, cage-relative τ_α^CR and bond-breaking τ_B (ε = 0.9, a = 0.6)")
+    f = A.save(fig, "tau_local_phi.png")
+    for p in pts:
+        cells = [f"{label.split(' ')[0]} {fmt(*p.mean(fn)[:2])}" for label, fn, _, _ in MEASURES if measured(p, fn)]
+        A.row(f"relaxation times at φ = {p.phi:g} (N {p.N})", "issue 26 (not in the paper)", "not measured",
+              ", ".join(cells), "—", f, [p])
+
+
+def local_n_results(A):
+    """tau_alpha, tau_alpha^CR and tau_B against N at each density run at
+    several N: does the cage-relative tau_alpha still depend on N?"""
+    multi = points_by_phi_n(A, lambda p: measured(p, TAU_CR))
+    if not multi:
+        say("    no density with tau_alpha^CR at several N: no rows")
+        return
+    fig, axes = plt.subplots(1, len(multi), figsize=(5.5 * len(multi), 4.4), squeeze=False)
+    for (phi, d), ax in zip(multi.items(), axes[0]):
+        ns = sorted(d)
+        used = [d[n] for n in ns]
+        for label, fn, col, m in MEASURES:
+            ms = [d[n].mean(fn) for n in ns]
+            ok = [i for i, v in enumerate(ms) if v[3]]
+            ax.errorbar([ns[i] for i in ok], [ms[i][0] for i in ok], [point_error(ms[i]) for i in ok], fmt=m + "-",
+                        color=col, label=label)
+            if len(ok) < 2:
+                continue
+            # each N: the mean over seeds, the error the runs quote and the seeds' own spread
+            cells = ", ".join(f"N {ns[i]}: {fmt(ms[i][0], point_error(ms[i]))} (seeds {ms[i][3]}, spread ± "
+                              f"{ms[i][2]:.2g})" for i in ok)
+            lo, hi = ms[ok[0]], ms[ok[-1]]
+            z = abs(hi[0] - lo[0]) / math.hypot(point_error(lo), point_error(hi))
+            drift = f"{(hi[0] / lo[0]) ** (1 / math.log2(ns[ok[-1]] / ns[ok[0]])) - 1:+.1%} per doubling of N"
+            verdict = (f"depends on N ({z:.1f} σ from N {ns[ok[0]]} to {ns[ok[-1]]}, {drift})" if z > 2 else
+                       f"no N dependence resolved ({z:.1f} σ from N {ns[ok[0]]} to {ns[ok[-1]]})")
+            A.row(f"{label.split(' ')[0]} against N at φ = {phi:g}", "issue 26, item 8 (not in the paper)",
+                  "not measured", cells, verdict, "", used)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel("N")
+        ax.set_ylabel("relaxation time")
+        ax.set_title(f"φ = {phi:g}, ε = 0.9, a = 0.6")
+        ax.legend(fontsize=8)
+    A.save(fig, "tau_local_N.png")
