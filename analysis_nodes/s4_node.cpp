@@ -30,15 +30,22 @@
 // pair and cutoff; and the FFT grids, 16 (L/h)^2 bytes per grid (h the grid
 // spacing), one set for all cutoffs.
 //
+// With [observables] cage_relative, every cutoff again with the weights of
+// the cage-relative displacements, w_i = theta(a - |dr_i^CR|) (Voronoi cages
+// of the origin frame, as the overlap node's), on DYNHET_S4_CR_<a>, its
+// t_s4 the cage-relative tau_alpha; positions are those at t0 both ways.
+//
 // Usage: s4_node [--lcm-url URL] [--publish-url URL] (as overlap_node)
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <map>
 #include <memory>
 #include <numeric>
 #include <string>
 
+#include "dynhet/analysis/cage.hpp"
 #include "dynhet/analysis/displacement.hpp"
 #include "dynhet/analysis/lag_interpolation.hpp"
 #include "dynhet/analysis/overlap.hpp"
@@ -86,7 +93,11 @@ private:
     interpolate_ = scene.s4_lags.empty(); // listed lags: results at the one nearest tau_alpha
     for (int j = 0; j < m.n_lags; ++j)
       if (slot_[j] == 0) slot_[j] = static_cast<int>(lags_.size()), lags_.push_back(m.lag_time[j]);
-    for (double a : m.cutoff_a) cuts_.push_back(Cutoff{a, {}, std::make_unique<an::OverlapAccumulator>(m.n_origins, m.lag_time)});
+    cage_ = std::find(m.observables.begin(), m.observables.end(), "s4_cr") != m.observables.end();
+    for (bool cr : {false, true})
+      if (!cr || cage_)
+        for (double a : m.cutoff_a)
+          cuts_.push_back(Cutoff{a, cr, {}, std::make_unique<an::OverlapAccumulator>(m.n_origins, m.lag_time)});
     const std::vector<double> none;
     for (const an::SubboxGrid& g : s4_grids(m.n_particles, m.box_length, sizes)) {
       grids_.push_back(g);
@@ -96,7 +107,7 @@ private:
       for (Cutoff& c : cuts_) c.acc.emplace_back(m.n_origins, static_cast<int>(lags_.size()), shells.q, shells.n_vectors);
     }
     std::fprintf(stderr, "s4_node: a =");
-    for (const Cutoff& c : cuts_) std::fprintf(stderr, " %g", c.a);
+    for (const Cutoff& c : cuts_) std::fprintf(stderr, " %g%s", c.a, c.cr ? " (cage-relative)" : "");
     std::fprintf(stderr, ", q <= %g, %zu of %d lags, grids (m: points):", q_max_, lags_.size(), m.n_lags);
     for (size_t g = 0; g < grids_.size(); ++g) std::fprintf(stderr, " %d: %d", grids_[g].per_side, fft_[g]->points());
     std::fprintf(stderr, "\n");
@@ -110,17 +121,29 @@ private:
   }
   void load_state(dynhet::StateIn& in) override {
     for (Cutoff& c : cuts_) in(c.acc, *c.q_acc);
+    if (cage_) // the cages of the held origins, rebuilt from their positions
+      for (const auto& [k, pos0] : held_origins()) on_origin(k, pos0);
   }
+  void on_origin(int k, const std::vector<double>& pos0) override {
+    if (cage_) cages_[k] = an::voronoi_neighbours(pos0.data(), info().n_particles, info().box_length);
+  }
+  void on_origin_dropped(int k) override { cages_.erase(k); }
 
   void on_pair(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) override {
     const long n = info().n_particles;
     d2_.resize(n);
     for (long i = 0; i < n; ++i)
       d2_[i] = std::pow(f.position[2 * i] - pos0[2 * i], 2) + std::pow(f.position[2 * i + 1] - pos0[2 * i + 1], 2);
+    if (cage_) { // |dr^CR|^2, from the positions pos0 + dr^CR
+      pos_cr_.resize(2 * n), d2_cr_.resize(n);
+      an::cage_relative_positions(pos0.data(), f.position.data(), cages_.at(k), dr_, pos_cr_.data());
+      for (long i = 0; i < n; ++i)
+        d2_cr_[i] = std::pow(pos_cr_[2 * i] - pos0[2 * i], 2) + std::pow(pos_cr_[2 * i + 1] - pos0[2 * i + 1], 2);
+    }
     // Per cutoff: the weights and the transforms, on the grids (plans and
     // buffers) all cutoffs share; d2 is the same for every cutoff.
     for (Cutoff& c : cuts_) {
-      an::overlap_weights(d2_.data(), n, c.a, w_); // w_i = theta(a - |dr_i|)
+      an::overlap_weights((c.cr ? d2_cr_ : d2_).data(), n, c.a, w_); // w_i = theta(a - |dr_i|)
       const double q = std::accumulate(w_.begin(), w_.end(), 0.0) / n; // Q(t;t0) = W(0) of the whole box
       c.q_acc->add(k, j, &q, 1);
       for (size_t g = 0; g < grids_.size(); ++g)
@@ -131,6 +154,7 @@ private:
   // What the node keeps per cutoff a: S4 per grid and Q(t;t0) of the whole box.
   struct Cutoff {
     double a;
+    bool cr; // of the cage-relative displacements
     std::vector<an::S4Accumulator> acc;            // per grid
     std::unique_ptr<an::OverlapAccumulator> q_acc; // Q(t;t0) of the whole box, for tau_alpha and chi4
   };
@@ -165,6 +189,7 @@ private:
   void publish_cutoff(const Cutoff& c, bool final) {
     dynhet::s4_t m{};
     stamp(m, final);
+    m.cage_relative = c.cr;
     m.cutoff_a = c.a, m.q_max = q_max_, m.qxi_max = kQxiMax;
     m.tau_alpha = c.q_acc->result().tau_alpha;
     const int l = fit_slot(c, m.tau_alpha);
@@ -201,14 +226,15 @@ private:
     m.n_lags = static_cast<int32_t>(lags_.size());
     m.n_lag_values = static_cast<int32_t>(m.s4_lag.size());
     m.n_lag_fits = static_cast<int32_t>(m.xi_lag.size());
-    if (out().publish(dynhet::cutoff_channel(dynhet::kChanS4, m.cutoff_a), &m) != 0)
+    const char* cr = c.cr ? " (cage-relative)" : "";
+    if (out().publish(dynhet::cutoff_channel(dynhet::kChanS4, m.cutoff_a, c.cr), &m) != 0)
       std::fprintf(stderr, "s4_node: could not publish S4 (%d bytes)\n", m.getEncodedSize());
     if (final)
-      std::fprintf(stderr, "s4_node: a=%g t_s4=%.4g (tau_alpha %.4g; %s), whole box xi=%.4g +- %.2g chi0=%.4g +- %.2g, chi4=%.4g +- %.2g (%d origins)\n",
-                   m.cutoff_a, m.t_s4, m.tau_alpha,
+      std::fprintf(stderr, "s4_node%s: a=%g t_s4=%.4g (tau_alpha %.4g; %s), whole box xi=%.4g +- %.2g chi0=%.4g +- %.2g, chi4=%.4g +- %.2g (%d origins)\n",
+                   cr, m.cutoff_a, m.t_s4, m.tau_alpha,
                    m.lag_lo >= 0 ? "interpolated between two lags" : "the lag nearest", m.xi, m.xi_err, m.chi0, m.chi0_err, m.chi4_box, m.chi4_box_err, m.n_origins);
     if (final)
-      for (const auto& n : notes) std::fprintf(stderr, "s4_node: a=%g %s\n", m.cutoff_a, n.c_str());
+      for (const auto& n : notes) std::fprintf(stderr, "s4_node%s: a=%g %s\n", cr, m.cutoff_a, n.c_str());
     if (final) {
       // The whole box's xi against the fit range (q xi <= 0.5 .. 2).
       std::string xs;
@@ -218,8 +244,8 @@ private:
         xs += buf;
       }
       const std::vector<double> v(m.scan_oz_xi.begin() + whole * m.n_scan, m.scan_oz_xi.begin() + (whole + 1) * m.n_scan);
-      std::fprintf(stderr, "s4_node: a=%g whole box OZ xi by fit range (q xi <=):%s; half their range %.2g against the error %.2g\n",
-                   m.cutoff_a, xs.c_str(), an::half_range(v), m.xi_err);
+      std::fprintf(stderr, "s4_node%s: a=%g whole box OZ xi by fit range (q xi <=):%s; half their range %.2g against the error %.2g\n",
+                   cr, m.cutoff_a, xs.c_str(), an::half_range(v), m.xi_err);
     }
   }
 
@@ -286,6 +312,9 @@ private:
   std::vector<std::unique_ptr<an::S4Grid>> fft_; // per grid, shared by the cutoffs
   std::vector<Cutoff> cuts_;                     // per cutoff of the scene, in its order
   std::vector<double> d2_, w_;                   // per pair, reused (w_: one cutoff at a time)
+  bool cage_ = false;                            // also the cage-relative cutoffs (s4_cr)
+  std::map<int, an::Neighbours> cages_;          // origin k -> its Voronoi neighbours
+  std::vector<double> dr_, pos_cr_, d2_cr_;      // per pair, reused: the cage-relative |dr|^2
   Clock::time_point last_publish_{};
 };
 

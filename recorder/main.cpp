@@ -80,7 +80,7 @@ std::string channel_of(const dynhet::overlap_t &m) {
 std::string channel_of(const dynhet::chi4_t &m) {
   return cutoff_channel(dynhet::kChanChi4, m.cutoff_a, m.cage_relative);
 }
-std::string channel_of(const dynhet::s4_t &m) { return cutoff_channel(dynhet::kChanS4, m.cutoff_a); }
+std::string channel_of(const dynhet::s4_t &m) { return cutoff_channel(dynhet::kChanS4, m.cutoff_a, m.cage_relative); }
 std::string channel_of(const dynhet::clusters_t &m) {
   return cutoff_channel(dynhet::kChanClusters, m.cutoff_a);
 }

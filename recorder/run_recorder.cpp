@@ -365,9 +365,9 @@ bool RunRecorder::on_s4(const s4_t &m) {
     bad = size_problem("xi_lag, chi0_lag", m.n_lag_fits, m.n_lags, m.n_grids);
   if (bad.empty() && m.n_values > 0)
     bad = size_problem("scan_oz_xi, scan_oz_chi0, scan_a2_xi, scan_a2_chi0", m.n_scan_values, m.n_grids, m.n_scan);
-  if (!bad.empty()) return rejected(cutoff_channel(kChanS4, m.cutoff_a), bad);
+  if (!bad.empty()) return rejected(cutoff_channel(kChanS4, m.cutoff_a, m.cage_relative), bad);
   guarded("s4", [&] { write_s4(m); });
-  if (m.is_final) completion_.final_result("s4", m.cutoff_a);
+  if (m.is_final) completion_.final_result(result_group("s4", m.cage_relative), m.cutoff_a);
   return true;
 }
 
@@ -382,8 +382,8 @@ bool RunRecorder::on_s4(const s4_t &m) {
 // chi4_box, chi4_box_err.
 void RunRecorder::write_s4(const s4_t &m) {
   const std::string label = cutoff_label(m.cutoff_a);
-  const std::string base = "s4/" + label + "/";
-  if (!s4_started_[label]) {
+  const std::string base = result_group("s4", m.cage_relative) + "/" + label + "/";
+  if (started_.insert(base).second) {
     writer_->write_fixed(base + "lag_time", m.lag_time);
     writer_->write_fixed(base + "subbox_particles", m.subbox_particles);
     writer_->write_fixed(base + "subbox_per_side", m.subbox_per_side);
@@ -404,7 +404,7 @@ void RunRecorder::write_s4(const s4_t &m) {
                            "chi0 NaN); 2: xi below the q range, q xi < 0.5 at the largest q fitted (xi NaN); "
                            "3: no fit. The same rule as oz_xi at t_s4 (whose jackknife error must also be "
                            "below xi)");
-    s4_started_[label] = true;
+    if (m.cage_relative) writer_->set_attribute(g, "displacements", kCageRelative);
   }
   if (m.n_values <= 0) return;
   if (m.frame_index < 0) return; // no frame folded in yet: nothing to record

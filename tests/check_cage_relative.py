@@ -7,7 +7,8 @@ tiled 3 x 3, taken for the central copy and folded back to particle indices.
 
   dr_i^CR = dr_i - mean over j in V_i(t0) of dr_j
 
-Checked: overlap_cr Q(t) and tau_alpha per cutoff, msd_cr (all and small
+Checked: overlap_cr Q(t) and tau_alpha per cutoff, s4_cr by check_run.py's
+exact sums with the cage-relative weights, msd_cr (all and small
 particles), chi4_cr of the whole box (N times the variance of Q over
 origins, n - 1), and in msd and msd_cr both ways F_s(q, t) = <J0(q |dr|)>
 (scipy's j0) at the recorded q and alpha_2(t) = <dr^4> / (2 <dr^2>^2) - 1,
@@ -69,7 +70,7 @@ def main(path):
     f = h5py.File(path, "r")
     obs = f["observables"]
     check(int(f.attrs.get("complete", 0)) == 1, "file marked complete")
-    for name in ("overlap", "chi4", "msd", "displacement"):
+    for name in ("overlap", "chi4", "msd", "displacement", "s4"):
         if name in obs:
             check(name + "_cr" in obs, f"{name}_cr recorded beside {name}")
     L = float(f["particles/all/box/edges"][0])
@@ -126,6 +127,13 @@ def main(path):
         # At the shortest lag the neighbours' displacements are nearly
         # independent of i's: <|dr^CR|^2> = <|dr|^2> (1 + <1/N_i>), about 7/6.
         check(1.05 < short < 1.3, f"msd_cr / msd at the shortest lag {short:.3f}: about 1 + 1/6")
+    if "s4_cr" in obs:  # S4 of the cage-relative weights, by the exact sums of check_run.py
+        import check_run
+        check_run.failures = failures
+        lag = obs["schedule"]["lag_time"][()]
+        for name, g in obs["s4_cr"].items():
+            check_run.check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, lag,
+                               dr_of=lambda k, j: dr_cr[k, j], overlap="overlap_cr", need_fit=False)
     if "msd" in obs:
         small = species == np.min(species)
         radius = f["parameters/run_info"].attrs.get("radius") if "parameters/run_info" in f else None

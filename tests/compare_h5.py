@@ -7,7 +7,7 @@ What a run's wall clock decides, and so is compared only where it is not the clo
 - the sim's status (observables/sim): it is published once a second, so which frames have a record is the
   clock's; its last record (the sim's last word: Z, collision counts, frames) is compared, but
   collisions_per_second and eta_seconds, which are rates of the clock;
-- s4 and displacement (and displacement_cr) publish at most once a second before their final message: their last record is
+- s4 and displacement (and their _cr) publish at most once a second before their final message: their last record is
   compared (the final result), the earlier ones are the clock's.
 
 Usage: compare_h5.py A.h5 B.h5 [--verbose] [--ignore PATH]...
@@ -19,7 +19,8 @@ import sys
 import h5py
 import numpy as np
 
-THROTTLED = ("observables/sim/", "observables/s4/", "observables/displacement/", "observables/displacement_cr/")
+THROTTLED = ("observables/sim/", "observables/s4/", "observables/s4_cr/", "observables/displacement/",
+             "observables/displacement_cr/")
 WALL = ("/wall_time/", "observables/sim/collisions_per_second/", "observables/sim/eta_seconds/")
 
 
