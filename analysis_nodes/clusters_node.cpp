@@ -25,6 +25,13 @@
 //   their neighbour graphs (4 N + 8 per pair, ~30 N bytes); tallies of
 //   n_cutoffs x n_lags x 2 x blocks x ~5 log10(N) bins x 32 bytes.
 //
+// - Cage-relative ([observables] cage_relative): every cutoff again with
+//   slow and fast chosen by |dr^CR| (Voronoi cages of the origin frame, as
+//   the overlap node's), the same neighbour graph and R_g at t0 + t, its
+//   own tau_alpha (of the cage-relative Q), on DYNHET_CLUSTERS_CR_<a>. The
+//   sets are indexed c = 0 .. 2 n_cutoffs - 1: cutoff c % n_cutoffs,
+//   cage-relative from n_cutoffs on.
+//
 // Usage: clusters_node [--lcm-url URL] [--publish-url URL] (see frame_node.hpp)
 #include <algorithm>
 #include <array>
@@ -39,6 +46,7 @@
 #include <vector>
 
 #include "dynhet/model.hpp"
+#include "dynhet/analysis/cage.hpp"
 #include "dynhet/analysis/clusters.hpp"
 #include "dynhet/analysis/fits.hpp"
 #include "dynhet/analysis/lag_interpolation.hpp"
@@ -120,10 +128,12 @@ private:
     if (spec_.neighbour_cutoffs.size() == 3)
       cut_ = an::NeighbourCutoffs{{spec_.neighbour_cutoffs[0], spec_.neighbour_cutoffs[1], spec_.neighbour_cutoffs[2]}};
     n_blocks_ = std::min(spec_.error_blocks, m.n_origins);
+    cage_ = std::find(m.observables.begin(), m.observables.end(), "clusters_cr") != m.observables.end();
+    n_sets_ = m.n_cutoffs * (cage_ ? 2 : 1);
     const an::ClusterTally empty(n_, spec_.bins_per_decade, spec_.fractal_min_size);
-    tallies_.assign(static_cast<size_t>(m.n_cutoffs) * m.n_lags * 2,
+    tallies_.assign(static_cast<size_t>(n_sets_) * m.n_lags * 2,
                     BlockTallies{empty, std::vector<an::ClusterTally>(n_blocks_, empty)});
-    for (int c = 0; c < m.n_cutoffs; ++c) q_.emplace_back(m.n_origins, m.lag_time);
+    for (int c = 0; c < n_sets_; ++c) q_.emplace_back(m.n_origins, m.lag_time);
   }
 
   BlockTallies& tallies(int c, int j, Kind kind) {
@@ -165,8 +175,14 @@ private:
     return g;
   }
 
-  void on_origin(int k, const std::vector<double>& pos0) override { add_origin(k, pos0); }
-  void on_origin_dropped(int k) override { graphs_.erase(k); }
+  void on_origin(int k, const std::vector<double>& pos0) override {
+    add_origin(k, pos0);
+    if (cage_) cages_[k] = an::voronoi_neighbours(pos0.data(), n_, box_);
+  }
+  void on_origin_dropped(int k) override {
+    graphs_.erase(k);
+    cages_.erase(k);
+  }
 
   // Checkpoints: g_ab's sums, the cutoffs once fixed, Q(t;t0) and the
   // tallies; the neighbour graphs of the held origins are rebuilt.
@@ -176,6 +192,8 @@ private:
     io(in);
     if (cut_)
       for (const auto& [k, pos] : held_origins()) build_graph(k, pos);
+    if (cage_)
+      for (const auto& [k, pos] : held_origins()) cages_[k] = an::voronoi_neighbours(pos.data(), n_, box_);
   }
 
   // One (origin, lag): Q for tau_alpha, then slow and fast clusters for every cutoff.
@@ -184,18 +202,25 @@ private:
     d2_.resize(n_);
     for (long i = 0; i < n_; ++i)
       d2_[i] = std::pow(pt[2 * i] - pos0[2 * i], 2) + std::pow(pt[2 * i + 1] - pos0[2 * i + 1], 2);
+    if (cage_) { // |dr^CR|^2, from the positions pos0 + dr^CR
+      pos_cr_.resize(2 * n_), d2_cr_.resize(n_);
+      an::cage_relative_positions(pos0.data(), pt.data(), cages_.at(k), dr_, pos_cr_.data());
+      for (long i = 0; i < n_; ++i)
+        d2_cr_[i] = std::pow(pos_cr_[2 * i] - pos0[2 * i], 2) + std::pow(pos_cr_[2 * i + 1] - pos0[2 * i + 1], 2);
+    }
     auto graph = graphs_.find(k);
     const int block = static_cast<int>(static_cast<long>(k) * n_blocks_ / info().n_origins);
-    for (int c = 0; c < info().n_cutoffs; ++c) {
-      const double a = info().cutoff_a[c];
-      const std::vector<std::uint8_t> slow = an::slow_particles(d2_.data(), n_, a);
+    for (int c = 0; c < n_sets_; ++c) {
+      const double a = cutoff(c);
+      const std::vector<double>& d2 = cage_relative(c) ? d2_cr_ : d2_;
+      const std::vector<std::uint8_t> slow = an::slow_particles(d2.data(), n_, a);
       long n_slow = 0;
       for (std::uint8_t s : slow) n_slow += s;
       const double q = double(n_slow) / n_; // Q(t;t0), eq. (6) over the whole box
       q_[c].add(k, j, &q, 1);
       if (graph == graphs_.end()) continue; // before the cutoffs were fixed
       tallies(c, j, kSlow).block[block].add(finder_.find(graph->second, pos0.data(), pt.data(), box_, slow.data()));
-      const std::vector<std::uint8_t> fast = an::fast_particles(d2_.data(), n_, a);
+      const std::vector<std::uint8_t> fast = an::fast_particles(d2.data(), n_, a);
       tallies(c, j, kFast).block[block].add(finder_.find(graph->second, pos0.data(), pt.data(), box_, fast.data()));
     }
   }
@@ -220,11 +245,15 @@ private:
     return an::bracket_lag(info().lag_time, tau_alpha, [&](int j) { return tallies(c, j, kSlow).sets() > 0; });
   }
 
+  double cutoff(int c) const { return info().cutoff_a[c % info().n_cutoffs]; }
+  bool cage_relative(int c) const { return c >= info().n_cutoffs; }
+
   void publish_results(bool final) override {
-    for (int c = 0; c < info().n_cutoffs; ++c) {
+    for (int c = 0; c < n_sets_; ++c) {
       dynhet::clusters_t m{};
       stamp(m, final);
-      m.cutoff_a = info().cutoff_a[c];
+      m.cutoff_a = cutoff(c);
+      m.cage_relative = cage_relative(c);
       fill_neighbours(m);
       const auto q = q_[c].result();
       m.tau_alpha = q.tau_alpha, m.tau_alpha_err = q.tau_alpha_err;
@@ -235,12 +264,12 @@ private:
       m.lag_lo = b.ok() ? b.lo : -1, m.lag_hi = b.ok() ? b.hi : -1, m.lag_weight = b.ok() ? b.w : kNaN;
       m.lag_third = -1; // no interpolation error from a third lag (interpolate, below)
       fill_at_lag(c, m.lag_index, b, m);
-      out().publish(dynhet::cutoff_channel(dynhet::kChanClusters, m.cutoff_a), &m);
+      out().publish(dynhet::cutoff_channel(dynhet::kChanClusters, m.cutoff_a, m.cage_relative), &m);
       if (final)
         std::fprintf(stderr,
-                     "clusters_node: a=%g tau_alpha=%.4g lag %.4g (%s): slow <N_c>=%.4g d_f=%.3g kappa=%.3g; "
+                     "clusters_node%s: a=%g tau_alpha=%.4g lag %.4g (%s): slow <N_c>=%.4g d_f=%.3g kappa=%.3g; "
                      "fast <N_c>=%.4g d_f=%.3g N0=%.3g sigma=%.3g (%d pairs)\n",
-                     m.cutoff_a, m.tau_alpha, m.lag, m.lag_lo >= 0 ? "interpolated" : "nearest", m.slow_mean_size, m.slow_d_f, m.slow_kappa, m.fast_mean_size,
+                     m.cage_relative ? " (cage-relative)" : "", m.cutoff_a, m.tau_alpha, m.lag, m.lag_lo >= 0 ? "interpolated" : "nearest", m.slow_mean_size, m.slow_d_f, m.slow_kappa, m.fast_mean_size,
                      m.fast_d_f, m.fast_n0, m.fast_sigma, pairs_done());
     }
   }
@@ -441,8 +470,12 @@ private:
   std::map<int, an::NeighbourGraph> graphs_; // per origin held
   an::ClusterFinder finder_;
   std::vector<double> d2_;
-  std::vector<an::OverlapAccumulator> q_; // Q(t;t0) per cutoff, for tau_alpha
-  std::vector<BlockTallies> tallies_;     // [(cutoff * n_lags + lag) * 2 + kind]
+  std::vector<an::OverlapAccumulator> q_; // Q(t;t0) per set, for tau_alpha
+  std::vector<BlockTallies> tallies_;     // [(set * n_lags + lag) * 2 + kind]
+  bool cage_ = false;                     // also the cage-relative sets (clusters_cr)
+  int n_sets_ = 0;                        // cutoffs, twice with cage_
+  std::map<int, an::Neighbours> cages_;   // origin k -> its Voronoi neighbours
+  std::vector<double> dr_, pos_cr_, d2_cr_; // per pair, reused
 };
 
 } // namespace

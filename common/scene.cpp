@@ -124,7 +124,7 @@ const std::vector<std::string>& known_observables() {
 }
 
 bool has_cage_relative(const std::string& o) {
-  return o == "overlap" || o == "chi4" || o == "msd" || o == "displacement" || o == "s4";
+  return o == "overlap" || o == "chi4" || o == "msd" || o == "displacement" || o == "s4" || o == "clusters";
 }
 
 std::string node_of(const std::string& observable) {
@@ -630,7 +630,7 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
                                          " bins is more than 4096 (the message would not survive UDP)");
   if (s.cage_relative && std::none_of(s.observables.begin(), s.observables.end(), has_cage_relative))
     c.fail("observables.cage_relative", "is true, but no observable named has a cage-relative version (overlap, "
-                                        "chi4, msd, displacement and s4 have; clusters not yet)");
+                                        "chi4, msd, displacement, s4 and clusters have)");
   if (const auto& bb = s.bond_breaking; !(bb.a1 > 0 && bb.a2 > bb.a1 && bb.a2 < 10))
     c.fail("bond_breaking.a2", "with a1 = " + num(bb.a1) + ", a2 = " + num(bb.a2) +
                                    " is not allowed; allowed: 0 < a1 < a2 < 10 (a bond forms below a1 sigma_ij "

@@ -82,7 +82,7 @@ std::string channel_of(const dynhet::chi4_t &m) {
 }
 std::string channel_of(const dynhet::s4_t &m) { return cutoff_channel(dynhet::kChanS4, m.cutoff_a, m.cage_relative); }
 std::string channel_of(const dynhet::clusters_t &m) {
-  return cutoff_channel(dynhet::kChanClusters, m.cutoff_a);
+  return cutoff_channel(dynhet::kChanClusters, m.cutoff_a, m.cage_relative);
 }
 std::string channel_of(const dynhet::bond_breaking_t &) { return dynhet::kChanBondBreaking; }
 std::string channel_of(const dynhet::msd_t &m) { return dynhet::result_channel(dynhet::kChanMsd, m.cage_relative); }

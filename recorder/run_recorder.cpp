@@ -455,9 +455,9 @@ void RunRecorder::write_s4(const s4_t &m) {
 bool RunRecorder::on_clusters(const clusters_t &m) {
   if (!info_ || m.run_id != info_->run_id) return false;
   if (const std::string bad = frame_problem(m.frame_index); !bad.empty())
-    return rejected(cutoff_channel(kChanClusters, m.cutoff_a), bad);
+    return rejected(cutoff_channel(kChanClusters, m.cutoff_a, m.cage_relative), bad);
   guarded("clusters", [&] { write_clusters(m); });
-  if (m.is_final) completion_.final_result("clusters", m.cutoff_a);
+  if (m.is_final) completion_.final_result(result_group("clusters", m.cage_relative), m.cutoff_a);
   return true;
 }
 
@@ -467,14 +467,14 @@ bool RunRecorder::on_clusters(const clusters_t &m) {
 // arrays (records, bins), the latter two from the first record that has them.
 void RunRecorder::write_clusters(const clusters_t &m) {
   const std::string label = cutoff_label(m.cutoff_a);
-  const std::string base = "clusters/" + label + "/";
-  if (!clusters_started_[label]) {
+  const std::string base = result_group("clusters", m.cage_relative) + "/" + label + "/";
+  if (started_.insert(base).second) {
     writer_->write_fixed(base + "lag_time", m.lag_time);
     writer_->set_attribute("observables/" + base, "cutoff_a", m.cutoff_a);
     writer_->set_attribute("observables/" + base, "n_blocks", m.n_blocks);
     writer_->set_attribute("observables/" + base, "kappa_n_min", m.kappa_n_min);
     writer_->set_attribute("observables/" + base, "kappa_n_max", m.kappa_n_max);
-    clusters_started_[label] = true;
+    if (m.cage_relative) writer_->set_attribute("observables/" + base, "displacements", kCageRelative);
   }
   if (m.frame_index < 0) return; // no frame folded in yet: nothing to record
   const Stamp at = *at_frame(m.frame_index, m.is_final);
@@ -484,8 +484,7 @@ void RunRecorder::write_clusters(const clusters_t &m) {
   writer_->append_observable(base + "pooled_minimum", at, m.pooled_minimum, {3});
   scalar("g_frames", m.g_frames);
   if (m.n_r > 0) {
-    if (!clusters_r_written_[label]) writer_->write_fixed(base + "r", m.r);
-    clusters_r_written_[label] = true;
+    if (started_.insert(base + "r").second) writer_->write_fixed(base + "r", m.r);
     array("g11", m.g11), array("g12", m.g12), array("g22", m.g22);
   }
   scalar("tau_alpha", m.tau_alpha), scalar("tau_alpha_err", m.tau_alpha_err);
@@ -507,12 +506,11 @@ void RunRecorder::write_clusters(const clusters_t &m) {
   scalar("fast_sigma", m.fast_sigma), scalar("fast_sigma_err", m.fast_sigma_err);
   scalar("fast_n_sigma", m.fast_n_sigma), scalar("fast_p0", m.fast_p0);
   if (m.n_bins > 0) {
-    if (!clusters_bins_written_[label]) {
+    if (started_.insert(base + "size_bins").second) {
       writer_->write_fixed(base + "size_lo", m.size_lo);
       writer_->write_fixed(base + "size_hi", m.size_hi);
       writer_->write_fixed(base + "size_centre", m.size_centre);
     }
-    clusters_bins_written_[label] = true;
     array("p_slow", m.p_slow), array("p_slow_err", m.p_slow_err);
     array("p_fast", m.p_fast), array("p_fast_err", m.p_fast_err);
     array("count_slow", m.count_slow), array("count_fast", m.count_fast);

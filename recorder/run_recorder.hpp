@@ -121,7 +121,6 @@ private:
   std::map<std::string, Node> nodes_;
   // The groups (and fixed datasets) written once: "msd", "overlap_cr/a0.6/", ...
   std::set<std::string> started_;
-  std::map<std::string, bool> clusters_started_, clusters_r_written_, clusters_bins_written_;
   std::optional<int64_t> node_clock_zero_;      // utime of the first node status
   int write_errors_ = 0;
   int64_t rejected_ = 0;

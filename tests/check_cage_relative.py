@@ -8,7 +8,8 @@ tiled 3 x 3, taken for the central copy and folded back to particle indices.
   dr_i^CR = dr_i - mean over j in V_i(t0) of dr_j
 
 Checked: overlap_cr Q(t) and tau_alpha per cutoff, s4_cr by check_run.py's
-exact sums with the cage-relative weights, msd_cr (all and small
+exact sums with the cage-relative weights, clusters_cr by its brute force
+with slow and fast chosen by |dr^CR|, msd_cr (all and small
 particles), chi4_cr of the whole box (N times the variance of Q over
 origins, n - 1), and in msd and msd_cr both ways F_s(q, t) = <J0(q |dr|)>
 (scipy's j0) at the recorded q and alpha_2(t) = <dr^4> / (2 <dr^2>^2) - 1,
@@ -70,7 +71,7 @@ def main(path):
     f = h5py.File(path, "r")
     obs = f["observables"]
     check(int(f.attrs.get("complete", 0)) == 1, "file marked complete")
-    for name in ("overlap", "chi4", "msd", "displacement", "s4"):
+    for name in ("overlap", "chi4", "msd", "displacement", "s4", "clusters"):
         if name in obs:
             check(name + "_cr" in obs, f"{name}_cr recorded beside {name}")
     L = float(f["particles/all/box/edges"][0])
@@ -134,6 +135,14 @@ def main(path):
         for name, g in obs["s4_cr"].items():
             check_run.check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, lag,
                                dr_of=lambda k, j: dr_cr[k, j], overlap="overlap_cr", need_fit=False)
+    if "clusters_cr" in obs:  # slow and fast clusters by |dr^CR|, by check_run.py's brute force
+        import check_run
+        import tomllib
+        check_run.failures = failures
+        text = f["parameters/scene_toml"][()]
+        scene = tomllib.loads(text.decode() if isinstance(text, bytes) else str(text))
+        check_run.check_clusters(f, unwrapped, L, origin_frame, pair_frame, obs["schedule"]["lag_time"][()], scene,
+                                 group="clusters_cr", dr_of=lambda k, j: dr_cr[k, j])
     if "msd" in obs:
         small = species == np.min(species)
         radius = f["parameters/run_info"].attrs.get("radius") if "parameters/run_info" in f else None

@@ -555,15 +555,20 @@ def clusters_bf(x0, xt, neighbours, selected, L):
     return out
 
 
-def check_clusters(f, unwrapped, L, origin_frame, pair_frame, lag, scene):
+def check_clusters(f, unwrapped, L, origin_frame, pair_frame, lag, scene, group="clusters", dr_of=None):
     """The cluster node's results against a brute-force recomputation from the frames: g_ab and
     the neighbour cutoffs, tau_alpha and the lag chosen, the sizes at every lag, and at the chosen
-    lag the P(N_c) counts, the R_g bins and d_f."""
+    lag the P(N_c) counts, the R_g bins and d_f. group "clusters_cr" with dr_of(k, j) the
+    cage-relative displacements: slow and fast chosen by those (R_g still at t0 + t)."""
+    if dr_of is None:
+        def dr_of(k, j):
+            return unwrapped[pair_frame[k][j]] - unwrapped[origin_frame[k]]
     spec = scene.get("clusters", {})
     species = f["particles/all/species"][()].astype(int)
     n = unwrapped.shape[1]
     n_min = spec.get("fractal_min_size", 10)
-    for name, g in f["observables/clusters"].items():
+    for name, g in f["observables/" + group].items():
+        name = name if group == "clusters" else f"{group}/{name}"
         a = float(g.attrs["cutoff_a"])
         r = g["r"][()]
         dr, nb = r[1] - r[0], len(r)
@@ -581,7 +586,7 @@ def check_clusters(f, unwrapped, L, origin_frame, pair_frame, lag, scene):
         check(np.allclose(cut, cut_bf, rtol=1e-9, atol=0), f"clusters {name}: neighbour cutoffs {cut} are the first minima of g_ab")
 
         # tau_alpha from Q(t) = fraction of slow particles; the lag nearest it in ln t.
-        disp = np.array([[unwrapped[pf] - unwrapped[of] for pf in pair_frame[k]] for k, of in enumerate(origin_frame)])
+        disp = np.array([[dr_of(k, jj) for jj in range(len(pair_frame[k]))] for k in range(len(origin_frame))])
         d2 = np.sum(disp ** 2, axis=3)  # origin, lag, particle
         q_bf = np.mean(d2 < a * a, axis=2).mean(axis=0)
         tau, tau_bf = float(g["tau_alpha"]["value"][-1]), crossing_time(lag, q_bf, math.exp(-1))

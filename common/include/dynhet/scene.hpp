@@ -84,7 +84,7 @@ struct Scene {
   bool keep_frames = false;
   // Also every displacement observable of the cage-relative displacements
   // dr_i - (mean dr of i's Voronoi neighbours at the origin) (issue 26):
-  // overlap, chi4, msd, displacement and s4, in groups <name>_cr.
+  // overlap, chi4, msd, displacement, s4 and clusters, in groups <name>_cr.
   bool cage_relative = false;
 
   // [overlap]
