@@ -23,6 +23,9 @@ matplotlib.use("Agg")  # a batch tool: figures to files
 from .. import fits as sf
 from .config import A_MAIN, CONVENTIONS, EPS_MAIN, say
 from .study import Analysis
+
+# What a section needs (a key of a run's cut), and the observable that gives it.
+NEEDS = {"chi4": "chi4", "s4_q": "s4", "cl_lag": "clusters"}
 from .overlap import ageing_results, overlap_results, tau_results
 from .transport import d_results, pdx_results
 from .clusters import cluster_results
@@ -62,10 +65,17 @@ def main(argv=None):
         + (f"; {len(A.skipped)} runs left out (not complete)" if A.skipped else ""))
     failed = []
 
-    def step(name, fn, *args):
+    def step(name, fn, *args, needs=()):
         say(f"  {name}")
         if not A.series():
             A.row(name, "—", "—", f"no run of the main series (pairs = neighbours, ε = {EPS_MAIN:g})", "not determined", "", [])
+            return None
+        # A study that does not compute an observable (its scene's
+        # observables.compute) has no result that needs it: said, not failed.
+        lacking = [k for k in needs if not any(k in r["cut"].get(A_MAIN, {}) for p in A.series() for r in p.runs)]
+        if lacking:
+            A.row(name, "—", "—", "not computed in this study (" + ", ".join(NEEDS[k] for k in lacking) + ")",
+                  "not run", "", [])
             return None
         try:
             return fn(A, *args)
@@ -79,21 +89,21 @@ def main(argv=None):
     for name, fn in (("overlap", overlap_results), ("ageing", ageing_results), ("D", d_results), ("P(dx)", pdx_results)):
         step(name, fn)
     # The joint fit first: the critical fits are also given with its phi_c.
-    joint = step("joint fit of tau_alpha, chi4, xi", joint_fit)
+    joint = step("joint fit of tau_alpha, chi4, xi", joint_fit, needs=("chi4", "s4_q"))
     res = step("tau_alpha(phi)", tau_results, joint)
     phi_c = res[0].p["xc"] if res and res[0].ok else math.nan
     phi_c_why = sf.cannot_judge(res[0], "xc") if res and res[0].ok else None
-    step("clusters", cluster_results, phi_c, phi_c_why, joint)
-    step("chi4", chi4_results, phi_c, joint)
-    step("S4 and xi", s4_results, joint)
-    step("finite size", fss_results, joint)
+    step("clusters", cluster_results, phi_c, phi_c_why, joint, needs=("cl_lag",))
+    step("chi4", chi4_results, phi_c, joint, needs=("chi4",))
+    step("S4 and xi", s4_results, joint, needs=("s4_q",))
+    step("finite size", fss_results, joint, needs=("chi4", "s4_q"))
     step("tau_alpha against N", tau_n_results)
     step("D against N", d_n_results)
     step("cage-relative tau_alpha and bond breaking against phi", local_phi_results)
     step("cage-relative tau_alpha and bond breaking against N", local_n_results)
     step("cutoff a", cutoff_results)
     step("restitution", restitution_results)
-    step("appendix", appendix_results)
+    step("appendix", appendix_results, needs=("chi4", "s4_q"))
     A.driving = ({}, "")
     step("driving rules", driving_results)
     driving_rows(A)
