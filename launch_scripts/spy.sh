@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # lcm-spy with dynhet's message types and its curve views (plugins): Q(t),
-# chi4(t), MSD(t) and S4(q) of a channel drawn live in lcm-spy. Debian's
+# chi4(t), MSD(t), S4(q) and C_B(t) of a channel drawn live in lcm-spy (the
+# cage-relative channels, _CR, by the same views, titled so). Debian's
 # /usr/bin/lcm-spy wrapper fails on current JDKs, so the Java class is
 # started directly.
 # Usage: launch_scripts/spy.sh [LCM_URL]     (a display is needed)

@@ -40,11 +40,13 @@ xvfb-run -a bash -c 'bash "$1" "$2" >"$3" 2>&1 &
   kill $p 2>/dev/null
   wait $p 2>/dev/null || true' _ "$spy" "$url" "$out/spy_sh.out"
 found=$(sed -n 's/^Found \([0-9]*\) plugins/\1/p' "$out/spy_sh.out")
-all_four() {
-  for c in OverlapPlugin Chi4Plugin MsdPlugin S4Plugin; do grep -q "^ dynhet\.spy\.$c@" "$1" || return 1; done
+all_five() {
+  for c in OverlapPlugin Chi4Plugin MsdPlugin S4Plugin BondBreakingPlugin; do
+    grep -q "^ dynhet\.spy\.$c@" "$1" || return 1
+  done
 }
-check '[[ $found == 4 ]] && all_four "$out/spy_sh.out"' \
-  "spy.sh: lcm-spy finds the 4 curve plugins (Q(t), chi4(t), MSD(t), S4(q)) (found ${found:-none})"
+check '[[ $found == 5 ]] && all_five "$out/spy_sh.out"' \
+  "spy.sh: lcm-spy finds the 5 curve plugins (Q(t), chi4(t), MSD(t), S4(q), C_B(t)) (found ${found:-none})"
 
 # 2. lcm-spy watching a real run, with the checker.
 cp=$(bash "$spy" --classpath):$build/dynhet_spy_check.jar

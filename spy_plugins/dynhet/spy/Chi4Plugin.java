@@ -31,7 +31,8 @@ public final class Chi4Plugin implements SpyPlugin {
     // Flat [g * n_lags + j].
     Curves.need((long)m.n_values == (long)m.n_grids * m.n_lags, "n_values is not n_grids x n_lags");
     Curves.length(m.chi4, m.n_values, "chi4");
-    Curves c = new Curves("chi4(t), a = " + Curves.num(m.cutoff_a), "t", "chi4", true, true);
+    Curves c = new Curves("chi4(t), a = " + Curves.num(m.cutoff_a) + Curves.cageRelative(m.cage_relative), "t",
+                          "chi4", true, true);
     StringBuilder peaks = new StringBuilder("peaks \u03c74^P at \u03c44:");
     for (int g = 0; g < m.n_grids; ++g) {
       String name = gridName(m.subbox_per_side[g], m.subbox_particles[g]);

@@ -76,6 +76,9 @@ final class Curves {
 
   // Checks of an untrusted message.
 
+  /** A title's suffix for results of the cage-relative displacements (channels with _CR). */
+  static String cageRelative(boolean cr) { return cr ? " (cage-relative)" : ""; }
+
   static void need(boolean ok, String why) throws BadMessage {
     if (!ok) throw new BadMessage(why);
   }

@@ -24,7 +24,7 @@ public final class MsdPlugin implements SpyPlugin {
     msd_t m = (msd_t)message;
     int n = m.n_lags;
     Curves.length(m.lag_time, n, "lag_time");
-    Curves c = new Curves("MSD(t)", "t", "MSD", true, true);
+    Curves c = new Curves("MSD(t)" + Curves.cageRelative(m.cage_relative), "t", "MSD", true, true);
     String all = percent(m.fraction_all), small = percent(m.fraction_small);
     Object[][] series = {{"all", m.msd_all},
                          {"small", m.msd_small},

@@ -20,7 +20,8 @@ public final class OverlapPlugin implements SpyPlugin {
     Curves.length(m.lag_time, m.n_lags, "lag_time");
     Curves.length(m.q, m.n_lags, "q");
     Curves.length(m.n_origins, m.n_lags, "n_origins");
-    Curves c = new Curves("Q(t), a = " + Curves.num(m.cutoff_a), "t", "Q", true, false);
+    Curves c = new Curves("Q(t), a = " + Curves.num(m.cutoff_a) + Curves.cageRelative(m.cage_relative), "t", "Q", true,
+                          false);
     c.add("Q(t)", m.lag_time, m.q, 0, m.n_lags);
     // The 1/e line across the lags: tau_alpha is where Q crosses it.
     double lo = Double.POSITIVE_INFINITY, hi = 0;

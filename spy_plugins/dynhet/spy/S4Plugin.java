@@ -30,7 +30,8 @@ public final class S4Plugin implements SpyPlugin {
     Curves.need(total == m.n_values, "n_values is not the sum of n_shells");
     Curves.length(m.q, m.n_values, "q");
     Curves.length(m.s4, m.n_values, "s4");
-    Curves c = new Curves("S4(q) at t = " + Curves.num(m.t_s4) + ", a = " + Curves.num(m.cutoff_a), "q", "S4",
+    Curves c = new Curves("S4(q) at t = " + Curves.num(m.t_s4) + ", a = " + Curves.num(m.cutoff_a) +
+                              Curves.cageRelative(m.cage_relative), "q", "S4",
                           true, true);
     int offset = 0;
     for (int g = 0; g < m.n_grids; ++g) {

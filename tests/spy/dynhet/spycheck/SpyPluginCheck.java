@@ -1,9 +1,11 @@
 package dynhet.spycheck;
 
+import dynhet.bond_breaking_t;
 import dynhet.chi4_t;
 import dynhet.msd_t;
 import dynhet.overlap_t;
 import dynhet.s4_t;
+import dynhet.spy.BondBreakingPlugin;
 import dynhet.spy.Chi4Plugin;
 import dynhet.spy.CurveView;
 import dynhet.spy.MsdPlugin;
@@ -282,6 +284,7 @@ public final class SpyPluginCheck {
     if (m instanceof chi4_t) return new Chi4Plugin();
     if (m instanceof msd_t) return new MsdPlugin();
     if (m instanceof s4_t) return new S4Plugin();
+    if (m instanceof bond_breaking_t) return new BondBreakingPlugin();
     return null;
   }
 
@@ -406,6 +409,36 @@ public final class SpyPluginCheck {
     t.q[1] = 0;
     cases.add(new Object[] {"s4: NaN and q = 0", t, false});
     runCases(new S4Plugin(), "DYNHET_S4_a0.6", s, cases);
+
+    // Bond breaking (not in the tiny scene's log): a message made here,
+    // C_B = exp(-t / 3) at the overlap's lags.
+    bond_breaking_t b = new bond_breaking_t();
+    b.run_id = q.run_id;
+    b.a1 = 1.1;
+    b.a2 = 1.5;
+    b.bonds_per_particle = 2.17;
+    b.n_lags = n;
+    b.lag_time = Arrays.copyOf(q.lag_time, n);
+    b.c_b = new double[n];
+    b.c_b_err = new double[n];
+    for (int j = 0; j < n; ++j) b.c_b[j] = Math.exp(-b.lag_time[j] / 3);
+    b.tau_b = 3;
+    b.tau_b_err = 0.1;
+    b.subbox_particles = new double[0];
+    b.subbox_per_side = new int[0];
+    b.chi_b = b.chi_b_err = b.chi_b_peak = b.tau_chi_b = b.chi_b_peak_err = b.tau_chi_b_err = new double[0];
+    cases.clear();
+    bond_breaking_t u = b.copy();
+    u.c_b = Arrays.copyOf(b.c_b, n - 1);
+    cases.add(new Object[] {"bond breaking: c_b 1 short", u, true});
+    u = b.copy();
+    u.n_lags = n + 1;
+    cases.add(new Object[] {"bond breaking: n_lags 1 more than its arrays", u, true});
+    u = b.copy();
+    u.c_b[0] = Double.NaN;
+    u.lag_time[1] = -1;
+    cases.add(new Object[] {"bond breaking: NaN and a negative lag", u, false});
+    runCases(new BondBreakingPlugin(), "DYNHET_BOND_BREAKING", b, cases);
   }
 
   /** Each case, then the good message: rejected ones counted and the curves kept; then the good one drawn. */
@@ -452,6 +485,7 @@ public final class SpyPluginCheck {
     if (m instanceof overlap_t) return ((overlap_t)m).copy();
     if (m instanceof chi4_t) return ((chi4_t)m).copy();
     if (m instanceof msd_t) return ((msd_t)m).copy();
+    if (m instanceof bond_breaking_t) return ((bond_breaking_t)m).copy();
     return ((s4_t)m).copy();
   }
 
@@ -507,6 +541,24 @@ public final class SpyPluginCheck {
         Curve c = new Curve(names[s]);
         for (int j = 0; j < m.n_lags; ++j) add(c, m.lag_time[j], ys[s][j], true, true);
         out.add(c);
+      }
+    } else if (message instanceof bond_breaking_t) {
+      bond_breaking_t m = (bond_breaking_t)message;
+      Curve cb = new Curve("C_B(t)");
+      double lo = Double.POSITIVE_INFINITY, hi = 0;
+      for (int j = 0; j < m.n_lags; ++j) {
+        add(cb, m.lag_time[j], m.c_b[j], true, false);
+        if (Double.isFinite(m.lag_time[j]) && m.lag_time[j] > 0) {
+          lo = Math.min(lo, m.lag_time[j]);
+          hi = Math.max(hi, m.lag_time[j]);
+        }
+      }
+      out.add(cb);
+      if (hi > 0) {
+        Curve e = new Curve("1/e");
+        e.points.add(new double[] {lo, Math.exp(-1)});
+        e.points.add(new double[] {hi, Math.exp(-1)});
+        out.add(e);
       }
     } else if (message instanceof s4_t) {
       s4_t m = (s4_t)message;
