@@ -53,6 +53,7 @@
 #include "dynhet/analysis/overlap.hpp"
 #include "dynhet/clusters_t.hpp"
 #include "dynhet/scene.hpp"
+#include "cages.hpp"
 #include "frame_node.hpp"
 
 namespace {
@@ -117,8 +118,10 @@ public:
 
 private:
   void start(const dynhet::run_info_t& m) override {
+    std::optional<dynhet::Scene> scene;
     try {
-      spec_ = dynhet::parse_scene_text(m.scene_toml, "run info scene").clusters;
+      scene = dynhet::parse_scene_text(m.scene_toml, "run info scene");
+      spec_ = scene->clusters;
     } catch (const std::exception& e) {
       throw std::runtime_error(std::string("cannot read the scene's [clusters] table: ") + e.what());
     }
@@ -129,6 +132,7 @@ private:
       cut_ = an::NeighbourCutoffs{{spec_.neighbour_cutoffs[0], spec_.neighbour_cutoffs[1], spec_.neighbour_cutoffs[2]}};
     n_blocks_ = std::min(spec_.error_blocks, m.n_origins);
     cage_ = std::find(m.observables.begin(), m.observables.end(), "clusters_cr") != m.observables.end();
+    if (cage_) cages_ = std::make_unique<dynhet::Cages>(m, *scene, "clusters_node");
     n_sets_ = m.n_cutoffs * (cage_ ? 2 : 1);
     const an::ClusterTally empty(n_, spec_.bins_per_decade, spec_.fractal_min_size);
     tallies_.assign(static_cast<size_t>(n_sets_) * m.n_lags * 2,
@@ -177,23 +181,27 @@ private:
 
   void on_origin(int k, const std::vector<double>& pos0) override {
     add_origin(k, pos0);
-    if (cage_) cages_[k] = an::voronoi_neighbours(pos0.data(), n_, box_);
+    if (cage_) cages_->build(k, pos0);
   }
   void on_origin_dropped(int k) override {
     graphs_.erase(k);
-    cages_.erase(k);
+    if (cage_) cages_->drop(k);
   }
 
   // Checkpoints: g_ab's sums, the cutoffs once fixed, Q(t;t0) and the
   // tallies; the neighbour graphs of the held origins are rebuilt.
   template <class Ar> void io(Ar& ar) { ar(g_sum_, g_frames_, cut_, q_, tallies_); }
-  void save_state(dynhet::StateOut& out) override { io(out); }
+  void save_state(dynhet::StateOut& out) override {
+    io(out);
+    if (cages_) out(*cages_);
+  }
   void load_state(dynhet::StateIn& in) override {
     io(in);
+    if (cages_) in(*cages_);
     if (cut_)
       for (const auto& [k, pos] : held_origins()) build_graph(k, pos);
     if (cage_)
-      for (const auto& [k, pos] : held_origins()) cages_[k] = an::voronoi_neighbours(pos.data(), n_, box_);
+      for (const auto& [k, pos] : held_origins()) cages_->build(k, pos);
   }
 
   // One (origin, lag): Q for tau_alpha, then slow and fast clusters for every cutoff.
@@ -204,7 +212,7 @@ private:
       d2_[i] = std::pow(pt[2 * i] - pos0[2 * i], 2) + std::pow(pt[2 * i + 1] - pos0[2 * i + 1], 2);
     if (cage_) { // |dr^CR|^2, from the positions pos0 + dr^CR
       pos_cr_.resize(2 * n_), d2_cr_.resize(n_);
-      an::cage_relative_positions(pos0.data(), pt.data(), cages_.at(k), dr_, pos_cr_.data());
+      an::cage_relative_positions(pos0.data(), pt.data(), cages_->at(k), dr_, pos_cr_.data());
       for (long i = 0; i < n_; ++i)
         d2_cr_[i] = std::pow(pos_cr_[2 * i] - pos0[2 * i], 2) + std::pow(pos_cr_[2 * i + 1] - pos0[2 * i + 1], 2);
     }
@@ -474,7 +482,7 @@ private:
   std::vector<BlockTallies> tallies_;     // [(set * n_lags + lag) * 2 + kind]
   bool cage_ = false;                     // also the cage-relative sets (clusters_cr)
   int n_sets_ = 0;                        // cutoffs, twice with cage_
-  std::map<int, an::Neighbours> cages_;   // origin k -> its Voronoi neighbours
+  std::unique_ptr<dynhet::Cages> cages_;  // the cages of the held origins (cage_)
   std::vector<double> dr_, pos_cr_, d2_cr_; // per pair, reused
 };
 

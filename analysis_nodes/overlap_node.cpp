@@ -38,6 +38,7 @@
 #include "dynhet/scene.hpp"
 #include "dynhet/stats.hpp"
 #include "bond_breaking_results.hpp"
+#include "cages.hpp"
 #include "displacement_results.hpp"
 #include "frame_node.hpp"
 
@@ -75,6 +76,8 @@ private:
     grid_ = an::make_subbox_grid(m.n_particles, m.box_length, m.overlap_subbox_particles);
     // The cage-relative set, if any, does everything the standard one does.
     cage_ = wants("overlap_cr") || wants("chi4_cr") || wants("msd_cr") || wants("displacement_cr");
+    if (cage_) cages_ = std::make_unique<dynhet::Cages>(m, dynhet::parse_scene_text(m.scene_toml, "run info scene"),
+                                                       "overlap_node");
     sets_.resize(cage_ ? 2 : 1);
     sets_.back().cage_relative = cage_;
     for (Measures& s : sets_)
@@ -102,17 +105,18 @@ private:
     }
     if (want_chi4_ || want_msd_ || want_displacement || want_bonds_) start_pass(m);
     std::fprintf(stderr, "overlap_node: %dx%d sub-boxes of N=%.1f%s\n", grid_.per_side, grid_.per_side,
-                 grid_.mean_particles, cage_ ? "; also of the cage-relative displacements (Voronoi cages)" : "");
+                 grid_.mean_particles,
+                 cage_ ? ("; also of the cage-relative displacements (" + cages_->describe() + ")").c_str() : "");
   }
 
   void on_origin(int k, const std::vector<double>& pos0) override {
     if (pass_on_) chi4_index_[k] = std::make_unique<an::OriginIndex>(pos0.data(), info().n_particles, spec_);
-    if (cage_) cages_[k] = an::voronoi_neighbours(pos0.data(), info().n_particles, info().box_length);
+    if (cage_) cages_->build(k, pos0);
     if (bonds_) bonds_->on_origin(k, pos0);
   }
   void on_origin_dropped(int k) override {
     chi4_index_.erase(k);
-    cages_.erase(k);
+    if (cage_) cages_->drop(k);
     if (bonds_) bonds_->on_origin_dropped(k);
   }
 
@@ -121,10 +125,12 @@ private:
   void save_state(dynhet::StateOut& out) override {
     for (Measures& s : sets_) s.io(out);
     if (bonds_) out(*bonds_);
+    if (cages_) out(*cages_);
   }
   void load_state(dynhet::StateIn& in) override {
     for (Measures& s : sets_) s.io(in);
     if (bonds_) in(*bonds_);
+    if (cages_) in(*cages_); // the g_ab cutoffs, before the held origins' cages are rebuilt
     if (pass_on_ || cage_)
       for (const auto& [k, pos0] : held_origins()) on_origin(k, pos0);
   }
@@ -141,7 +147,7 @@ private:
     // The same pair again, the frame's positions replaced by
     // pos0 + dr^CR: every measure below sees cage-relative displacements.
     dr_cr_.resize(n2);
-    an::cage_relative_positions(pos0.data(), f.position.data(), cages_.at(k), dr_, dr_cr_.data());
+    an::cage_relative_positions(pos0.data(), f.position.data(), cages_->at(k), dr_, dr_cr_.data());
     add_pair(sets_[1], k, j, pos0, dr_cr_.data());
   }
   void add_pair(Measures& s, int k, int j, const std::vector<double>& pos0, const double* pos) {
@@ -551,7 +557,7 @@ private:
   an::SubboxGrid grid_{};
   std::vector<Measures> sets_; // [0] of the displacements, [1] of the cage-relative ones (cage_)
   bool cage_ = false;
-  std::map<int, an::Neighbours> cages_;  // origin k -> the Voronoi neighbours at t0
+  std::unique_ptr<dynhet::Cages> cages_; // the cages of the held origins (cage_)
   std::vector<double> dr_, dr_cr_;       // the pair's displacements; pos0 + dr^CR
   std::vector<double> qr_;
   // The displacement pass, for chi4 and the MSD (only if the run asks)

@@ -54,6 +54,7 @@
 #include "dynhet/analysis/timescales.hpp"
 #include "dynhet/s4_t.hpp"
 #include "dynhet/scene.hpp"
+#include "cages.hpp"
 #include "frame_node.hpp"
 
 namespace {
@@ -94,6 +95,7 @@ private:
     for (int j = 0; j < m.n_lags; ++j)
       if (slot_[j] == 0) slot_[j] = static_cast<int>(lags_.size()), lags_.push_back(m.lag_time[j]);
     cage_ = std::find(m.observables.begin(), m.observables.end(), "s4_cr") != m.observables.end();
+    if (cage_) cages_ = std::make_unique<dynhet::Cages>(m, scene, "s4_node");
     for (bool cr : {false, true})
       if (!cr || cage_)
         for (double a : m.cutoff_a)
@@ -118,16 +120,20 @@ private:
   // Checkpoints: S4 per (origin, lag) on every grid and Q(t;t0), per cutoff.
   void save_state(dynhet::StateOut& out) override {
     for (Cutoff& c : cuts_) out(c.acc, *c.q_acc);
+    if (cages_) out(*cages_);
   }
   void load_state(dynhet::StateIn& in) override {
     for (Cutoff& c : cuts_) in(c.acc, *c.q_acc);
+    if (cages_) in(*cages_);
     if (cage_) // the cages of the held origins, rebuilt from their positions
       for (const auto& [k, pos0] : held_origins()) on_origin(k, pos0);
   }
   void on_origin(int k, const std::vector<double>& pos0) override {
-    if (cage_) cages_[k] = an::voronoi_neighbours(pos0.data(), info().n_particles, info().box_length);
+    if (cage_) cages_->build(k, pos0);
   }
-  void on_origin_dropped(int k) override { cages_.erase(k); }
+  void on_origin_dropped(int k) override {
+    if (cage_) cages_->drop(k);
+  }
 
   void on_pair(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) override {
     const long n = info().n_particles;
@@ -136,7 +142,7 @@ private:
       d2_[i] = std::pow(f.position[2 * i] - pos0[2 * i], 2) + std::pow(f.position[2 * i + 1] - pos0[2 * i + 1], 2);
     if (cage_) { // |dr^CR|^2, from the positions pos0 + dr^CR
       pos_cr_.resize(2 * n), d2_cr_.resize(n);
-      an::cage_relative_positions(pos0.data(), f.position.data(), cages_.at(k), dr_, pos_cr_.data());
+      an::cage_relative_positions(pos0.data(), f.position.data(), cages_->at(k), dr_, pos_cr_.data());
       for (long i = 0; i < n; ++i)
         d2_cr_[i] = std::pow(pos_cr_[2 * i] - pos0[2 * i], 2) + std::pow(pos_cr_[2 * i + 1] - pos0[2 * i + 1], 2);
     }
@@ -313,7 +319,7 @@ private:
   std::vector<Cutoff> cuts_;                     // per cutoff of the scene, in its order
   std::vector<double> d2_, w_;                   // per pair, reused (w_: one cutoff at a time)
   bool cage_ = false;                            // also the cage-relative cutoffs (s4_cr)
-  std::map<int, an::Neighbours> cages_;          // origin k -> its Voronoi neighbours
+  std::unique_ptr<dynhet::Cages> cages_;         // the cages of the held origins (cage_)
   std::vector<double> dr_, pos_cr_, d2_cr_;      // per pair, reused: the cage-relative |dr|^2
   Clock::time_point last_publish_{};
 };

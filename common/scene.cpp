@@ -363,6 +363,13 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
        [&](const std::string& key, const toml::node& n) { c.get_bool(key, n, s.keep_frames); }},
       {"cage_relative",
        [&](const std::string& key, const toml::node& n) { c.get_bool(key, n, s.cage_relative); }},
+      {"cage",
+       [&](const std::string& key, const toml::node& n) {
+         auto v = n.value_exact<std::string>();
+         if (!v) return c.bad_type(key, n, "a string: \"voronoi\" or \"g_ab\"");
+         if (*v != "voronoi" && *v != "g_ab") return c.bad_value(key, n, "allowed: \"voronoi\", \"g_ab\"");
+         s.cage = *v;
+       }},
   };
   schema["overlap"] = {
       {"subbox_particles", int_in(s.overlap_subbox_particles, 1, std::numeric_limits<int32_t>::max())},

@@ -44,6 +44,13 @@ check '$py "$root/tests/check_bond_breaking.py" "$tmp/ref/run.h5"' "bond breakin
 check 'grep -q "overlap_node (cage-relative): a=0.6 tau_alpha=" "$tmp/ref/overlap_node.log"' \
   "the overlap node states the cage-relative tau_alpha"
 
+# The other cages: within the first minima of g_ab (the clusters node's
+# neighbours), against brute force with the cutoffs the clusters node found.
+sed 's/^cage_relative = true/cage_relative = true\ncage = "g_ab"/' "$tmp/scene.toml" >"$tmp/gab.toml"
+run "$tmp/gab.toml" "$tmp/gab" || { tail -20 "$tmp/gab.log"; exit 1; }
+check '$py "$root/tests/check_cage_relative.py" "$tmp/gab/run.h5"' "with g_ab cages: the cage-relative results equal brute force"
+check 'grep -q "g_ab cages (r11" "$tmp/gab/overlap_node.log"' "the overlap node says which cages"
+
 # Stopped by SIGTERM mid-production (the nodes slowed so that production
 # lasts seconds), then resumed by the same command.
 run "$tmp/cuts.toml" "$tmp/straight" --test-node-delay 0.1 || { tail -20 "$tmp/straight.log"; exit 1; }

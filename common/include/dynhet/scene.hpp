@@ -86,6 +86,9 @@ struct Scene {
   // dr_i - (mean dr of i's Voronoi neighbours at the origin) (issue 26):
   // overlap, chi4, msd, displacement, s4 and clusters, in groups <name>_cr.
   bool cage_relative = false;
+  // The cages: "voronoi" (Voronoi neighbours) or "g_ab" (within the first
+  // minima of g_ab, clusters.neighbour_cutoffs if given).
+  std::string cage = "voronoi";
 
   // [overlap]
   int overlap_subbox_particles = 100; // target N = <N_r> per sub-box
