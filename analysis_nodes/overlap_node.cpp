@@ -40,32 +40,13 @@
 #include "bond_breaking_results.hpp"
 #include "cages.hpp"
 #include "displacement_results.hpp"
+#include "msd_results.hpp"
 #include "frame_node.hpp"
 
 namespace {
 
 namespace an = dynhet::analysis;
-
-// One set of the node's accumulators: of the displacements as they are, or
-// of the cage-relative ones.
-struct Measures {
-  bool cage_relative = false;
-  std::vector<an::OverlapAccumulator> acc; // one per cutoff
-  std::vector<double> msd_all, msd_small;  // per (origin, lag)
-  std::vector<double> msd_extreme[4];      // per (origin, lag): fast all, slow all, fast small, slow small
-  std::vector<double> flow_t, flow_l;      // per (origin, lag, mode): collective_modes
-  std::vector<double> amp;                 // per (origin, mode): u_k . e at the last lag (t re, im, l re, im)
-  std::vector<double> m4_all, m4_small;    // per (origin, lag): <|dr|^4> over the particles, for alpha_2
-  std::vector<double> fs_all, fs_small;    // per (origin, lag, q): <J0(q |dr|)>
-  std::unique_ptr<dynhet::DisplacementResults> displacement;
-  std::chrono::steady_clock::time_point last_displacement{};
-  std::vector<an::Chi4Accumulator> chi4_acc; // [grid * n_cutoffs + cutoff], cutoffs ascending
-  template <class Ar> void io(Ar& ar) {
-    ar(acc, msd_all, msd_small, msd_extreme, flow_t, flow_l, amp, m4_all, m4_small, fs_all, fs_small, chi4_acc);
-    if (displacement) ar(*displacement);
-  }
-  const char* says() const { return cage_relative ? " (cage-relative)" : ""; }
-};
+using dynhet::Measures;
 
 class OverlapNode : public dynhet::FrameNode {
 public:
@@ -89,13 +70,8 @@ private:
     if (want_msd_ || want_displacement || want_bonds_) {
       try {
         const dynhet::Scene scene = dynhet::parse_scene_text(m.scene_toml, "run info scene");
-        msd_spec_ = scene.msd;
+        if (want_msd_) msd_ = std::make_unique<dynhet::MsdResults>(m, scene.msd);
         bond_spec_ = scene.bond_breaking;
-        if (msd_spec_.fs) { // 2 pi / sigma_ab of the species' contact distances
-          const double r0 = m.radius[0], r1 = m.radius[1];
-          fs_q_ = {2 * M_PI / (2 * r0), 2 * M_PI / (r0 + r1), 2 * M_PI / (2 * r1)};
-        }
-        fs_q_.insert(fs_q_.end(), msd_spec_.fs_q.begin(), msd_spec_.fs_q.end());
         if (want_displacement)
           for (Measures& s : sets_) s.displacement = std::make_unique<dynhet::DisplacementResults>(m, scene.displacement);
       } catch (const std::exception& e) {
@@ -191,11 +167,6 @@ private:
   void start_pass(const dynhet::run_info_t& m) {
     pass_on_ = true;
     const size_t pairs = static_cast<size_t>(m.n_origins) * m.lag_time.size();
-    if (want_msd_) {
-      std::vector<int> nx, ny;
-      an::wave_vectors(kFlowModes, nx, ny);
-      n_modes_ = nx.size();
-    }
     spec_.grids = an::nested_subbox_grids(m.n_particles, m.box_length, m.chi4_subbox_particles);
     spec_.cutoffs = m.cutoff_a;
     std::sort(spec_.cutoffs.begin(), spec_.cutoffs.end()); // the pass wants them ascending
@@ -203,15 +174,7 @@ private:
       s.msd_all.assign(pairs, std::numeric_limits<double>::quiet_NaN());
       s.msd_small = s.msd_all;
       for (auto& v : s.msd_extreme) v = s.msd_all;
-      if (want_msd_) {
-        s.m4_all.assign(pairs, std::numeric_limits<double>::quiet_NaN());
-        s.m4_small = s.m4_all;
-        s.fs_all.assign(pairs * fs_q_.size(), std::numeric_limits<double>::quiet_NaN());
-        s.fs_small = s.fs_all;
-        s.flow_t.assign(pairs * n_modes_, std::numeric_limits<double>::quiet_NaN());
-        s.flow_l = s.flow_t;
-        s.amp.assign(static_cast<size_t>(m.n_origins) * n_modes_ * 4, std::numeric_limits<double>::quiet_NaN());
-      }
+      if (msd_) msd_->allocate(s);
       if (s.displacement) s.displacement->configure(spec_);
       for (const auto& g : spec_.grids)
         for (size_t c = 0; c < spec_.cutoffs.size(); ++c)
@@ -229,243 +192,16 @@ private:
     const size_t kj = static_cast<size_t>(k) * info().lag_time.size() + j;
     s.msd_all[kj] = pass_.msd_all;
     s.msd_small[kj] = pass_.msd_small;
-    if (want_msd_) {
-      // The instantaneous fastest and slowest subsets of this pair.
-      const auto [all, small] = an::msd_extremes_all_small(d2_.data(), species_.data(), n, msd_spec_.fraction_all,
-                                                           msd_spec_.fraction_small, select_);
-      s.msd_extreme[0][kj] = all.fast, s.msd_extreme[1][kj] = all.slow;
-      s.msd_extreme[2][kj] = small.fast, s.msd_extreme[3][kj] = small.slow;
-      self_part(s, kj);
-      const an::WaveModes w =
-          an::collective_modes(pos0.data(), pos, n, info().box_length, kFlowModes, pass_.msd_all);
-      std::copy(w.transverse.begin(), w.transverse.end(), s.flow_t.begin() + kj * n_modes_);
-      std::copy(w.longitudinal.begin(), w.longitudinal.end(), s.flow_l.begin() + kj * n_modes_);
-      if (j == info().n_lags - 1) // the amplitudes at the last lag, for the modes' lifetimes
-        for (size_t q = 0; q < n_modes_; ++q) {
-          double* a = &s.amp[(static_cast<size_t>(k) * n_modes_ + q) * 4];
-          a[0] = w.t_re[q], a[1] = w.t_im[q], a[2] = w.l_re[q], a[3] = w.l_im[q];
-        }
-    }
+    if (msd_) msd_->add(s, k, j, pos0.data(), pos, d2_.data(), pass_.msd_all);
     if (s.displacement) s.displacement->add(k, j, pass_, pass_.n_small);
   }
-  // <|dr|^4> and F_s(q) = <J0(q |dr|)> of all and of the small particles
-  // from the pair's |dr|^2 (one pass: each particle's J0 counts for both).
-  void self_part(Measures& s, size_t kj) {
-    const long n = info().n_particles;
-    const size_t nq = fs_q_.size();
-    fs_sum_.assign(2 * nq, 0.0);
-    double r4_all = 0, r4_small = 0;
-    long n_small = 0;
-    for (long i = 0; i < n; ++i) {
-      const double r2 = d2_[i], r4 = r2 * r2;
-      const bool small = species_[i] == 0;
-      r4_all += r4;
-      if (small) r4_small += r4, ++n_small;
-      if (nq == 0) continue;
-      const double r = std::sqrt(r2);
-      for (size_t q = 0; q < nq; ++q) {
-        const double j = ::j0(fs_q_[q] * r);
-        fs_sum_[q] += j;
-        if (small) fs_sum_[nq + q] += j;
-      }
-    }
-    s.m4_all[kj] = r4_all / double(n);
-    s.m4_small[kj] = n_small ? r4_small / double(n_small) : std::numeric_limits<double>::quiet_NaN();
-    for (size_t q = 0; q < nq; ++q) {
-      s.fs_all[kj * nq + q] = fs_sum_[q] / double(n);
-      s.fs_small[kj * nq + q] = n_small ? fs_sum_[nq + q] / double(n_small) : std::numeric_limits<double>::quiet_NaN();
-    }
-  }
-  // alpha_2(t) = <dr^4> / (2 <dr^2>^2) - 1, the means over particles and
-  // origins; the error from a jackknife over blocks of origins spanning the
-  // longest lag (the two tables side by side, so that each replicate leaves
-  // the same origins out of both).
-  void alpha2(const std::vector<double>& m4, const std::vector<double>& msd, std::vector<double>& a,
-              std::vector<double>& err) const {
-    const int no = info().n_origins, nl = static_cast<int>(info().lag_time.size());
-    std::vector<double> table(static_cast<size_t>(no) * 2 * nl);
-    for (int k = 0; k < no; ++k)
-      for (int j = 0; j < nl; ++j) {
-        table[static_cast<size_t>(k) * 2 * nl + j] = m4[static_cast<size_t>(k) * nl + j];
-        table[static_cast<size_t>(k) * 2 * nl + nl + j] = msd[static_cast<size_t>(k) * nl + j];
-      }
-    auto estimate = [nl](const std::vector<double>& v) {
-      std::vector<double> r(nl);
-      for (int j = 0; j < nl; ++j) r[j] = v[j] / (2 * v[nl + j] * v[nl + j]) - 1;
-      return r;
-    };
-    std::vector<double> mean, e;
-    origin_mean(m4, mean, e);
-    std::vector<double> m2;
-    origin_mean(msd, m2, e);
-    a.assign(nl, std::numeric_limits<double>::quiet_NaN());
-    for (int j = 0; j < nl; ++j) a[j] = mean[j] / (2 * m2[j] * m2[j]) - 1;
-    const int block = an::origin_block(info().lag_time.back(), dynhet::origin_spacing(info()), no);
-    err = an::origin_jackknife(table, no, 2 * nl, estimate, block);
-    if (err.size() != static_cast<size_t>(nl)) err.assign(nl, std::numeric_limits<double>::quiet_NaN());
-  }
-  // A per (origin, lag, q) table's mean over origins and its standard
-  // error, [q][lag].
-  void fs_mean(const std::vector<double>& table, std::vector<double>& mean, std::vector<double>& err) const {
-    const size_t nq = fs_q_.size(), nl = info().lag_time.size(), no = info().n_origins;
-    mean.assign(nq * nl, std::numeric_limits<double>::quiet_NaN());
-    err = mean;
-    std::vector<double> v(no * nl), m, e;
-    for (size_t q = 0; q < nq; ++q) {
-      for (size_t kj = 0; kj < no * nl; ++kj) v[kj] = table[kj * nq + q];
-      origin_mean(v, m, e);
-      std::copy(m.begin(), m.end(), mean.begin() + q * nl);
-      std::copy(e.begin(), e.end(), err.begin() + q * nl);
-    }
-  }
-  // Mean over the origins measured at each lag, and its standard error.
-  void origin_mean(const std::vector<double>& v, std::vector<double>& mean, std::vector<double>& err) const {
-    const size_t nj = info().lag_time.size();
-    mean.assign(nj, std::numeric_limits<double>::quiet_NaN());
-    err = mean;
-    for (size_t j = 0; j < nj; ++j) {
-      dynhet::BlockAverage b;
-      for (int k = 0; k < info().n_origins; ++k)
-        if (const double x = v[k * nj + j]; !std::isnan(x)) b.add(x);
-      if (b.count()) mean[j] = b.mean(), err[j] = b.standard_error();
-    }
-  }
   void publish_msd(const Measures& s, bool final) {
-    std::vector<double> frozen; // the waves' frozen shares (flow_part), for the final log line
-    dynhet::msd_t m{};
+    std::vector<double> frozen; // the waves' frozen shares, for the final log line
+    dynhet::msd_t m = msd_->message(s, frozen);
     stamp(m, final);
-    m.cage_relative = s.cage_relative;
-    m.lag_time = info().lag_time;
-    m.n_lags = static_cast<int32_t>(m.lag_time.size());
-    origin_mean(s.msd_all, m.msd_all, m.msd_all_err);
-    origin_mean(s.msd_small, m.msd_small, m.msd_small_err);
-    // D from Delta = 4 D t + b where the MSD has become diffusive (local
-    // log slope within 0.05 of 1 up to the end) or over the last decade of
-    // lags, whichever range is longer.
-    m.fit_t_max = m.lag_time.back();
-    m.fit_t_min = m.fit_t_max / 10;
-    if (const double onset = an::diffusive_onset(m.lag_time, m.msd_all); onset < m.fit_t_min) m.fit_t_min = onset;
-    m.fraction_all = msd_spec_.fraction_all;
-    m.fraction_small = msd_spec_.fraction_small;
-    origin_mean(s.msd_extreme[0], m.msd_fast_all, m.msd_fast_all_err);
-    origin_mean(s.msd_extreme[1], m.msd_slow_all, m.msd_slow_all_err);
-    origin_mean(s.msd_extreme[2], m.msd_fast_small, m.msd_fast_small_err);
-    origin_mean(s.msd_extreme[3], m.msd_slow_small, m.msd_slow_small_err);
-    alpha2(s.m4_all, s.msd_all, m.alpha2_all, m.alpha2_all_err);
-    alpha2(s.m4_small, s.msd_small, m.alpha2_small, m.alpha2_small_err);
-    m.fs_q = fs_q_;
-    m.n_q = static_cast<int32_t>(fs_q_.size());
-    fs_mean(s.fs_all, m.fs_all, m.fs_all_err);
-    fs_mean(s.fs_small, m.fs_small, m.fs_small_err);
-    m.n_fs = static_cast<int32_t>(m.fs_all.size());
-    m.diffusion = m.diffusion_err = m.diffusion_flow = m.diffusion_flow_err = std::numeric_limits<double>::quiet_NaN();
-    if (std::isfinite(m.fit_t_min) && m.fit_t_min < m.fit_t_max) {
-      // Unweighted over the range, the error from a jackknife over blocks
-      // of origins (the lags of one origin are correlated).
-      auto fit = [&](const std::vector<double>& msd) {
-        const auto d = an::fit_diffusion(m.lag_time, msd, m.fit_t_min, m.fit_t_max);
-        return std::vector<double>{d.n >= 3 ? d.d : std::numeric_limits<double>::quiet_NaN()};
-      };
-      m.diffusion = fit(m.msd_all)[0];
-      // D = D_local + D_flow (flow_part). The local part's error: a
-      // jackknife over blocks of origins spanning the fit's longest lag
-      // (origin_block) of the MSD less the modes' share; the flows'
-      // spread, which blocks of one run do not see, added in quadrature.
-      // Without the modes (no waves measured), the jackknife of the MSD.
-      const int block = an::origin_block(m.fit_t_max, dynhet::origin_spacing(info()), info().n_origins);
-      const int nl = static_cast<int>(m.lag_time.size());
-      frozen = flow_part(s, m);
-      if (std::isfinite(m.diffusion_flow_err)) {
-        std::vector<double> local(s.msd_all);
-        for (size_t kj = 0; kj < local.size(); ++kj)
-          for (size_t q = 0; q < n_modes_; ++q)
-            local[kj] -= s.flow_t[kj * n_modes_ + q] + s.flow_l[kj * n_modes_ + q];
-        const auto e = an::origin_jackknife(local, info().n_origins, nl, fit, block);
-        if (std::isfinite(m.diffusion) && e.size() == 1) m.diffusion_err = std::hypot(e[0], m.diffusion_flow_err);
-      } else {
-        const auto e = an::origin_jackknife(s.msd_all, info().n_origins, nl, fit, block);
-        if (std::isfinite(m.diffusion) && e.size() == 1) m.diffusion_err = e[0];
-      }
-    }
     out().publish(dynhet::result_channel(dynhet::kChanMsd, s.cage_relative), &m);
-    if (final && std::isfinite(m.diffusion_flow)) {
-      // The frozen share of the longest waves per |n| (median over the
-      // waves; nan: no two origins the last lag apart, all taken as frozen).
-      std::vector<int> nx, ny;
-      an::wave_vectors(kFlowModes, nx, ny);
-      std::string shells;
-      for (int r = 1; r <= kFlowModes; ++r) {
-        std::vector<double> g;
-        for (size_t q = 0; q < n_modes_; ++q)
-          if (nx[q] * nx[q] + ny[q] * ny[q] <= r * r && nx[q] * nx[q] + ny[q] * ny[q] > (r - 1) * (r - 1))
-            g.push_back(frozen[q]);
-        // NaN (no two origins far enough apart) for one wave is NaN for all
-        if (std::any_of(g.begin(), g.end(), [](double x) { return std::isnan(x); })) g.assign(1, NAN);
-        std::sort(g.begin(), g.end());
-        if (!g.empty()) shells += " " + std::to_string(r) + ":" + std::to_string(g[g.size() / 2]).substr(0, 6);
-      }
-      std::fprintf(stderr,
-                   "overlap_node%s: D=%.5g +- %.2g over t in [%.4g, %.4g]; D_flow=%.4g +- %.2g (waves |n| <= %d); "
-                   "median frozen share of the transverse waves by |n|:%s\n",
-                   s.says(), m.diffusion, m.diffusion_err, m.fit_t_min, m.fit_t_max, m.diffusion_flow, m.diffusion_flow_err,
-                   kFlowModes, shells.c_str());
-    }
+    if (final) msd_->log_flows(m, frozen, s.says());
   }
-  // D_flow = sum over the modes of c = a quarter of the slope of the mode's
-  // share of the MSD over D's fit range, and the spread of D_flow between
-  // runs. Measured in a 96-origin run (N = 4096, phi = 0.76,
-  // docs/analysis.md "D and the long-lived flows"): a long wave's amplitude
-  // u_k . e is a part frozen over the run plus a part that renews within
-  // about one window t (its energy decorrelates by d = t). The frozen share
-  // f of the wave's energy is the correlation of u_k between origins whose
-  // windows do not overlap (d >= t), clipped to [0, 1]; 1 where no two
-  // origins are that far apart. The frozen part is one Gaussian sample per
-  // run: exponential energy, variance (f c)^2 / 2 estimated; the renewing
-  // part a Gamma over the T / t windows of the run: ((1 - f) c)^2 /
-  // (1 + T / t).
-  // Returns the frozen share f of each wave's transverse part (NaN where
-  // not measured), for the log.
-  std::vector<double> flow_part(const Measures& s, dynhet::msd_t& m) const {
-    std::vector<double> frozen(n_modes_, std::numeric_limits<double>::quiet_NaN());
-    if (n_modes_ == 0) return frozen;
-    const int no = info().n_origins;
-    const double t = m.lag_time.back();
-    const double span = (no - 1) * dynhet::origin_spacing(info()) + t;
-    std::vector<double> t0(no);
-    for (int k = 0; k < no; ++k) t0[k] = info().frame_time[info().origin_frame[k]];
-    double sum = 0, var = 0;
-    std::vector<double> mean, err;
-    for (size_t q = 0; q < n_modes_; ++q)
-      for (int part = 0; part < 2; ++part) {
-        const std::vector<double>& table = part == 0 ? s.flow_t : s.flow_l;
-        std::vector<double> v(m.lag_time.size() * no);
-        for (size_t kj = 0; kj < v.size(); ++kj) v[kj] = table[kj * n_modes_ + q];
-        origin_mean(v, mean, err);
-        const auto d = an::fit_diffusion(m.lag_time, mean, m.fit_t_min, m.fit_t_max);
-        if (d.n < 3 || !std::isfinite(d.d)) return frozen;
-        // The amplitude's correlation between origins at least t apart.
-        double power = 0, cross = 0;
-        int n_power = 0, n_cross = 0;
-        for (int k = 0; k < no; ++k) {
-          const double* a = &s.amp[(static_cast<size_t>(k) * n_modes_ + q) * 4 + 2 * part];
-          if (std::isnan(a[0])) continue;
-          power += a[0] * a[0] + a[1] * a[1], ++n_power;
-          for (int l = k + 1; l < no; ++l) {
-            const double* b = &s.amp[(static_cast<size_t>(l) * n_modes_ + q) * 4 + 2 * part];
-            if (std::isnan(b[0]) || t0[l] - t0[k] < t * (1 - 1e-9)) continue;
-            cross += a[0] * b[0] + a[1] * b[1], ++n_cross; // Re(a conj b)
-          }
-        }
-        const bool measured = n_cross > 0 && power > 0;
-        const double f = measured ? std::clamp((cross / n_cross) / (power / n_power), 0.0, 1.0) : 1.0;
-        sum += d.d;
-        var += std::pow(f * d.d, 2) / 2 + std::pow((1 - f) * d.d, 2) / (1 + span / t);
-        if (part == 0 && measured) frozen[q] = f;
-      }
-    m.diffusion_flow = sum, m.diffusion_flow_err = std::sqrt(var);
-    return frozen;
-  }
-
   void publish_chi4(const Measures& s, bool final) {
     const size_t nc = spec_.cutoffs.size(), ng = spec_.grids.size(), nj = info().lag_time.size();
     for (size_t c = 0; c < nc; ++c) {
@@ -521,7 +257,7 @@ private:
     }
     for (Measures& s : sets_) {
       if (want_chi4_) publish_chi4(s, final);
-      if (want_msd_) publish_msd(s, final);
+      if (msd_) publish_msd(s, final);
       if (s.displacement) publish_displacement(s, final);
       publish_overlap(s, final);
     }
@@ -564,11 +300,8 @@ private:
   bool pass_on_ = false, want_chi4_ = false, want_msd_ = false, want_bonds_ = false;
   dynhet::Scene::BondBreaking bond_spec_;
   std::unique_ptr<dynhet::BondBreaking> bonds_; // bond breaking, if the run asks
-  static constexpr int kFlowModes = 4;       // |n| <= 4: waves of L / 4 and longer
-  size_t n_modes_ = 0;
-  std::vector<double> d2_, select_;          // |dr|^2 of the pair; the selection's buffer
-  std::vector<double> fs_q_, fs_sum_;        // F_s's wave numbers; a pair's sums (all, then small)
-  dynhet::Scene::Msd msd_spec_;
+  std::vector<double> d2_;                   // |dr|^2 of the pair
+  std::unique_ptr<dynhet::MsdResults> msd_; // the MSD's part (if the run asks)
   an::DisplacementSpec spec_;
   std::vector<uint8_t> species_;
   std::map<int, std::unique_ptr<an::OriginIndex>> chi4_index_;
