@@ -65,20 +65,21 @@ def main(argv=None):
         + (f"; {len(A.skipped)} runs left out (not complete)" if A.skipped else ""))
     failed = []
 
-    def step(name, fn, *args, needs=()):
-        say(f"  {name}")
+    def step(name, fn, *args, needs=(), on=None):
+        on = on or A  # the analysis the section runs on (the cage-relative view, say)
+        say(f"  {name}" + (", cage-relative" if on is not A else ""))
         if not A.series():
             A.row(name, "—", "—", f"no run of the main series (pairs = neighbours, ε = {EPS_MAIN:g})", "not determined", "", [])
             return None
         # A study that does not compute an observable (its scene's
         # observables.compute) has no result that needs it: said, not failed.
-        lacking = [k for k in needs if not any(k in r["cut"].get(A_MAIN, {}) for p in A.series() for r in p.runs)]
+        lacking = [k for k in needs if not any(k in r["cut"].get(A_MAIN, {}) for p in on.series() for r in p.runs)]
         if lacking:
-            A.row(name, "—", "—", "not computed in this study (" + ", ".join(NEEDS[k] for k in lacking) + ")",
-                  "not run", "", [])
+            on.row(name, "—", "—", "not computed in this study (" + ", ".join(NEEDS[k] for k in lacking) + ")",
+                   "not run", "", [])
             return None
         try:
-            return fn(A, *args)
+            return fn(on, *args)
         except Exception as e:  # one result that cannot be made must not cost the others
             import traceback
             traceback.print_exc()
@@ -104,6 +105,17 @@ def main(argv=None):
     step("cutoff a", cutoff_results)
     step("restitution", restitution_results)
     step("appendix", appendix_results, needs=("chi4", "s4_q"))
+    if A.has_cage_relative():
+        # tau_alpha, the joint fit, chi4, S4 and xi, the clusters again, of
+        # the cage-relative displacements: the same code on a view of the runs.
+        C = A.cage_relative_view()
+        joint_cr = step("joint fit of tau_alpha, chi4, xi", joint_fit, needs=("chi4", "s4_q"), on=C)
+        res_cr = step("tau_alpha(phi)", tau_results, joint_cr, on=C)
+        phi_c_cr = res_cr[0].p["xc"] if res_cr and res_cr[0].ok else math.nan
+        why_cr = sf.cannot_judge(res_cr[0], "xc") if res_cr and res_cr[0].ok else None
+        step("clusters", cluster_results, phi_c_cr, why_cr, joint_cr, needs=("cl_lag",), on=C)
+        step("chi4", chi4_results, phi_c_cr, joint_cr, needs=("chi4",), on=C)
+        step("S4 and xi", s4_results, joint_cr, needs=("s4_q",), on=C)
     A.driving = ({}, "")
     step("driving rules", driving_results)
     driving_rows(A)

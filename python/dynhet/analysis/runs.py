@@ -22,6 +22,61 @@ def cutoff_groups(run, kind):
     return {a: run.observable(kind, a) for a in run.cutoffs(kind)}
 
 
+def read_cutoffs(run, suffix=""):
+    """{a: the cutoff's arrays} of the overlap, chi4, S4 and clusters groups
+    (suffix "_cr": their cage-relative versions; empty where the run has none)."""
+    ov, ch, s4g, cl = (cutoff_groups(run, k + suffix) for k in ("overlap", "chi4", "s4", "clusters"))
+    out = {}
+    for a, g in ov.items():
+        c = {"lag": g["lag_time"][:], "q": last(g, "q"), "q_err": last(g, "q_err")}
+        for k in ("tau_alpha", "tau_alpha_err", "beta", "beta_err", "tau0", "tau0_err"):
+            c[k] = fnum(last(g, k))
+        c["tau_t0"] = last(g, "tau_alpha_t0")
+        c["t0"] = g["t0"][:] if "t0" in g else None
+        if a in ch:
+            h = ch[a]
+            n_sub = h["subbox_particles"][:]
+            nl = len(h["lag_time"][:])
+            c["chi4_lag"] = h["lag_time"][:]
+            c["chi4_N"] = n_sub
+            c["chi4"] = last(h, "chi4").reshape(len(n_sub), nl)
+            c["chi4_err"] = last(h, "chi4_err").reshape(len(n_sub), nl)
+            for k in ("chi4_peak", "chi4_peak_err", "tau4", "tau4_err"):
+                c[k] = last(h, k)
+            # Older files lack it: their peaks count as interior.
+            c["tau4_interior"] = (last(h, "tau4_interior").astype(bool) if "tau4_interior" in h
+                                  else np.ones(len(n_sub), bool))
+        if a in s4g:
+            s = s4g[a]
+            q = s["q"][:]
+            lag = s["lag_time"][:]
+            ng = len(s["subbox_particles"][:])
+            c["s4_q"], c["s4_lag"] = q, lag
+            c["s4_nshells"] = s["n_shells"][:]
+            c["s4_N"] = s["subbox_particles"][:]
+            c["s4_t"] = last(s, "s4_lag").reshape(len(lag), len(q))
+            c["xi_t"] = last(s, "xi_lag").reshape(len(lag), ng)
+            c["chi0_t"] = last(s, "chi0_lag").reshape(len(lag), ng)
+            for k in ("oz_chi0", "oz_chi0_err", "a2_chi0", "a2_chi0_err", "chi4", "chi4_err", "oz_xi", "oz_xi_err",
+                      "oz_q_fit_max"):
+                c["s4_" + k] = last(s, k)
+            for k in ("t_s4", "xi", "xi_err", "chi0", "chi0_err"):
+                c["s4_" + k] = fnum(last(s, k))
+        if a in cl:
+            g2 = cl[a]
+            if "size_centre" in g2:  # absent where this cutoff's tau_alpha was never reached
+                c["cl_size"] = g2["size_centre"][:]
+                c["cl_width"] = (g2["size_hi"][:] - g2["size_lo"][:] + 1).astype(float)
+            for k in ("p_slow", "p_fast", "rg_slow", "rg_fast", "rg_size_slow", "rg_size_fast"):
+                c["cl_" + k] = last(g2, k)
+            c["cl_p_slow_err"] = last(g2, "p_slow_err") if "p_slow_err" in g2 else np.full_like(c["cl_p_slow"], np.nan)
+            for k in ("slow_d_f", "slow_d_f_err", "fast_d_f", "fast_d_f_err", "slow_kappa", "slow_kappa_err",
+                      "fast_sigma", "fast_n_sigma", "fast_p0", "lag"):
+                c["cl_" + k] = fnum(last(g2, k))
+        out[a] = c
+    return out
+
+
 def read_run(path, meta):
     """Everything the analysis uses from one run.h5, as plain numpy."""
     r = dict(meta)
@@ -29,59 +84,14 @@ def read_run(path, meta):
         r["complete"] = int(run.complete)
         obs = run.observables()
         r["N"] = int(meta["n_particles"])
-        r["cut"] = {}
-        ov, ch, s4g, cl = (cutoff_groups(run, k) for k in ("overlap", "chi4", "s4", "clusters"))
-        ov_cr = cutoff_groups(run, "overlap_cr") if "overlap_cr" in obs else {}
-        for a, g in ov.items():
-            c = {"lag": g["lag_time"][:], "q": last(g, "q"), "q_err": last(g, "q_err")}
-            for k in ("tau_alpha", "tau_alpha_err", "beta", "beta_err", "tau0", "tau0_err"):
-                c[k] = fnum(last(g, k))
-            c["tau_t0"] = last(g, "tau_alpha_t0")
-            if a in ov_cr:  # the cage-relative overlap (observables.cage_relative)
-                c["tau_cr"], c["tau_cr_err"] = fnum(last(ov_cr[a], "tau_alpha")), fnum(last(ov_cr[a], "tau_alpha_err"))
-                c["q_cr"] = last(ov_cr[a], "q")
-            c["t0"] = g["t0"][:] if "t0" in g else None
-            if a in ch:
-                h = ch[a]
-                n_sub = h["subbox_particles"][:]
-                nl = len(h["lag_time"][:])
-                c["chi4_lag"] = h["lag_time"][:]
-                c["chi4_N"] = n_sub
-                c["chi4"] = last(h, "chi4").reshape(len(n_sub), nl)
-                c["chi4_err"] = last(h, "chi4_err").reshape(len(n_sub), nl)
-                for k in ("chi4_peak", "chi4_peak_err", "tau4", "tau4_err"):
-                    c[k] = last(h, k)
-                # Older files lack it: their peaks count as interior.
-                c["tau4_interior"] = (last(h, "tau4_interior").astype(bool) if "tau4_interior" in h
-                                      else np.ones(len(n_sub), bool))
-            if a in s4g:
-                s = s4g[a]
-                q = s["q"][:]
-                lag = s["lag_time"][:]
-                ng = len(s["subbox_particles"][:])
-                c["s4_q"], c["s4_lag"] = q, lag
-                c["s4_nshells"] = s["n_shells"][:]
-                c["s4_N"] = s["subbox_particles"][:]
-                c["s4_t"] = last(s, "s4_lag").reshape(len(lag), len(q))
-                c["xi_t"] = last(s, "xi_lag").reshape(len(lag), ng)
-                c["chi0_t"] = last(s, "chi0_lag").reshape(len(lag), ng)
-                for k in ("oz_chi0", "oz_chi0_err", "a2_chi0", "a2_chi0_err", "chi4", "chi4_err", "oz_xi", "oz_xi_err",
-                          "oz_q_fit_max"):
-                    c["s4_" + k] = last(s, k)
-                for k in ("t_s4", "xi", "xi_err", "chi0", "chi0_err"):
-                    c["s4_" + k] = fnum(last(s, k))
-            if a in cl:
-                g2 = cl[a]
-                if "size_centre" in g2:  # absent where this cutoff's tau_alpha was never reached
-                    c["cl_size"] = g2["size_centre"][:]
-                    c["cl_width"] = (g2["size_hi"][:] - g2["size_lo"][:] + 1).astype(float)
-                for k in ("p_slow", "p_fast", "rg_slow", "rg_fast", "rg_size_slow", "rg_size_fast"):
-                    c["cl_" + k] = last(g2, k)
-                c["cl_p_slow_err"] = last(g2, "p_slow_err") if "p_slow_err" in g2 else np.full_like(c["cl_p_slow"], np.nan)
-                for k in ("slow_d_f", "slow_d_f_err", "fast_d_f", "fast_d_f_err", "slow_kappa", "slow_kappa_err",
-                          "fast_sigma", "fast_n_sigma", "fast_p0", "lag"):
-                    c["cl_" + k] = fnum(last(g2, k))
-            r["cut"][a] = c
+        r["cut"] = read_cutoffs(run)
+        # The same of the cage-relative displacements (observables.cage_relative),
+        # and their tau_alpha beside the standard one.
+        r["cut_cr"] = read_cutoffs(run, "_cr")
+        for a, c in r["cut"].items():
+            if a in r["cut_cr"]:
+                c["tau_cr"], c["tau_cr_err"] = r["cut_cr"][a]["tau_alpha"], r["cut_cr"][a]["tau_alpha_err"]
+                c["q_cr"] = r["cut_cr"][a]["q"]
         m = run.msd() if "msd" in obs else None
         if m is not None:
             r["D"], r["D_err"] = fnum(last(m, "diffusion")), fnum(last(m, "diffusion_err"))

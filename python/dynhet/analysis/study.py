@@ -118,3 +118,47 @@ class Analysis:
     def fit(self, name, f):
         self.fits[name] = f
         return f
+
+    # -- the other way
+    def has_cage_relative(self):
+        return any(A_MAIN in r.get("cut_cr", {}) for p in self.points.values() for r in p.runs)
+
+    def cage_relative_view(self):
+        """This study with every run's per-cutoff results (overlap, chi4, S4,
+        clusters) replaced by their cage-relative versions, runs without them
+        left out: the sections' own code states each result the other way.
+        Rows and fits go to this analysis, marked "(cage-relative)" and "cr_";
+        their verdict against the paper moves to the note (the paper measured
+        the standard way: these rows do not count as agreeing or differing);
+        figures are saved as cr_<name>."""
+        return CageRelativeView(self)
+
+
+class CageRelativeView(Analysis):
+    def __init__(self, base):  # noqa: super().__init__ not called: a view of base, nothing read
+        self.__dict__.update(base.__dict__)
+        self.base = base
+
+        def swapped(points):
+            out = {}
+            for k, p in points.items():
+                runs = [dict(r, cut=r["cut_cr"]) for r in p.runs if A_MAIN in r.get("cut_cr", {})]
+                if runs:
+                    q = Point((p.pairs, p.eps, p.phi, p.N))
+                    q.runs = runs
+                    if hasattr(p, "study"):
+                        q.study = p.study
+                    out[k] = q
+            return out
+        self.points, self.extra = swapped(base.points), swapped(base.extra)
+
+    def save(self, fig, name):
+        return self.base.save(fig, "cr_" + name)
+
+    def row(self, item, section, paper, ours, verdict, figure, pts, note=""):
+        against = f"against the paper's standard measure: {verdict}" if verdict in ("agrees", "differs") else ""
+        self.base.row(f"{item} (cage-relative)", section, paper, ours, "—", figure, pts,
+                      "; ".join(x for x in (against, note) if x))
+
+    def fit(self, name, f):
+        return self.base.fit("cr_" + name, f)

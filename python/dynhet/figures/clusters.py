@@ -2,7 +2,9 @@
 layout), one row per cutoff a: g_ab(r) with the neighbour cutoffs; R_g
 against N_c (geometric bin means) with the d_f fit; P(N_c) with the power
 law (slow) and the log-normal (fast); the mean cluster size against the lag
-with tau_alpha and the chosen lag.
+with tau_alpha and the chosen lag. Where the run has clusters_cr
+(observables.cage_relative), the cage-relative P(N_c) and mean sizes in
+the same panels, open squares and dashed lines.
 
 """
 import math
@@ -53,9 +55,15 @@ def plot_rg(ax, g):
     legend_below(ax)
 
 
-def plot_p(ax, g):
+def plot_p(ax, g, cr=None):
     if "p_slow" not in g:
         return
+    if cr is not None and "p_slow" in cr:  # the cage-relative P(N_c), open markers
+        for kind, colour in (("slow", "C3"), ("fast", "C7")):
+            p, err, count = cr[f"p_{kind}"], cr[f"p_{kind}_err"], cr[f"count_{kind}"]
+            ok = count > 0
+            ax.errorbar(cr["size_centre"][()][ok], p[ok], yerr=np.nan_to_num(err[ok]), fmt="s", mfc="none", ms=3,
+                        capsize=2, color=colour, label=f"{kind}, cage-relative")
     centre = g["size_centre"][()]
     n_lo, n_hi = int(g.attrs["kappa_n_min"]), int(g.attrs["kappa_n_max"])
     for kind, colour in (("slow", "C3"), ("fast", "C7")):
@@ -85,11 +93,17 @@ def plot_p(ax, g):
     legend_below(ax)
 
 
-def plot_lags(ax, g):
+def plot_lags(ax, g, cr=None):
     t = g["lag_time"][()]
     for kind, colour in (("slow", "C3"), ("fast", "C7")):
         ax.errorbar(t, g[f"mean_size_{kind}"], yerr=np.nan_to_num(g[f"mean_size_{kind}_err"]),
                     marker="o", ms=3, capsize=2, color=colour, label=f"{kind} <N_c>")
+        if cr is not None:
+            ax.errorbar(t, cr[f"mean_size_{kind}"], yerr=np.nan_to_num(cr[f"mean_size_{kind}_err"]), marker="s",
+                        mfc="none", ls="--", ms=3, capsize=2, color=colour, label=f"{kind}, cage-relative")
+    if cr is not None and math.isfinite(float(cr["tau_alpha"])):
+        ax.axvline(float(cr["tau_alpha"]), color="C4", ls=":", lw=1,
+                   label=f"cage-relative tau_alpha = {float(cr['tau_alpha']):.3g}")
     tau, lag = float(g["tau_alpha"]), float(g["lag"])
     if math.isfinite(tau):
         ax.axvline(tau, color="k", ls=":", lw=1, label=f"tau_alpha = {tau:.3g}")
@@ -113,10 +127,11 @@ def main(path, png):
         fig, axes = plt.subplots(len(groups), 4, figsize=(18, 5.2 * len(groups)), squeeze=False,
                                  layout="constrained")
         for row, (name, g) in zip(axes, groups):
+            cr = run.observable("clusters_cr", name) if name in run.cutoffs("clusters_cr") else None
             plot_g(row[0], g)
             plot_rg(row[1], g)
-            plot_p(row[2], g)
-            plot_lags(row[3], g)
+            plot_p(row[2], g, cr)
+            plot_lags(row[3], g, cr)
             for ax in row:  # each panel names its cutoff
                 ax.set_title(f"a = {g.attrs.get('cutoff_a', name)}: " + ax.get_title())
         save(fig, run, png, 100)

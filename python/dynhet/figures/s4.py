@@ -4,6 +4,9 @@ t_s4 nearest that cutoff's tau_alpha, log-log, with the OZ fit
 chi0/(1 + (q xi)^2) and the fit with A^2 (q xi)^4 over their ranges (the
 dotted lines end them), chi4 at the same t as a square at the left; and a
 last panel with xi(t) of the OZ fit of every grid at every computed lag.
+Where the run has s4_cr (observables.cage_relative), the cage-relative S4(q)
+at its own t_s4 (the cage-relative tau_alpha) is in the same panels, open
+markers, with its OZ fit (dash-dot) and chi4 (open square); its xi(t) dashed.
 
 """
 import math
@@ -16,8 +19,29 @@ import numpy as np
 from ..run import open_run
 
 
-def plot_grid(ax, g, gi, start):
-    """S4(q) of grid gi at t_s4 with both fits and chi4 at the same t."""
+def plot_cage_relative(ax, c, gi, qmin):
+    """The cage-relative S4(q) of grid gi at its t_s4, its OZ fit and chi4."""
+    start = np.concatenate([[0], np.cumsum(c["n_shells"][()])])
+    sl = slice(start[gi], start[gi + 1])
+    q, s, e = c["q"][()][sl], c["s4"][sl], c["s4_err"][sl]
+    ok = (q > 0) & np.isfinite(s) & (s > 0)
+    t = float(c["t_s4"])
+    ax.errorbar(q[ok], s[ok], yerr=np.nan_to_num(e[ok]), fmt="o", mfc="none", color="C4", ms=3.5, capsize=2,
+                label=f"cage-relative $S_4(q)$ at t = {t:.3g}")
+    chi4, chi4_err = c["chi4"][gi], c["chi4_err"][gi]
+    if math.isfinite(chi4):
+        ax.errorbar([qmin / 2], [chi4], yerr=[np.nan_to_num(chi4_err)], fmt="s", mfc="none", color="C4", ms=5,
+                    capsize=2, label=rf"cage-relative $\chi_4$ = {chi4:.3g}")
+    chi0, xi, xi_err = c["oz_chi0"][gi], c["oz_xi"][gi], c["oz_xi_err"][gi]
+    if math.isfinite(xi) and math.isfinite(chi0):
+        qq = np.geomspace(qmin / 2, q.max() if len(q) else 1.0, 100)
+        ax.plot(qq, chi0 / (1 + (qq * xi) ** 2), "-.", color="C4",
+                label=rf"cage-relative OZ: $\xi$ = {xi:.3g} ± {xi_err:.2g}, $\chi_0$ = {chi0:.3g}")
+
+
+def plot_grid(ax, g, gi, start, cr=None):
+    """S4(q) of grid gi at t_s4 with both fits and chi4 at the same t (and
+    the cage-relative ones of group cr, if given)."""
     sizes, sides = g["subbox_particles"][()], g["subbox_per_side"][()]
     q_all, s4, s4_err = g["q"][()], g["s4"], g["s4_err"]
     sl = slice(start[gi], start[gi + 1])
@@ -45,6 +69,8 @@ def plot_grid(ax, g, gi, start):
         ax.plot(qq, chi0 / (1 + x2 + a * a * x2 * x2), "-" if form == "oz" else "--", color=color,
                 label=rf"{name}: $\xi$ = {xi:.3g} ± {xi_err:.2g}, $\chi_0$ = {chi0:.3g} ± {chi0_err:.2g}{extra}")
         ax.axvline(qf, color=color, lw=0.8, ls=":")
+    if cr is not None and gi < len(cr["subbox_per_side"]):
+        plot_cage_relative(ax, cr, gi, qmin)
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("q")
@@ -57,13 +83,17 @@ def plot_grid(ax, g, gi, start):
     legend_below(ax)
 
 
-def plot_xi(ax, g):
-    """OZ xi(t) of every grid at every computed lag, t_s4 marked."""
+def plot_xi(ax, g, cr=None):
+    """OZ xi(t) of every grid at every computed lag, t_s4 marked (and the
+    cage-relative xi(t), dashed)."""
     sizes, lags = g["subbox_particles"][()], g["lag_time"][()]
     t_s4, tau_alpha = float(g["t_s4"]), float(g["tau_alpha"])
     xi_lag = g["xi_lag"]  # [lag][grid]
     for gi in range(len(sizes)):
-        ax.plot(lags, xi_lag[:, gi], "o-", ms=3, label=f"sub-boxes of N = {sizes[gi]:.0f}")
+        line = ax.plot(lags, xi_lag[:, gi], "o-", ms=3, label=f"sub-boxes of N = {sizes[gi]:.0f}")
+        if cr is not None and gi < cr["xi_lag"].shape[1]:
+            ax.plot(cr["lag_time"][()], cr["xi_lag"][:, gi], "o--", ms=3, mfc="none", color=line[0].get_color(),
+                    label=f"N = {sizes[gi]:.0f}, cage-relative")
     ax.axvline(t_s4, color="k", lw=0.8, ls=":", label=rf"$t_{{s4}}$ = {t_s4:.3g} ($\tau_\alpha$ = {tau_alpha:.3g})")
     ax.set_xscale("log")
     ax.set_xlabel("t")
@@ -79,6 +109,7 @@ def main(path, png):
             print(f"plot_s4: {path} has no s4 results", file=sys.stderr)
             return 1
         groups = [run.s4(a) for a in run.cutoffs("s4")]
+        crs = [run.observable("s4_cr", a) if a in run.cutoffs("s4_cr") else None for a in run.cutoffs("s4")]
         # Per cutoff its grids' panels and the xi(t) panel, at most three a
         # row (two when there are four): a grid of panels, not a strip.
         panels = max(len(g["subbox_per_side"]) for g in groups) + 1
@@ -86,13 +117,13 @@ def main(path, png):
         rows_per = math.ceil(panels / cols)
         fig, axes = plt.subplots(rows_per * len(groups), cols, figsize=(5.2 * cols, 5.0 * rows_per * len(groups)),
                                  squeeze=False, layout="constrained")
-        for k, g in enumerate(groups):
+        for k, (g, cr) in enumerate(zip(groups, crs)):
             block = axes[k * rows_per:(k + 1) * rows_per].ravel()
             ng = len(g["subbox_per_side"])
             start = np.concatenate([[0], np.cumsum(g["n_shells"][()])])
             for gi in range(ng):
-                plot_grid(block[gi], g, gi, start)
-            plot_xi(block[ng], g)
+                plot_grid(block[gi], g, gi, start, cr)
+            plot_xi(block[ng], g, cr)
             for ax in block[ng + 1:]:
                 ax.set_visible(False)
         save(fig, run, png, 100)
