@@ -67,3 +67,18 @@ def test_every_problem_is_named(tmp_path):
     assert "run_length.lag_min_tau: must be smaller than run_length.lag_max_tau" in msg
     assert "override[0].when.packing_fraction: value 0.75 is not on axis" in msg
     assert "colour" in msg
+
+
+def test_run_lengths_in_the_cage_relative_tau_alpha(tmp_path):
+    # unit = "tau_alpha_cr": every run (and its pilot) computes the
+    # cage-relative observables, and its tau is read from overlap_cr.
+    s = study(tmp_path, GOOD.replace('tau_alpha = "pilot"', 'tau_alpha = "pilot"\nunit = "tau_alpha_cr"'))
+    p = s.points()[0]
+    assert s.tau_group() == "overlap_cr"
+    assert s.scene(p, tau=2.0)["observables"]["cage_relative"] is True
+    pilot = s.scene(p, tau=2.0, pilot=True)
+    assert pilot["observables"]["cage_relative"] is True and pilot["observables"]["compute"] == ["overlap"]
+    assert study(tmp_path, GOOD).tau_group() == "overlap"
+    with pytest.raises(StudyError) as e:
+        study(tmp_path, GOOD.replace('tau_alpha = "pilot"', 'tau_alpha = "pilot"\nunit = "tau_cr"'))
+    assert "run_length.unit: value 'tau_cr' is not allowed" in str(e.value)

@@ -24,6 +24,7 @@ AXES = {  # axis -> (scene table, key, type)
 }
 RUN_LENGTH_KEYS = {
     "tau_alpha": str,  # "scene" | "pilot" | "interpolate"
+    "unit": str,  # "tau_alpha" | "tau_alpha_cr": the relaxation time the run lengths are counted in
     "equilibration_tau": float,
     "lag_max_tau": float,
     "lag_min_tau": float,
@@ -34,7 +35,7 @@ RUN_LENGTH_KEYS = {
     "max_attempts": int,
     "tau_guess": list,
 }
-RUN_LENGTH_DEFAULTS = dict(tau_alpha="scene", equilibration_tau=10.0, lag_max_tau=4.0, lag_min_tau=0.02,
+RUN_LENGTH_DEFAULTS = dict(tau_alpha="scene", unit="tau_alpha", equilibration_tau=10.0, lag_max_tau=4.0, lag_min_tau=0.02,
                            origin_spacing_tau=1.0, origins=8, pilot_particles=2048, pilot_margin=1.2, max_attempts=3,
                            tau_guess=[])
 
@@ -137,6 +138,9 @@ class Study:
         if rl["tau_alpha"] not in ("scene", "pilot", "interpolate"):
             self.errors.append(f"run_length.tau_alpha: value {rl['tau_alpha']!r} is not allowed; "
                                'allowed: "scene" (the scene\'s own times), "pilot", "interpolate"')
+        if rl["unit"] not in ("tau_alpha", "tau_alpha_cr"):
+            self.errors.append(f"run_length.unit: value {rl['unit']!r} is not allowed; allowed: \"tau_alpha\", "
+                               '"tau_alpha_cr" (the cage-relative tau_alpha, which does not fall with N)')
         if not (1.0 <= rl["pilot_margin"] <= 10.0):
             self.errors.append(f"run_length.pilot_margin: value {rl['pilot_margin']} is not allowed; allowed: 1 to 10")
         for k in ("equilibration_tau", "lag_max_tau", "lag_min_tau", "origin_spacing_tau"):
@@ -249,7 +253,7 @@ class Study:
         if tau is not None:
             rl = self.run_length
             eq, origins, lag_max = rl["equilibration_tau"], rl["origins"], rl["lag_max_tau"]
-            if pilot:  # short and small: only tau_alpha is wanted
+            if pilot:  # short and small: only tau_alpha (or tau_alpha^CR) is wanted
                 eq, origins = min(eq, 5.0), min(origins, 4)
                 sc["system"]["n_particles"] = min(int(sc["system"]["n_particles"]), rl["pilot_particles"])
                 sc["observables"] = {"compute": ["overlap"], "cutoff_a": sc.get("observables", {}).get("cutoff_a", [0.6])}
@@ -262,7 +266,13 @@ class Study:
             sched["origin_spacing"] = round(rl["origin_spacing_tau"] * tau, 6)
             sched["lag_min"] = round(rl["lag_min_tau"] * tau, 6)
             sched["lag_max"] = round(lag_max * tau, 6)
+        if self.run_length["unit"] == "tau_alpha_cr":  # lengths in tau_alpha^CR: every run (and pilot) measures it
+            sc.setdefault("observables", {})["cage_relative"] = True
         return sc
+
+    def tau_group(self):
+        """The run.h5 group whose tau_alpha the run lengths are counted in."""
+        return "overlap_cr" if self.run_length["unit"] == "tau_alpha_cr" else "overlap"
 
     def first_cutoff(self, sc):
         return sc.get("observables", {}).get("cutoff_a", [0.6])[0]

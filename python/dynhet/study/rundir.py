@@ -23,16 +23,16 @@ def write_status(d, st):
     write_atomic(os.path.join(d, "status.toml"), toml_dump(st, "# dynhet study run status (run_study.sh reads it)"))
 
 
-def run_h5_result(path, cutoff):
-    """(complete, tau_alpha) of a run.h5."""
+def run_h5_result(path, cutoff, group="overlap"):
+    """(complete, tau_alpha) of a run.h5 (group overlap_cr: the cage-relative tau_alpha)."""
     out = subprocess.run(
         ["/usr/bin/python3", "-c",
          "import h5py,sys,math\n"
          "f=h5py.File(sys.argv[1],'r')\n"
          "c=int(f.attrs.get('complete',0))\n"
-         "g=f.get('observables/overlap/a'+sys.argv[2])\n"
+         "g=f.get('observables/'+sys.argv[3]+'/a'+sys.argv[2])\n"
          "t=float(g['tau_alpha/value'][-1]) if g is not None else float('nan')\n"
-         "print(c, t)", path, f"{cutoff:g}"],
+         "print(c, t)", path, f"{cutoff:g}", group],
         capture_output=True, text=True)
     if out.returncode != 0:
         return 0, float("nan")

@@ -100,7 +100,7 @@ def do_run(sd, p, log=print):
         rc, wall, cpu = rc2, wall + wall2, cpu + cpu2
     if rc == RESUMABLE and not STOPPING.is_set() and newest_whole_cut(d) == cut0:
         rc = 1  # no progress: a failure, not an interruption
-    complete, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc)) if rc == 0 else (0, float("nan"))
+    complete, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc), st.tau_group()) if rc == 0 else (0, float("nan"))
     status.update({"exit": rc, "wall_s": wall, "cpu_s": cpu, "finished": time.strftime("%Y-%m-%dT%H:%M:%S"),
                    "tau_alpha": tau})
     status.pop("pid", None)

@@ -137,7 +137,7 @@ def pilot_locked(sd, p, name, d):
         rc, wall, cpu = run_scene(os.path.join(d, "scene.toml"), d, os.path.join(d, "run_scene.log"))
         if STOPPING.is_set():
             raise StudyInterrupted(f"pilot of {name} stopped")
-        complete, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc))
+        complete, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc), st.tau_group())
         if rc != 0 or not complete:
             write_status(d, {"state": "failed", "exit": rc, "message": f"pilot run failed; log {d}/run_scene.log"})
             raise StudyError(f"pilot of {name} failed (exit {rc}); its log: {d}/run_scene.log")
