@@ -1,0 +1,44 @@
+"""The study analysis' cage-relative view (Analysis.cage_relative_view):
+every run's per-cutoff results replaced by its cage-relative ones, runs
+without them left out, rows marked and kept out of the agree/differ count,
+fits and figures prefixed; the study itself untouched."""
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from dynhet.analysis.points import Point  # noqa: E402
+from dynhet.analysis.study import Analysis  # noqa: E402
+
+
+def analysis(tmp_path):
+    A = Analysis.__new__(Analysis)  # no study directory: points made here
+    A.dir, A.figdir = str(tmp_path), str(tmp_path / "figures")
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    for phi, with_cr in ((0.70, True), (0.75, False)):
+        p = Point(("neighbours", 0.9, phi, 4096))
+        for seed in (1, 2):
+            r = {"seed": seed, "cut": {0.6: {"tau_alpha": 10.0 * phi}}}
+            if with_cr:
+                r["cut_cr"] = {0.6: {"tau_alpha": 30.0 * phi}}
+            p.runs.append(r)
+        A.points[p.pairs, p.eps, p.phi, p.N] = p
+    return A
+
+
+def test_the_view_swaps_the_results_and_marks_its_rows(tmp_path):
+    A = analysis(tmp_path)
+    assert A.has_cage_relative()
+    C = A.cage_relative_view()
+    assert [p.phi for p in C.series()] == [0.70]                      # the point without _cr is left out
+    assert [r["cut"][0.6]["tau_alpha"] for r in C.series()[0].runs] == [21.0, 21.0]
+    assert [r["cut"][0.6]["tau_alpha"] for r in A.series()[0].runs] == [7.0, 7.0]  # the study untouched
+    C.row("τ_α at φ = 0.7", "3.1", "7", "21", "differs", "", C.series())
+    C.fit("tau_power", "a fit")
+    row = A.rows[-1]
+    assert row["item"] == "τ_α at φ = 0.7 (cage-relative)" and row["verdict"] == "—"
+    assert "against the paper's standard measure: differs" in row["note"]
+    assert A.fits == {"cr_tau_power": "a fit"}
+    fig = plt.figure()
+    fig.add_subplot().plot([1, 2], [1, 2])
+    assert C.save(fig, "tau.png") == "figures/cr_tau.png"
