@@ -8,6 +8,7 @@
 #include <string>
 
 #include "dynhet/analysis/fits.hpp"
+#include "dynhet/analysis/self_scattering.hpp"
 #include "dynhet/analysis/timescales.hpp"
 #include "dynhet/model.hpp"
 #include "dynhet/stats.hpp"
@@ -67,30 +68,10 @@ MsdResults::MsdResults(const run_info_t& run, const Scene::Msd& spec)
 // <|dr|^4> and F_s(q) = <J0(q |dr|)> of all and of the small particles
 // from the pair's |dr|^2 (one pass: each particle's J0 counts for both).
 void MsdResults::self_part(Measures& s, size_t kj, const double* d2) {
-  const long n = run_.n_particles;
+  const an::SelfScatteringAllSmall r = an::self_scattering_all_small(d2, species_.data(), run_.n_particles, fs_q_);
+  s.m4_all[kj] = r.all.m4, s.m4_small[kj] = r.small.m4;
   const size_t nq = fs_q_.size();
-  fs_sum_.assign(2 * nq, 0.0);
-  double r4_all = 0, r4_small = 0;
-  long n_small = 0;
-  for (long i = 0; i < n; ++i) {
-    const double r2 = d2[i], r4 = r2 * r2;
-    const bool small = species_[i] == 0;
-    r4_all += r4;
-    if (small) r4_small += r4, ++n_small;
-    if (nq == 0) continue;
-    const double r = std::sqrt(r2);
-    for (size_t q = 0; q < nq; ++q) {
-      const double j = ::j0(fs_q_[q] * r);
-      fs_sum_[q] += j;
-      if (small) fs_sum_[nq + q] += j;
-    }
-  }
-  s.m4_all[kj] = r4_all / double(n);
-  s.m4_small[kj] = n_small ? r4_small / double(n_small) : std::numeric_limits<double>::quiet_NaN();
-  for (size_t q = 0; q < nq; ++q) {
-    s.fs_all[kj * nq + q] = fs_sum_[q] / double(n);
-    s.fs_small[kj * nq + q] = n_small ? fs_sum_[nq + q] / double(n_small) : std::numeric_limits<double>::quiet_NaN();
-  }
+  for (size_t q = 0; q < nq; ++q) s.fs_all[kj * nq + q] = r.all.fs[q], s.fs_small[kj * nq + q] = r.small.fs[q];
 }
 // alpha_2(t) = <dr^4> / (2 <dr^2>^2) - 1, the means over particles and
 // origins; the error from a jackknife over blocks of origins spanning the

@@ -66,7 +66,7 @@ private:
   Scene::Msd spec_;
   std::vector<std::uint8_t> species_;
   size_t n_modes_ = 0;
-  std::vector<double> fs_q_, fs_sum_; // F_s's wave numbers; a pair's sums (all, then small)
+  std::vector<double> fs_q_;          // F_s's wave numbers
   std::vector<double> select_;        // the subsets' selection buffer
 };
 
