@@ -3,14 +3,16 @@
 // (one channel per cutoff a, e.g. DYNHET_OVERLAP_a0.6) after every frame
 // that adds a pair; if the run asks for chi4, also chi4(t) for every listed
 // sub-box size on DYNHET_CHI4_<a>, from the same displacements, and the
-// MSD (with the instantaneous fastest and slowest subsets) on DYNHET_MSD
-// and P(dx, t) on DYNHET_DISPLACEMENT. With [observables] cage_relative,
-// all of them again, in the same pass, of the cage-relative displacements
-// dr_i - (mean dr of i's Voronoi neighbours in the origin frame), on the
-// channels with _CR (DYNHET_OVERLAP_CR_a0.6, DYNHET_MSD_CR, ...). It holds
-// only the origin frames that some later frame still needs (16 N bytes
-// each, plus 4 N per origin for chi4's sub-box index and about 28 N for
-// the neighbours of a cage).
+// MSD (with the instantaneous fastest and slowest subsets, alpha_2 and
+// F_s; msd_results.cpp) on DYNHET_MSD and P(dx, t) on DYNHET_DISPLACEMENT;
+// with "bond_breaking", C_B(t), tau_B and chi_B on DYNHET_BOND_BREAKING.
+// With [observables] cage_relative, all but bond breaking again, in the
+// same pass, of the cage-relative displacements dr_i - (mean dr of i's
+// cage in the origin frame; cages.cpp), on the channels with _CR
+// (DYNHET_OVERLAP_CR_a0.6, DYNHET_MSD_CR, ...). It holds only the origin
+// frames that some later frame still needs (16 N bytes each, plus 4 N per
+// origin for chi4's sub-box index, about 28 N for the cages and 20 N per
+// bond for the bonds).
 //
 // Usage: overlap_node [--lcm-url URL] [--publish-url URL]
 // With --lcm-url file://LOG?speed=0 it re-runs the analysis from an
