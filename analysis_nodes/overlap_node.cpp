@@ -11,8 +11,8 @@
 // cage in the origin frame; cages.cpp), on the channels with _CR
 // (DYNHET_OVERLAP_CR_a0.6, DYNHET_MSD_CR, ...). It holds only the origin
 // frames that some later frame still needs (16 N bytes each, plus 4 N per
-// origin for chi4's sub-box index, about 28 N for the cages and 20 N per
-// bond for the bonds).
+// origin for chi4's sub-box index, about 28 N for the cages and 24 bytes
+// per bond for the bonds, 1.3 to 2.2 bonds per particle).
 //
 // Usage: overlap_node [--lcm-url URL] [--publish-url URL]
 // With --lcm-url file://LOG?speed=0 it re-runs the analysis from an
