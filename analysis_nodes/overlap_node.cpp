@@ -116,17 +116,16 @@ private:
   void on_pair(int k, int j, const std::vector<double>& pos0, const dynhet::Frame& f) override {
     add_pair(sets_[0], k, j, pos0, f.position.data());
     const long n2 = 2L * info().n_particles;
-    if (bonds_) {
+    if (cage_) { // the frame's positions replaced by pos0 + dr^CR (dr_ left holding dr)
+      dr_cr_.resize(n2);
+      an::cage_relative_positions(pos0.data(), f.position.data(), cages_->at(k), dr_, dr_cr_.data());
+    } else if (bonds_) {
       dr_.resize(n2);
       for (long i = 0; i < n2; ++i) dr_[i] = f.position[i] - pos0[i];
-      bonds_->add(k, j, pos0, dr_.data());
     }
-    if (!cage_) return;
-    // The same pair again, the frame's positions replaced by
-    // pos0 + dr^CR: every measure below sees cage-relative displacements.
-    dr_cr_.resize(n2);
-    an::cage_relative_positions(pos0.data(), f.position.data(), cages_->at(k), dr_, dr_cr_.data());
-    add_pair(sets_[1], k, j, pos0, dr_cr_.data());
+    if (bonds_) bonds_->add(k, j, pos0, dr_.data());
+    // The same pair again, every measure seeing cage-relative displacements.
+    if (cage_) add_pair(sets_[1], k, j, pos0, dr_cr_.data());
   }
   void add_pair(Measures& s, int k, int j, const std::vector<double>& pos0, const double* pos) {
     an::overlap_subboxes(pos0.data(), pos, info().n_particles, grid_, info().cutoff_a, qr_);

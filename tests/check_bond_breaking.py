@@ -16,21 +16,8 @@ import sys
 import h5py
 import numpy as np
 
-failures = []
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        failures.append(what)
-
-
-def crossing_time(t, q, level):
-    for j in range(1, len(q)):
-        if q[j] < level <= q[j - 1]:
-            a, b = math.log(t[j - 1]), math.log(t[j])
-            return math.exp(a + (b - a) * (q[j - 1] - level) / (q[j - 1] - q[j]))
-    return math.nan
+# The checks and tau's crossing as check_run.py has them (one list of failures).
+from check_run import check, crossing_time, failures  # noqa: E402
 
 
 def main(path):

@@ -26,22 +26,9 @@ import numpy as np
 from scipy.spatial import Delaunay
 from scipy.special import j0
 
-failures = []
-
-
-def check(cond, what):
-    print(("ok   " if cond else "FAIL ") + what)
-    if not cond:
-        failures.append(what)
-
-
-def crossing_time(t, q, level):
-    """The first lag where q falls below level, linear in ln t between lags (timescales.cpp)."""
-    for j in range(1, len(q)):
-        if q[j] < level <= q[j - 1]:
-            a, b = math.log(t[j - 1]), math.log(t[j])
-            return math.exp(a + (b - a) * (q[j - 1] - level) / (q[j - 1] - q[j]))
-    return math.nan
+# The checks and tau's crossing as check_run.py has them (one list of failures).
+import check_run  # noqa: E402
+from check_run import check, crossing_time, failures  # noqa: E402
 
 
 def voronoi_neighbours(x, L):
@@ -152,16 +139,12 @@ def main(path):
         check(abs(short - (1 + inv_n)) < 0.1, f"msd_cr / msd at the shortest lag {short:.3f}: about 1 + <1/N_i> = "
               f"{1 + inv_n:.3f}")
     if "s4_cr" in obs:  # S4 of the cage-relative weights, by the exact sums of check_run.py
-        import check_run
-        check_run.failures = failures
         lag = obs["schedule"]["lag_time"][()]
         for name, g in obs["s4_cr"].items():
             check_run.check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, lag,
                                dr_of=lambda k, j: dr_cr[k, j], overlap="overlap_cr", need_fit=False)
     if "clusters_cr" in obs:  # slow and fast clusters by |dr^CR|, by check_run.py's brute force
-        import check_run
         import tomllib
-        check_run.failures = failures
         text = f["parameters/scene_toml"][()]
         scene = tomllib.loads(text.decode() if isinstance(text, bytes) else str(text))
         check_run.check_clusters(f, unwrapped, L, origin_frame, pair_frame, obs["schedule"]["lag_time"][()], scene,

@@ -92,7 +92,10 @@ Neighbours voronoi_neighbours(const double* pos, long n, double box) {
   return v;
 }
 
-void cage_relative(const double* dr, const Neighbours& v, double* out) {
+namespace {
+// out_i = from_i - (mean dr_j over i's neighbours; 0 without any): from =
+// dr gives dr^CR, from = the positions at t gives pos0 + dr^CR.
+void less_cage_mean(const double* dr, const Neighbours& v, const double* from, double* out) {
   const long n = v.size();
   for (long i = 0; i < n; ++i) {
     const long c = v.count(i);
@@ -101,26 +104,20 @@ void cage_relative(const double* dr, const Neighbours& v, double* out) {
       const std::int32_t j = v.list[k];
       mx += dr[2 * j], my += dr[2 * j + 1];
     }
-    out[2 * i] = dr[2 * i] - (c > 0 ? mx / c : 0.0);
-    out[2 * i + 1] = dr[2 * i + 1] - (c > 0 ? my / c : 0.0);
+    out[2 * i] = from[2 * i] - (c > 0 ? mx / c : 0.0);
+    out[2 * i + 1] = from[2 * i + 1] - (c > 0 ? my / c : 0.0);
   }
 }
+} // namespace
+
+void cage_relative(const double* dr, const Neighbours& v, double* out) { less_cage_mean(dr, v, dr, out); }
 
 void cage_relative_positions(const double* pos0, const double* pos, const Neighbours& v, std::vector<double>& dr,
                              double* out) {
   const long n = v.size();
   dr.resize(2 * n);
   for (long i = 0; i < 2 * n; ++i) dr[i] = pos[i] - pos0[i];
-  for (long i = 0; i < n; ++i) {
-    const long c = v.count(i);
-    double mx = 0, my = 0;
-    for (std::int64_t k = v.offset[i]; k < v.offset[i + 1]; ++k) {
-      const std::int32_t j = v.list[k];
-      mx += dr[2 * j], my += dr[2 * j + 1];
-    }
-    out[2 * i] = pos[2 * i] - (c > 0 ? mx / c : 0.0);
-    out[2 * i + 1] = pos[2 * i + 1] - (c > 0 ? my / c : 0.0);
-  }
+  less_cage_mean(dr.data(), v, pos, out);
 }
 
 } // namespace dynhet::analysis

@@ -22,14 +22,7 @@ public final class BondBreakingPlugin implements SpyPlugin {
     Curves c = new Curves("C_B(t), bonds " + Curves.num(m.a1) + " to " + Curves.num(m.a2) + " sigma", "t", "C_B",
                           true, false);
     c.add("C_B(t)", m.lag_time, m.c_b, 0, m.n_lags);
-    // The 1/e line across the lags: tau_B is where C_B crosses it.
-    double lo = Double.POSITIVE_INFINITY, hi = 0;
-    for (double t : m.lag_time)
-      if (Double.isFinite(t) && t > 0) {
-        lo = Math.min(lo, t);
-        hi = Math.max(hi, t);
-      }
-    if (hi > 0) c.add("1/e", new double[] {lo, hi}, new double[] {Math.exp(-1), Math.exp(-1)}, 0, 2);
+    c.addOneOverE(m.lag_time); // tau_B is where C_B crosses it
     c.say(Curves.stamp(m.run_id, m.frame_index, m.sim_time, m.is_final) + " \u00b7 " +
           Curves.num(m.bonds_per_particle) + " bonds per particle");
     c.say("\u03c4_B = " + Curves.pm(m.tau_b, m.tau_b_err));

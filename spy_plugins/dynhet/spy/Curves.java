@@ -76,6 +76,17 @@ final class Curves {
 
   // Checks of an untrusted message.
 
+  /** The line 1/e across the positive, finite lags (none without any). */
+  void addOneOverE(double[] lags) throws BadMessage {
+    double lo = Double.POSITIVE_INFINITY, hi = 0;
+    for (double t : lags)
+      if (Double.isFinite(t) && t > 0) {
+        lo = Math.min(lo, t);
+        hi = Math.max(hi, t);
+      }
+    if (hi > 0) add("1/e", new double[] {lo, hi}, new double[] {Math.exp(-1), Math.exp(-1)}, 0, 2);
+  }
+
   /** A title's suffix for results of the cage-relative displacements (channels with _CR). */
   static String cageRelative(boolean cr) { return cr ? " (cage-relative)" : ""; }
 

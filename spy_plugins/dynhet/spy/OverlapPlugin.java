@@ -23,14 +23,7 @@ public final class OverlapPlugin implements SpyPlugin {
     Curves c = new Curves("Q(t), a = " + Curves.num(m.cutoff_a) + Curves.cageRelative(m.cage_relative), "t", "Q", true,
                           false);
     c.add("Q(t)", m.lag_time, m.q, 0, m.n_lags);
-    // The 1/e line across the lags: tau_alpha is where Q crosses it.
-    double lo = Double.POSITIVE_INFINITY, hi = 0;
-    for (double t : m.lag_time)
-      if (Double.isFinite(t) && t > 0) {
-        lo = Math.min(lo, t);
-        hi = Math.max(hi, t);
-      }
-    if (hi > 0) c.add("1/e", new double[] {lo, hi}, new double[] {Math.exp(-1), Math.exp(-1)}, 0, 2);
+    c.addOneOverE(m.lag_time); // tau_alpha is where Q crosses it
     int origins = m.n_lags > 0 ? m.n_origins[0] : 0;
     c.say("a = " + Curves.num(m.cutoff_a) + " \u00b7 " +
           Curves.stamp(m.run_id, m.frame_index, m.sim_time, m.is_final) + " \u00b7 " + origins +

@@ -42,8 +42,9 @@ void cage_relative(const double* dr, const Neighbours& v, double* out);
 // The positions whose displacements from pos0 are the cage-relative ones,
 // pos_i - (mean dr_j of i's neighbours) = pos0_i + dr^CR_i (up to
 // rounding), in one gather: what the overlap node hands its measures for
-// the cage-relative set. dr is a buffer (filled with pos - pos0); out must
-// not alias pos0 or pos.
+// the cage-relative set. dr is a buffer, left holding pos - pos0 (the
+// unwrapped displacements, for whoever needs them too); out must not alias
+// pos0 or pos.
 void cage_relative_positions(const double* pos0, const double* pos, const Neighbours& v, std::vector<double>& dr,
                              double* out);
 
