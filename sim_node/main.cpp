@@ -541,11 +541,7 @@ int main(int argc, char** argv) {
             if (g_signal) {
               checkpoint_written = true;
               const int before = cuts->last_whole();
-              // Still saying it is alive (once a second) while the parts come in.
-              if (c >= 0 && cuts->wait_whole(c, cut_wait, [&] {
-                    rep.update(eng, 0.0);
-                    return false;
-                  }))
+              if (c >= 0 && cuts->wait_whole(c, cut_wait))
                 throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
                                          "; checkpoint cut " + std::to_string(c) + " after frame " +
                                          std::to_string(next_frame - 1) + " (t=" + std::to_string(eng.time()) +
@@ -645,13 +641,9 @@ int main(int argc, char** argv) {
     }
     advance(t_end);
     // The cuts still open are whole once the nodes have caught up: a run
-    // that dies after the sim ends then loses nothing the sim did. The sim
-    // keeps publishing its status meanwhile (once a second): a node still
-    // catching up must not take the wait for the sim's death.
-    if (cuts && cuts->newest_open() >= 0 && !cuts->wait_whole(cuts->newest_open(), cut_wait, [&] {
-          rep.update(eng, 0.0);
-          return g_signal != 0;
-        })) {
+    // that dies after the sim ends then loses nothing the sim did.
+    if (cuts && cuts->newest_open() >= 0 &&
+        !cuts->wait_whole(cuts->newest_open(), cut_wait, [] { return g_signal != 0; })) {
       if (g_signal) {
         checkpoint_written = true;
         throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
