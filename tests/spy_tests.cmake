@@ -15,5 +15,5 @@ if(TARGET dynhet_spy_plugins)
   # and counted. Screenshots in build/test_output/spy_plugins/.
   add_test(NAME spy_plugins
     COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/spy_plugins.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
-  set_tests_properties(spy_plugins PROPERTIES LABELS process TIMEOUT 180)
+  set_tests_properties(spy_plugins PROPERTIES LABELS process TIMEOUT 240)
 endif()

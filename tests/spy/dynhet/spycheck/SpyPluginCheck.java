@@ -92,6 +92,8 @@ public final class SpyPluginCheck {
       uncaught.add(t.getName() + ": " + e);
       e.printStackTrace();
     });
+    String limit = System.getenv("DYNHET_SPYCHECK_WATCHDOG_MS"); // to try the watchdog
+    watchdog(limit == null ? 150_000 : Long.parseLong(limit));
     JFrame.setDefaultLookAndFeelDecorated(true); // title bars on a display without a window manager
     File out = new File(args[3]);
     live(args[0], new File(args[1]), new File(args[2]), out);
@@ -102,6 +104,36 @@ public final class SpyPluginCheck {
     System.out.println(failures == 0 ? "spy plugin check: passed"
                                      : "spy plugin check: " + failures + " failed");
     System.exit(failures == 0 ? 0 : 1);
+  }
+
+  /**
+   * A checker that hangs says where: after LIMIT ms every thread's stack
+   * (and the threads that deadlock, if any) goes to stderr and the checker
+   * exits 3, before ctest's timeout kills it silently.
+   */
+  static void watchdog(long limit) {
+    Thread w = new Thread(() -> {
+      try {
+        Thread.sleep(limit);
+      } catch (InterruptedException e) {
+        return;
+      }
+      java.lang.management.ThreadMXBean mx = java.lang.management.ManagementFactory.getThreadMXBean();
+      long[] dead = mx.findDeadlockedThreads();
+      System.out.println("FAIL the checker is stuck after " + limit / 1000 + " s" +
+                         (dead == null ? "" : " (" + dead.length + " threads deadlocked)") +
+                         "; every thread's stack is in check.err");
+      System.out.flush();
+      for (java.lang.management.ThreadInfo t : mx.dumpAllThreads(true, true)) System.err.print(t);
+      for (Map.Entry<Thread, StackTraceElement[]> e : Thread.getAllStackTraces().entrySet()) {
+        System.err.println("thread " + e.getKey().getName());
+        for (StackTraceElement s : e.getValue()) System.err.println("    at " + s);
+      }
+      System.err.flush();
+      Runtime.getRuntime().halt(3);
+    }, "watchdog");
+    w.setDaemon(true);
+    w.start();
   }
 
   // 1. Live, inside lcm-spy.
@@ -151,7 +183,9 @@ public final class SpyPluginCheck {
     }
     check(views.size() == LIVE.length, "lcm-spy opened a curve view (plugin) for each of " +
                                            Arrays.toString(LIVE) +
-                                           " on a double click (opened: " + views.keySet() + ")");
+                                           " on a double click (opened: " + views.keySet() +
+                                           (views.size() == LIVE.length ? "" : "; lcm-spy's rows: " + edt(() -> rows(table))) +
+                                           ")");
     check(done.exists(), "the run ended within 180 s");
     Thread.sleep(3 * CurveView.REFRESH_MS + 500); // the views' last look at lcm-spy's messages
     Map<String, List<Object>> log = readLog(logFile);
@@ -224,6 +258,12 @@ public final class SpyPluginCheck {
         return true;
       }
     return false;
+  }
+
+  static List<Object> rows(JTable table) {
+    List<Object> r = new ArrayList<>();
+    for (int row = 0; row < table.getRowCount(); ++row) r.add(table.getValueAt(row, 0));
+    return r;
   }
 
   static CurveView viewOf(String channel) {
