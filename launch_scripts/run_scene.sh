@@ -216,16 +216,25 @@ fi
 [[ $run_id =~ ^[1-9][0-9]*$ ]] || { echo "run_scene: --run-id must be a positive integer, not $run_id" >&2; exit 2; }
 
 start() { # name, then the command; waits for its "ready" line
-  local n=$1; shift
-  if ((${#resume_cut[@]})); then echo "---- resumed from cut ${resume_cut[1]}" >>"$out/$n.log"; else : >"$out/$n.log"; fi
+  # On resume the log goes on: only the lines after this start's own
+  # separator count (an earlier attempt's "ready" is not this process's),
+  # and a process that replays its part (the recorder its journal, which
+  # grows with the run) gets up to 10 minutes, with a word every 30 s.
+  local n=$1 limit=100 from=1; shift
+  if ((${#resume_cut[@]})); then
+    echo "---- resumed from cut ${resume_cut[1]}" >>"$out/$n.log"
+    from=$(wc -l <"$out/$n.log") limit=6000
+  else : >"$out/$n.log"; fi
   "$@" 2>>"$out/$n.log" &
   pids+=($!) names+=("$n")
-  for _ in $(seq 100); do
-    grep -q "ready" "$out/$n.log" 2>/dev/null && return 0
-    kill -0 "${pids[-1]}" 2>/dev/null || { echo "run_scene: $n died at start:" >&2; cat "$out/$n.log" >&2; exit 1; }
+  for ((i = 1; i <= limit; ++i)); do
+    tail -n +"$from" "$out/$n.log" 2>/dev/null | grep -q "ready" && return 0
+    kill -0 "${pids[-1]}" 2>/dev/null ||
+      { echo "run_scene: $n died at start:" >&2; tail -n +"$from" "$out/$n.log" >&2; exit 1; }
+    ((i % 300)) || echo "run_scene: $n is not ready after $((i / 10)) s (resuming: replaying its part)" >&2
     sleep 0.1
   done
-  echo "run_scene: $n did not get ready in 10 s" >&2; exit 1
+  echo "run_scene: $n did not get ready in $((limit / 10)) s" >&2; exit 1
 }
 
 echo "run_scene: ${scene:-resuming $resume} -> $out (bus $bus, $url, run $run_id, role $role)" >&2

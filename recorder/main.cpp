@@ -312,10 +312,12 @@ bool Session::start_cuts() {
     }
     std::remove(opt_.out.c_str()); // rebuilt from the journal
     replaying_ = true;
+    rec_.flush_each(false);
     const auto r = cuts_->resume(opt_.resume_cut, [&](const std::string &ch, const uint8_t *d, uint32_t n) {
       dispatch(ch, d, static_cast<int>(n));
     });
     replaying_ = false;
+    rec_.flush_each(true);
     if (!fatal_.empty()) return false;
     if (!rec_.has_run() || rec_.run_id() != r.run_id)
       throw dynhet::BadPart(r.part +
@@ -327,6 +329,7 @@ bool Session::start_cuts() {
     return true;
   } catch (const std::exception &e) {
     replaying_ = false;
+    rec_.flush_each(true);
     fatal_ = std::string("cannot resume: ") + e.what();
     return false;
   }

@@ -72,7 +72,7 @@ template <class F> void RunRecorder::guarded(const char *what, F &&write) {
                         std::to_string(kDiskReserve / (1024 * 1024)) + " MiB the recorder keeps to close the file");
   try {
     write();
-    writer_->flush();
+    if (flush_each_) writer_->flush();
   } catch (const std::exception &e) {
     const std::string why = e.what();
     if (++write_errors_ <= 10) std::fprintf(stderr, "recorder: %s: %s\n", what, why.substr(0, 400).c_str());
@@ -80,6 +80,11 @@ template <class F> void RunRecorder::guarded(const char *what, F &&write) {
     if (why.find("errno = 28") != std::string::npos || why.find("No space left") != std::string::npos)
       stop_writing("no space left on device (ENOSPC) writing " + std::string(what));
   }
+}
+
+void RunRecorder::flush_each(bool on) {
+  flush_each_ = on;
+  if (on && writer_) guarded("flush", [] {});
 }
 
 void RunRecorder::stop_writing(const std::string &why) {
