@@ -131,7 +131,9 @@ cuts="" cut_args=() resume_cut=()
 if [[ $role == all && -z $resume && $no_cuts == 0 ]]; then
   cuts=$out/checkpoints
   if ((fresh)); then
-    rm -rf "$cuts"/cut-* "$cuts"/recorder.journal "$out/run.h5" "$out/scene.toml"
+    rm -rf "$cuts"/cut-* "$cuts"/recorder.journal "$out/run.h5"
+    # (not the scene to run, when it is DIR's own: the study runner's)
+    [[ $(realpath "$scene") == $(realpath -m "$out/scene.toml") ]] || rm -f "$out/scene.toml"
   fi
   if [[ -f $out/scene.toml ]] && ! cmp -s "$scene" "$out/scene.toml"; then
     # The run in DIR was of another scene: name the keys that differ.

@@ -84,6 +84,17 @@ check 'grep -qE "was interrupted; resuming (mid-production from checkpoint cut [
   "run again: the interrupted run resumes from its last checkpoint cut (or, before any, from its state before the frames)"
 check 'grep -q "4 of 4 runs complete, 0 failed" "$tmp/b2.out"' "run again: 4 of 4 complete"
 /usr/bin/python3 "$root/tests/compare_studies.py" "$tmp/a" "$tmp/b" || fail=1
+# A run marked failed is run again from the start (run_scene.sh --fresh, its
+# old cuts and file gone), not resumed from a cut that would fail again,
+# and comes out as before, bit for bit.
+failed_run=$(ls -d "$tmp"/b/runs/*/ | head -1)
+sed -i 's/^state = .*/state = "failed"/' "$failed_run/status.toml"
+"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/b" --jobs 2 >"$tmp/b3.out" 2>&1 || { cat "$tmp/b3.out"; exit 1; }
+check 'grep -q "failed before .*running it again" "$tmp/b3.out" && grep -q "3 of 4 runs complete already" "$tmp/b3.out" &&
+  tail -n +"$(grep -n "^# " "$failed_run/run_scene.log" | tail -1 | cut -d: -f1)" "$failed_run/run_scene.log" | head -1 | grep -q -- "--fresh" &&
+  grep -q "4 of 4 runs complete, 0 failed" "$tmp/b3.out"' \
+  "a run marked failed is run again from the start (--fresh) and completes"
+/usr/bin/python3 "$root/tests/compare_studies.py" "$tmp/a" "$tmp/b" || fail=1
 
 # prepared_states = "equilibrated": every run starts from an equilibrated
 # state of its dynamics and ends bit for bit like the runs of study a.

@@ -69,8 +69,9 @@ def call_child(cmd, log, **kw):
             CHILDREN.discard(proc)
 
 
-def run_scene(scene_path, out, log_path, resume=None):
-    cmd = ["bash", RUN_SCENE, "--no-build", "--out", out]
+def run_scene(scene_path, out, log_path, resume=None, fresh=False):
+    """fresh: the run starts over (run_scene.sh --fresh), its old cuts and file discarded."""
+    cmd = ["bash", RUN_SCENE, "--no-build", "--out", out] + (["--fresh"] if fresh else [])
     cmd += ["--resume", resume] if resume else [scene_path]
     with open(log_path, "a") as log:
         log.write(f"\n# {time.strftime('%Y-%m-%d %H:%M:%S')} {' '.join(cmd)}\n")

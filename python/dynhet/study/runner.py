@@ -81,7 +81,12 @@ def do_run(sd, p, log=print):
         status["requeues"] = int(os.environ["SLURM_RESTART_COUNT"])
     scene_path = os.path.join(d, "scene.toml")
     cut0 = newest_whole_cut(d)
-    rc, wall, cpu = run_scene(scene_path, d, os.path.join(d, "run_scene.log"), None if resume == "cut" else resume)
+    # A run that failed (or was too short) starts over: resuming it from its
+    # last cut would repeat what failed (a recorder part that lost frames
+    # can never make the run complete).
+    again = old.get("state") in ("failed", "too_short", "unknown")
+    rc, wall, cpu = run_scene(scene_path, d, os.path.join(d, "run_scene.log"), None if resume == "cut" else resume,
+                              fresh=again and resume is None)
     # A process of the run died (exit 75: resumable): again from the last
     # whole cut, a few times, before the run counts as failed; twice in a row
     # without a new whole cut is no transient (a resume that fails the same
