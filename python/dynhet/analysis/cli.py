@@ -25,7 +25,7 @@ from .config import A_MAIN, CONVENTIONS, EPS_MAIN, say
 from .study import Analysis
 
 # What a section needs (a key of a run's cut), and the observable that gives it.
-NEEDS = {"chi4": "chi4", "s4_q": "s4", "cl_lag": "clusters"}
+NEEDS = {"chi4": "chi4", "s4_q": "s4", "cl_lag": "clusters", "D": "msd"}
 from .overlap import ageing_results, overlap_results, tau_results
 from .transport import d_results, pdx_results
 from .clusters import cluster_results
@@ -73,7 +73,8 @@ def main(argv=None):
             return None
         # A study that does not compute an observable (its scene's
         # observables.compute) has no result that needs it: said, not failed.
-        lacking = [k for k in needs if not any(k in r["cut"].get(A_MAIN, {}) for p in on.series() for r in p.runs)]
+        lacking = [k for k in needs
+                   if not any(k in r["cut"].get(A_MAIN, {}) or k in r for p in on.series() for r in p.runs)]
         if lacking:
             on.row(name, "—", "—", "not computed in this study (" + ", ".join(NEEDS[k] for k in lacking) + ")",
                    "not run", "", [])
@@ -87,8 +88,9 @@ def main(argv=None):
             A.row(name, "—", "—", f"analysis failed: {type(e).__name__}: {e}", "failed", "", [])
             return None
 
-    for name, fn in (("overlap", overlap_results), ("ageing", ageing_results), ("D", d_results), ("P(dx)", pdx_results)):
-        step(name, fn)
+    for name, fn, needs in (("overlap", overlap_results, ()), ("ageing", ageing_results, ()),
+                            ("D", d_results, ("D",)), ("P(dx)", pdx_results, ())):
+        step(name, fn, needs=needs)
     # The joint fit first: the critical fits are also given with its phi_c.
     joint = step("joint fit of tau_alpha, chi4, xi", joint_fit, needs=("chi4", "s4_q"))
     res = step("tau_alpha(phi)", tau_results, joint)
