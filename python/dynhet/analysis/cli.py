@@ -8,7 +8,10 @@ Reads STUDY_DIR/index.toml and every complete run's run.h5 and writes
   STUDY_DIR/figures/*.png    one figure per result of the paper (sec. 3)
   STUDY_DIR/reproduction.md  one row per result: the paper's number, ours
                              with its error, agreement, the CPU time behind it
-(--table FILE writes the table there as well, e.g. docs/reproduction.md).
+  STUDY_DIR/finite_size.md   every measure against N where a density was run
+                             at several N, with a verdict (converged or drifting)
+(--table FILE writes the table there as well, e.g. docs/reproduction.md;
+--finite-size FILE the finite-size report, its figures in finite_size/ beside it).
 """
 import argparse
 import math
@@ -36,6 +39,7 @@ from .cutoff import cutoff_results
 from .restitution import restitution_results
 from .appendix import appendix_results
 from .driving import driving_results, driving_rows
+from .finite_size import write_finite_size
 from .output import write_h5, write_table
 
 
@@ -47,6 +51,8 @@ def main(argv=None):
                                  epilog=DOC.split("\n\n", 1)[1])
     ap.add_argument("study_dir")
     ap.add_argument("--table", help="also write the reproduction table here (e.g. docs/reproduction.md)")
+    ap.add_argument("--finite-size", metavar="FILE",
+                    help="also write the finite-size report here (e.g. docs/finite_size.md)")
     ap.add_argument("--discussion", help="a Markdown file appended to the table (what we found about each disagreement)")
     ap.add_argument("--also", action="append", default=[], metavar="STUDY_DIR",
                     help="another study whose runs add points: tau_alpha against N where it ran other N, and the "
@@ -126,6 +132,15 @@ def main(argv=None):
     write_table(A, os.path.join(A.dir, "reproduction.md"), cmd, a.discussion, a.restate)
     if a.table:
         write_table(A, a.table, cmd, a.discussion, a.restate)
+    try:
+        densities = write_finite_size(A, os.path.join(A.dir, "finite_size.md"), cmd)
+        if a.finite_size:
+            write_finite_size(A, a.finite_size, cmd)
+        say(f"  finite size: {densities} densities run at several N")
+    except Exception:  # the report must not cost the table
+        import traceback
+        traceback.print_exc()
+        failed.append("finite-size report")
     differ = [r["item"] for r in A.rows if r["verdict"].startswith("differs")]
     say(f"analyse_study: {len(A.rows)} rows, {len(differ)} differ from the paper; {len(A.fits)} fits; "
         f"study.h5, reproduction.md and {(len(os.listdir(A.figdir)) if os.path.isdir(A.figdir) else 0)} figures in {A.dir} ({time.time() - t0:.1f} s)")

@@ -1,0 +1,216 @@
+"""The finite-size report (issue 27): every quantity against N at each
+density run at several N, standard and cage-relative side by side, with a
+verdict computed from the numbers: converged within errors from which N on,
+or still drifting (and by how much per doubling of N). Written by
+analyse_study.sh --finite-size PATH from the study and its --also studies."""
+import math
+import os
+import shutil
+
+import matplotlib.pyplot as plt
+import numpy as np
+
+from .config import A_MAIN
+from .plotting import colours
+from .points import point_error
+from .quantities import PER_RUN, XI_MIN, chi0_at_tau, kappa_of, whole_box_s4
+from .size import points_by_phi_n
+from .verdicts import fmt
+
+# chi4^P (the peak of chi4(t)) per sub-box size: a run's grid counts for a
+# size when its <N_r> is within a factor 1.6 of it and is not the whole box.
+SUBBOX_SIZES = (32, 128, 512, 2048, 8192, 32768)
+MIN_SHELLS = 5      # xi needs at least this many q shells below q xi = 1 (issue 27, item 4)
+Z_CONVERGED = 2.0   # values within 2 combined standard errors agree
+
+
+def cutx(r, cr):
+    return r["cut_cr" if cr else "cut"][A_MAIN]
+
+
+def chi4p_of(size):
+    """chi4^P of the grid with sub-boxes of about `size` particles; NaN where the
+    run has no such grid or its peak is not interior (a bound, not a peak)."""
+    def fn(r, cr=False):
+        c = cutx(r, cr)
+        ns = np.asarray(c["chi4_N"], float)
+        for g in np.argsort(np.abs(np.log(ns / size))):
+            if ns[g] >= 0.999 * r["N"] or not (size / 1.6 <= ns[g] <= size * 1.6):
+                continue
+            if not c["tau4_interior"][g]:
+                return math.nan, math.nan
+            return c["chi4_peak"][g], c["chi4_peak_err"][g]
+        return math.nan, math.nan
+    return fn
+
+
+def xi_shells(r, cr=False):
+    """(xi, error, shells): the whole box's OZ xi at tau_alpha and how many q
+    shells lie below q xi = 1; xi is NaN with fewer than MIN_SHELLS shells
+    (not resolved at this N) or below XI_MIN."""
+    c = cutx(r, cr)
+    t = c["tau_alpha"]
+    g = whole_box_s4(c)
+    off = int(np.sum(c["s4_nshells"][:g]))
+    q = np.asarray(c["s4_q"][off:off + int(c["s4_nshells"][g])])
+    xi = np.interp(math.log(t), np.log(c["s4_lag"]), c["xi_t"][:, g]) if np.isfinite(t) else math.nan
+    if not np.isfinite(xi):
+        return math.nan, math.nan, 0
+    shells = int(np.sum((q > 0) & (q * xi <= 1.0)))
+    rel = c["s4_oz_xi_err"][g] / c["s4_oz_xi"][g] if c["s4_oz_xi"][g] > 0 else math.nan
+    if shells < MIN_SHELLS or xi < XI_MIN:
+        return math.nan, math.nan, shells
+    return xi, abs(xi) * rel, shells
+
+
+def with_cr(fn):
+    """A per-run function of the standard results made to take cr=True."""
+    def f(r, cr=False):
+        if not cr:
+            return fn(r)
+        view = dict(r, cut=r["cut_cr"])
+        return fn(view)
+    return f
+
+
+def tau_of(r, cr=False):
+    c = cutx(r, cr)
+    return c["tau_alpha"], c["tau_alpha_err"]
+
+
+# (name, file name, per-run function (r, cr) -> (value, error), has a
+# cage-relative version, log axis)
+QUANTITIES = [("τ_α", "tau_alpha", tau_of, True, True),
+              ("τ_B (bond breaking)", "tau_b", lambda r, cr=False: PER_RUN["tau_b"](r), False, True)] + \
+    [(f"χ4^P, sub-boxes of {n}", f"chi4p_{n}", chi4p_of(n), True, True) for n in SUBBOX_SIZES] + \
+    [("χ0 of S4 (whole box, at τ_α)", "chi0", with_cr(chi0_at_tau), True, True),
+     ("ξ of S4 (whole box, at τ_α)", "xi", lambda r, cr=False: xi_shells(r, cr)[:2], True, True),
+     ("κ (slow clusters)", "kappa", with_cr(kappa_of), True, False),
+     ("d_f (slow clusters)", "d_f", lambda r, cr=False: (cutx(r, cr)["cl_slow_d_f"], cutx(r, cr)["cl_slow_d_f_err"]),
+      True, False)]
+
+
+def size_verdict(ns, vals, errs):
+    """Converged or drifting, from the numbers: the smallest N0 such that the
+    value at every N >= N0 agrees with the largest N's within Z_CONVERGED
+    combined errors (at least two sizes); otherwise the drift per doubling of N
+    between the two largest sizes. Returns (text, N0 or None, drift, error)."""
+    d = [(n, v, e) for n, v, e in zip(ns, vals, errs) if np.isfinite(v) and np.isfinite(e)]
+    if len(d) < 2:
+        return ("one N only" if d else "no data"), None, math.nan, math.nan
+    d.sort()
+    nmax, vmax, emax = d[-1]
+    n0 = None
+    for k in range(len(d) - 2, -1, -1):
+        n, v, e = d[k]
+        if abs(v - vmax) <= Z_CONVERGED * math.hypot(e, emax):
+            n0 = n
+        else:
+            break
+    if n0 is not None:
+        return f"converged from N = {n0} on (within {Z_CONVERGED:g}σ of N = {nmax})", n0, math.nan, math.nan
+    n1, v1, e1 = d[-2]
+    per = math.log2(nmax / n1)
+    drift, derr = (vmax - v1) / per, math.hypot(emax, e1) / per
+    rel = drift / abs(v1) if v1 else math.nan
+    return (f"drifting: {fmt(drift, derr)} per doubling of N ({100 * rel:+.0f}%) from N = {n1} to {nmax}",
+            None, drift, derr)
+
+
+def cell(m):
+    v, _, _, n = m
+    return "—" if not np.isfinite(v) else f"{fmt(v, point_error(m))}" + ("" if n > 1 else " ¹")
+
+
+def quantity_rows(d, fn, cr):
+    ns = sorted(d)
+    ms = [d[n].mean(lambda r: fn(r, cr)) for n in ns]
+    verdict = size_verdict(ns, [m[0] for m in ms], [point_error(m) if np.isfinite(m[0]) else math.nan for m in ms])
+    return ns, ms, verdict
+
+
+def has_cr(p):
+    return any(r.get("cut_cr") and A_MAIN in r["cut_cr"] for r in p.runs)
+
+
+def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi):
+    fig, ax = plt.subplots(figsize=(6, 4.3))
+    drawn = False
+    for (phi, d), col in zip(multi.items(), colours(len(multi))):
+        for cr in ((False, True) if has_cr_version else (False,)):
+            if cr and not any(has_cr(p) for p in d.values()):
+                continue
+            ns, ms, _ = quantity_rows(d, fn, cr)
+            x = [n for n, m in zip(ns, ms) if np.isfinite(m[0])]
+            if not x:
+                continue
+            y = [m[0] for m in ms if np.isfinite(m[0])]
+            e = [point_error(m) for m in ms if np.isfinite(m[0])]
+            ax.errorbar(x, y, e, fmt="s--" if cr else "o-", ms=4, color=col, mfc="none" if cr else col,
+                        label=f"φ = {phi:g}" + (" (cage-relative)" if cr else ""))
+            drawn = True
+    if not drawn:
+        plt.close(fig)
+        return ""
+    ax.set_xscale("log")
+    if log_y:
+        ax.set_yscale("log")
+    ax.set_xlabel("N")
+    ax.set_ylabel(name)
+    ax.set_title(f"{name} against N")
+    ax.legend(fontsize=7)
+    return A.save(fig, f"fs_{slug}.png")
+
+
+def write_finite_size(A, path, command):
+    """The report at `path`; its figures next to it in finite_size/ (copied
+    from the study's figures/)."""
+    multi = points_by_phi_n(A)
+    L = ["# Finite size: every measure against N", "",
+         "Generated by `launch_scripts/analyse_study.sh` (do not edit by hand) from the studies in "
+         + ", ".join(f"`{os.path.relpath(s, os.path.dirname(os.path.abspath(path)))}`" for s in [A.dir] + A.also)
+         + f". Command: `{command}`", "",
+         f"Each cell: the mean over seeds with its error (the runs' own errors, jackknife over origin blocks, "
+         f"combined; the seeds' spread where no run quotes one); ¹ one seed. A verdict is computed from the "
+         f"numbers: **converged** from the smallest N whose value and every larger N's agree with the largest "
+         f"N's within {Z_CONVERGED:g} combined errors; otherwise **drifting**, with the change per doubling of N "
+         f"between the two largest sizes. χ4^P is the peak of χ4(t) of sub-boxes of about that many particles "
+         f"(interior peaks only); ξ is the whole box's Ornstein-Zernike ξ at τ_α, taken only where at least "
+         f"{MIN_SHELLS} q shells lie below q ξ = 1 (else \"—\": not resolved at this N). a = {A_MAIN}, ε = 0.9, "
+         f"neighbour kick pairs. Nothing here is tuned toward the paper's numbers.", ""]
+    if not multi:
+        L += ["No density was run at more than one N.", ""]
+    figures = []
+    for phi, d in multi.items():
+        ns = sorted(d)
+        L += [f"## φ = {phi:g}", "",
+              "| quantity | " + " | ".join(f"N = {n}" for n in ns) + " | verdict |",
+              "|---|" + "---|" * len(ns) + "---|"]
+        for name, _, fn, has_cr_version, _ in QUANTITIES:
+            for cr in ((False, True) if has_cr_version else (False,)):
+                if cr and not any(has_cr(p) for p in d.values()):
+                    continue
+                qn, ms, (text, _, _, _) = quantity_rows(d, fn, cr)
+                if not any(np.isfinite(m[0]) for m in ms):
+                    continue
+                label = name + (" — cage-relative" if cr else "")
+                L.append(f"| {label} | " + " | ".join(cell(m) for m in ms) + f" | {text} |")
+        seeds = ", ".join(f"N {n}: {len(d[n].runs)}" for n in ns)
+        L += ["", f"Runs (seeds) per N: {seeds}.", ""]
+    if multi:
+        L += ["## Plots", ""]
+        for name, slug, fn, has_cr_version, log_y in QUANTITIES:
+            f = plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi)
+            if f:
+                figures.append(f)
+                L.append(f"- {name}: ![{name}](finite_size/{os.path.basename(f)})")
+        L.append("")
+    out_dir = os.path.dirname(os.path.abspath(path))
+    fig_dir = os.path.join(out_dir, "finite_size")
+    if figures:
+        os.makedirs(fig_dir, exist_ok=True)
+        for f in figures:
+            shutil.copy(os.path.join(A.dir, f), os.path.join(fig_dir, os.path.basename(f)))
+    with open(path, "w") as fh:
+        fh.write("\n".join(L))
+    return len(multi)

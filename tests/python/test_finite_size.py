@@ -1,0 +1,80 @@
+"""dynhet.analysis.finite_size: the verdicts computed from the numbers
+(converged from which N on, or the drift per doubling of N), xi only with
+enough q shells, and the report on synthetic points at three N."""
+import math
+
+import matplotlib
+import numpy as np
+
+matplotlib.use("Agg")
+
+from dynhet.analysis.finite_size import MIN_SHELLS, size_verdict, write_finite_size, xi_shells  # noqa: E402
+from dynhet.analysis.points import Point  # noqa: E402
+from dynhet.analysis.study import Analysis  # noqa: E402
+
+
+def test_converged_from_the_first_n_that_agrees_with_every_larger_one():
+    text, n0, _, _ = size_verdict([1024, 4096, 16384, 65536], [10.0, 12.0, 12.1, 12.05], [0.2, 0.2, 0.2, 0.2])
+    assert n0 == 4096 and text.startswith("converged from N = 4096")
+    # 1024 is 2.05 / 0.283 = 7 sigma off: not converged there
+    text, n0, _, _ = size_verdict([1024, 4096], [12.0, 12.5], [0.2, 0.2])
+    assert n0 == 1024   # 0.5 / 0.28 = 1.8 sigma: within 2
+
+
+def test_a_gap_below_the_largest_n_breaks_convergence():
+    # 4096 agrees with 65536, 16384 does not: converged only from ... nowhere
+    text, n0, drift, err = size_verdict([4096, 16384, 65536], [12.0, 13.0, 12.0], [0.1, 0.1, 0.1])
+    assert n0 is None and text.startswith("drifting")
+    assert math.isclose(drift, -1.0 / 2) and math.isclose(err, math.hypot(0.1, 0.1) / 2)
+
+
+def test_drift_per_doubling_between_the_two_largest_sizes():
+    text, n0, drift, err = size_verdict([1024, 4096, 16384], [48.0, 42.0, 27.0], [4.0, 3.0, 1.0])
+    assert n0 is None
+    assert math.isclose(drift, (27.0 - 42.0) / 2) and math.isclose(err, math.hypot(3.0, 1.0) / 2)
+    assert "per doubling of N" in text and "(-18%)" in text
+
+
+def test_one_or_no_size():
+    assert size_verdict([1024], [1.0], [0.1])[0] == "one N only"
+    assert size_verdict([1024, 4096], [math.nan, math.nan], [0.1, 0.1])[0] == "no data"
+
+
+def s4_cut(xi, L):
+    """A whole-box S4 group of a box of side L: shells at q = 2 pi k / L."""
+    q = 2 * math.pi / L * np.arange(0, 40)
+    return {"tau_alpha": 10.0, "s4_nshells": np.array([len(q)]), "s4_q": q, "s4_N": np.array([4096.0]),
+            "s4_lag": np.array([1.0, 10.0, 100.0]), "xi_t": np.full((3, 1), xi),
+            "s4_oz_xi": np.array([xi]), "s4_oz_xi_err": np.array([0.1 * xi])}
+
+
+def test_xi_needs_five_shells_below_q_xi_1():
+    L = 100.0
+    # shells below q xi = 1: k <= L / (2 pi xi); xi = 2: 7 shells, xi = 4: 3 shells
+    v, e, n = xi_shells({"cut": {0.6: s4_cut(2.0, L)}})
+    assert n == 7 >= MIN_SHELLS and math.isclose(v, 2.0) and math.isclose(e, 0.2)
+    v, e, n = xi_shells({"cut": {0.6: s4_cut(4.0, L)}})
+    assert n == 3 and math.isnan(v)
+
+
+def test_the_report_on_three_sizes(tmp_path):
+    A = Analysis.__new__(Analysis)
+    A.dir, A.figdir, A.also = str(tmp_path / "study"), str(tmp_path / "study" / "figures"), []
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    for n, t, tcr in ((1024, 48.0, 200.0), (4096, 42.0, 250.0), (16384, 27.0, 251.0)):
+        p = Point(("neighbours", 0.9, 0.79, n))
+        for seed, d in ((1, -1.0), (2, 1.0)):
+            p.runs.append({"seed": seed, "N": n,
+                           "cut": {0.6: {"tau_alpha": t + d, "tau_alpha_err": 1.0}},
+                           "cut_cr": {0.6: {"tau_alpha": tcr + d, "tau_alpha_err": 1.0}}})
+        A.points[p.pairs, p.eps, p.phi, p.N] = p
+    out = tmp_path / "docs" / "finite_size.md"
+    out.parent.mkdir()
+    assert write_finite_size(A, str(out), "analyse_study.sh study") == 1
+    text = out.read_text()
+    assert "## φ = 0.79" in text
+    row = next(l for l in text.splitlines() if l.startswith("| τ_α |"))
+    assert "48 ± 0.71" in row and "drifting: -7.5 ± 0.5 per doubling of N" in row
+    row = next(l for l in text.splitlines() if l.startswith("| τ_α — cage-relative |"))
+    assert "converged from N = 4096 on" in row
+    assert (tmp_path / "docs" / "finite_size" / "fs_tau_alpha.png").stat().st_size > 1000
