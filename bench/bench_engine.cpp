@@ -1,7 +1,8 @@
 // Engine benchmark: events per second and ns per collision against N and
 // phi, memory per particle, and the energy drift of elastic runs, as a
 // table. Usage: bench_engine [--n 10000,100000] [--phi 0.6,0.78] [--coll 50]
-//   [--eps 1.0] [--driven] [--pairs neighbours|any] [--reach 1] [--cache DIR] [--tile-from 10000]
+//   [--eps 1.0] [--driven] [--pairs neighbours|any] [--reach 1] [--kick-search list|cells] [--cache DIR]
+//   [--tile-from 10000]
 // With --tile-from B, a system of N = k^2 B particles starts from the
 // compressed B-particle state tiled k x k (velocities redrawn), instead of
 // compressing N particles from scratch (which takes hours at N = 10^6).
@@ -69,7 +70,7 @@ int main(int argc, char** argv) {
   double coll_per_particle = 50, eps = 1.0, sync = 50.0;
   bool driven = false, fingerprint = false;
   double skin = dynhet::engine::Params{}.skin;
-  std::string cache, pairs = "neighbours";
+  std::string cache, pairs = "neighbours", kick_search = "list";
   double reach = dynhet::engine::Params{}.kick_reach;
   long tile_from = 0;
   app.add_option("--n", ns, "particle numbers")->delimiter(',');
@@ -80,6 +81,10 @@ int main(int argc, char** argv) {
   app.add_option("--pairs", pairs, "kick pairs: neighbours (within --reach) or any two particles")
       ->check(CLI::IsMember({"neighbours", "any"}));
   app.add_option("--reach", reach, "largest surface gap of a neighbour kick pair, small radii");
+  app.add_option("--kick-search", kick_search,
+                 "neighbour pairs: the partner drawn from the kick list (list) or searched in the 3 x 3 cells "
+                 "(cells, the earlier engine's)")
+      ->check(CLI::IsMember({"list", "cells"}));
   app.add_option("--sync", sync, "time between synchronisations (memory re-sorting)");
   app.add_option("--cache", cache,
                  "keep compressed states here (HDF5 checkpoints) and start from them next time");
@@ -93,7 +98,8 @@ int main(int argc, char** argv) {
 
   std::printf("# dynhet engine, one core; eps=%g, %s; timed over %g collisions per particle, "
               "synchronised every %g; rates per CPU second\n", eps,
-              driven ? ("driven, kick pairs: " + (pairs == "any" ? pairs : pairs + " within " + std::to_string(reach)))
+              driven ? ("driven, kick pairs: " + (pairs == "any" ? pairs : pairs + " within " + std::to_string(reach) +
+                                                                   " (partner from the " + kick_search + ")"))
                            .c_str()
                      : "undriven",
               coll_per_particle, sync);
@@ -107,6 +113,7 @@ int main(int argc, char** argv) {
       p.skin = skin;
       p.kick_pairs = pairs == "any" ? dynhet::engine::KickPairs::any : dynhet::engine::KickPairs::neighbours;
       p.kick_reach = reach;
+      p.kick_search_cells = kick_search == "cells";
       dynhet::engine::Engine e(p);
       auto t0 = std::chrono::steady_clock::now();
       const std::string cached =

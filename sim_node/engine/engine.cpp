@@ -126,6 +126,12 @@ void Engine::reorder() {
 
 // ---------------------------------------------------------------- lists
 
+bool Engine::kick_near(int i, int j) const {
+  const double dx = min_image(centre_[i].x - centre_[j].x), dy = min_image(centre_[i].y - centre_[j].y);
+  const double reach = radius_[species_[i]] + radius_[species_[j]] + p_.kick_reach + skin_ + list_margin_;
+  return dx * dx + dy * dy <= reach * reach;
+}
+
 bool Engine::near(int i, int j) const {
   const double dx = min_image(centre_[i].x - centre_[j].x), dy = min_image(centre_[i].y - centre_[j].y);
   const double reach = list_scale_ * (radius_[species_[i]] + radius_[species_[j]]) + skin_ + list_margin_;
@@ -149,6 +155,8 @@ void Engine::wrap(int i) {
 }
 
 void Engine::build_lists() {
+  const bool kl = kick_lists();
+  kick_nbr_.reset(kl ? static_cast<size_t>(n_) : 0);
   for (long i = 0; i < n_; ++i) {
     wrap(static_cast<int>(i));
     centre_[i] = Centre{part_[i].x, part_[i].y};
@@ -162,7 +170,10 @@ void Engine::build_lists() {
     for (const int ci : around) {
       const int32_t* c = cells_.row(ci);
       for (int k = 1; k <= c[0]; ++k)
-        if (c[k] > i && near(i, c[k])) link(i, c[k]);
+        if (c[k] > i) {
+          if (near(i, c[k])) link(i, c[k]);
+          if (kl && kick_near(i, c[k])) link_kick(i, c[k]);
+        }
     }
   }
 }
@@ -185,6 +196,13 @@ void Engine::rebuild(int i) {
     for (int k = 1; k <= l[0]; ++k) nbr_.remove(l[k], i);
   }
   nbr_.clear(i);
+  const bool kl = kick_lists();
+  if (kl) {
+    const int32_t* l = kick_nbr_.row(i);
+    for (int k = 1; k <= l[0]; ++k) kick_nbr_.prefetch(l[k]);
+    for (int k = 1; k <= l[0]; ++k) kick_nbr_.remove(l[k], i);
+    kick_nbr_.clear(i);
+  }
   centre_[i] = Centre{part_[i].x, part_[i].y};
   if (cx != cell_x_[i] || cy != cell_y_[i]) {
     cell_remove(i);
@@ -205,6 +223,7 @@ void Engine::rebuild(int i) {
   for (int k = 0; k < nc; ++k) {
     const int j = cand[k];
     if (j != i && near(i, j)) link(i, j);
+    if (kl && j != i && kick_near(i, j)) link_kick(i, j);
   }
   ++count_.rebuilds;
   predict(i);
@@ -386,7 +405,12 @@ uint64_t Engine::kick_hash(int64_t k, int draw, int which) const {
 
 int Engine::kick_pair(int64_t k, int& i, int& j) const {
   const auto hash = [&](int d, int which) { return kick_hash(k, d, which); };
-  if (neighbour_kicks_) {
+  if (neighbour_kicks_ && kick_lists()) {
+    for (int d = 0; d < kMaxKickDraws; ++d) {
+      i = below(hash(d, 0), static_cast<uint64_t>(n_));
+      if ((j = kick_partner(k, d, i)) >= 0) return d;
+    }
+  } else if (neighbour_kicks_) {
     int32_t cand[kMaxKickCandidates];
     for (int d = 0; d < kMaxKickDraws; ++d) {
       i = below(hash(d, 0), static_cast<uint64_t>(n_));
@@ -427,6 +451,39 @@ int Engine::kick_candidates(int i, int32_t* out) const {
     }
   }
   return m;
+}
+
+bool Engine::within_kick_reach(int i, int j) const {
+  const Particle &a = part_[i], &b = part_[j];
+  const double dx = min_image((a.x + a.vx * (now_ - a.t)) - (b.x + b.vx * (now_ - b.t)));
+  const double dy = min_image((a.y + a.vy * (now_ - a.t)) - (b.y + b.vy * (now_ - b.t)));
+  const double reach = radius_[a.species] + p_.kick_reach + radius_[species_[j]];
+  return dx * dx + dy * dy <= reach * reach;
+}
+
+// The second particle of draw d of kick k, first particle i: members of
+// i's kick list drawn uniformly (hashes of k, d and the trial) until one is
+// within reach: uniform over those within reach. After kKickTrials in vain
+// (few or none within reach) the row is searched whole and one of those
+// within reach taken uniformly (the same distribution), or -1 if none.
+int Engine::kick_partner(int64_t k, int d, int i) const {
+  const int32_t* l = kick_nbr_.row(static_cast<size_t>(i));
+  const int m = l[0];
+  if (m == 0) return -1;
+  const uint64_t h = kick_hash(k, d, 1);
+  for (int t = 0; t < kKickTrials; ++t) {
+    const int j = l[1 + below(t == 0 ? h : mix64(h + 0x9e3779b97f4a7c15ULL * static_cast<uint64_t>(t)),
+                              static_cast<uint64_t>(m))];
+    if (within_kick_reach(i, j)) return j;
+  }
+  int32_t cand[kMaxKickCandidates];
+  int c = 0;
+  for (int q = 1; q <= m; ++q)
+    if (within_kick_reach(i, l[q])) {
+      if (c == kMaxKickCandidates) throw std::logic_error("engine: more than 512 particles within kick reach");
+      cand[c++] = l[q];
+    }
+  return c ? cand[below(mix64(h ^ 0x5f6c6973745f6b21ULL), static_cast<uint64_t>(c))] : -1;
 }
 
 Engine::KickPair Engine::next_kick_pair() const {
@@ -470,15 +527,28 @@ void Engine::kick() {
   kick_time_ = now_ + rng_.exponential(kick_pair_rate_);
   predict(i);
   predict(j);
-  // The next pair's lines (with neighbour pairs, the first particle's and
-  // its cell's: its partner depends on where things are then; requesting
-  // the lines of the search itself a kick or two ahead, in stages, gained
-  // nothing measurable).
+  // The next pair's lines. With neighbour pairs from kick lists, in stages
+  // (below); with the cell search, the first particle's and its cell's: its
+  // partner depends on where things are then (requesting the search's own
+  // lines a kick or two ahead gained nothing measurable there).
   if (neighbour_kicks_) {
     const int ni = below(kick_hash(count_.kicks, 0, 0), static_cast<uint64_t>(n_));
-    __builtin_prefetch(&part_[ni]);
-    __builtin_prefetch(&cell_x_[ni]);
-    __builtin_prefetch(&cell_y_[ni]);
+    if (kick_lists()) {
+      // In stages: the row of the next kick's first particle was requested
+      // a kick ago, so its first draw's particle (line, list and centre)
+      // can be requested now, with the first particle's; the row of the
+      // kick after it now.
+      prefetch_particle(ni);
+      const int32_t* l = kick_nbr_.row(ni);
+      if (l[0] > 0) prefetch_particle(l[1 + below(kick_hash(count_.kicks, 0, 1), static_cast<uint64_t>(l[0]))]);
+      const int nn = below(kick_hash(count_.kicks + 1, 0, 0), static_cast<uint64_t>(n_));
+      __builtin_prefetch(&part_[nn]);
+      kick_nbr_.prefetch(nn);
+    } else {
+      __builtin_prefetch(&part_[ni]);
+      __builtin_prefetch(&cell_x_[ni]);
+      __builtin_prefetch(&cell_y_[ni]);
+    }
   } else {
     int ni, nj;
     kick_pair(count_.kicks, ni, nj);
@@ -855,7 +925,7 @@ double Engine::mean_neighbours() const {
 size_t Engine::memory_bytes() const {
   auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return b(part_) + b(species_by_id_) + b(species_) + b(id_) + b(image_x_) + b(image_y_) + b(last_collision_) +
-         cells_.bytes() + b(cell_x_) + b(cell_y_) + nbr_.bytes() + b(centre_) + cal_.bytes();
+         cells_.bytes() + b(cell_x_) + b(cell_y_) + nbr_.bytes() + kick_nbr_.bytes() + b(centre_) + cal_.bytes();
 }
 
 double Engine::max_overlap() const { return 1.0 - min_gap_ratio(); }

@@ -64,6 +64,12 @@ struct Params {
   // the unit of length); 0 picks auto_skin(packing_fraction). Only speed
   // depends on it (bench_engine --skin).
   double skin = 0;
+  // Neighbour kick pairs: the second particle drawn from the first's kick
+  // list (false, the default: rejection from a superset, docs/engine.md) or
+  // by a search of the 3 x 3 cells around it (true: the earlier engine's,
+  // kept as the reference the tests and bench_engine --kick-search compare
+  // with). Both are uniform over the same partners; the trajectories differ.
+  bool kick_search_cells = false;
 };
 
 // Fastest skin at N = 10^5 (bench_engine --skin, docs/engine.md), in small
@@ -278,6 +284,18 @@ private:
   // kMaxKickCandidates); returns their number.
   static constexpr int kMaxKickCandidates = 512;
   int kick_candidates(int i, int32_t* out) const;
+  // Kick lists (neighbour pairs, in the run): row i holds every slot whose
+  // list centre is within r_i + r_j + kick_reach + skin of i's, so that it
+  // holds everyone within kick reach of i now (centres are within skin / 2
+  // of their particles), about twice as many. The second particle is drawn
+  // from it and kept if within reach (rejection: uniform over those within
+  // reach); after kKickTrials draws in vain the row is searched whole.
+  static constexpr int kKickTrials = 8;
+  bool kick_lists() const { return neighbour_kicks_ && driving_ && !p_.kick_search_cells; }
+  bool kick_near(int i, int j) const;
+  bool within_kick_reach(int i, int j) const; // now, by the particles' positions
+  int kick_partner(int64_t k, int draw, int i) const; // -1: nobody within reach
+  void link_kick(int i, int j) { kick_nbr_.push(i, j), kick_nbr_.push(j, i); }
   void prefetch_list(int i) const;     // i's neighbour list and list centre
   void prefetch_particle(int i) const; // its line, list and centre
   void rebase();
@@ -342,6 +360,7 @@ private:
 
   // Neighbour lists: row i holds the slots of i's neighbours.
   Rows nbr_;
+  Rows kick_nbr_; // kick lists (kick_lists())
   struct Centre {
     double x, y;
   };
