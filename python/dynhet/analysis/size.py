@@ -47,23 +47,28 @@ def d_n_results(A):
         cells.append(f"φ {phi:g}: " + ", ".join(f"{fmt(v[0], point_error(v))} (N {n})" for n, v in zip(ns, vals)))
         used += list(d.values())
     log_axes(ax[0], "N", "D", "D against the number of particles")
-    # theta at each N from the densities that N has
+    # theta at each N over the same densities at every N (like with like: the
+    # densities of the largest N with at least 3 of them; theta' of the
+    # highest densities differs from theta), at each N that has them all
     per_n = {}
     for d in multi.values():
         for n, p in d.items():
-            per_n.setdefault(n, []).append(p)
-    th = {}
-    for n, pts in sorted(per_n.items()):
-        if len(pts) >= 3:
-            f = A.fit(f"D_tau_N{n}", fit_series(sorted(pts, key=lambda p: p.phi), dD, sf.power, xrun=tau))
-            if f.ok:
-                th[n] = (-f.p["s"], f.error("s"), len(pts))
+            per_n.setdefault(n, {})[p.phi] = p
+    th, common = {}, []
+    wide = [n for n, ps in per_n.items() if len(ps) >= 3]
+    if wide:
+        common = sorted(per_n[max(wide)])
+        for n, ps in sorted(per_n.items()):
+            if all(phi in ps for phi in common):
+                f = A.fit(f"D_tau_N{n}", fit_series([ps[phi] for phi in common], dD, sf.power, xrun=tau))
+                if f.ok:
+                    th[n] = (-f.p["s"], f.error("s"), len(common))
     if th:
         ns = sorted(th)
         ax[1].errorbar(ns, [th[n][0] for n in ns], [th[n][1] for n in ns], fmt="o-", color="k")
     ax[1].set_xscale("log")
     ax[1].set_xlabel("N")
-    ax[1].set_ylabel("θ (D ∝ τ_α^-θ over the densities run)")
+    ax[1].set_ylabel("θ (D ∝ τ_α^-θ, φ = " + ", ".join(f"{x:g}" for x in common) + ")")
     ax[1].set_title("θ against N")
     f = A.save(fig, "D_N.png")
     A.row("D against N (box-scale flows)", "3.2 (D, θ)", "not studied", "; ".join(cells), "figure", f, used)
@@ -72,7 +77,8 @@ def d_n_results(A):
         lo, hi = th[ns[0]], th[ns[-1]]
         z = abs(hi[0] - lo[0]) / math.hypot(lo[1], hi[1]) if np.isfinite(math.hypot(lo[1], hi[1])) else math.nan
         A.row("θ against N (D ∝ τ_α^-θ at each N)", "3.2, fig. D-vs-tau", "not studied",
-              ", ".join(f"N {n}: {fmt(th[n][0], th[n][1])} ({th[n][2]} φ)" for n in ns),
+              ", ".join(f"N {n}: {fmt(th[n][0], th[n][1])}" for n in ns)
+              + " (each over φ = " + ", ".join(f"{x:g}" for x in common) + ")",
               ("moves with N" if z > 2 else "no change with N resolved") + f" ({z:.1f} σ from N {ns[0]} to {ns[-1]})"
               if np.isfinite(z) else "not determined", f, used)
 
