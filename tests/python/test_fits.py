@@ -53,3 +53,17 @@ def test_jackknife_over_identical_seeds_has_no_spread():
     x = np.geomspace(1, 50, 8)
     f = sf.jackknife_over_seeds(lambda drop: sf.power(x, 2 * x, 0.1 * x), [1, 2, 3])
     assert f.jk["s"] < 1e-12 and f.jk["A"] < 1e-12  # zero but for rounding
+
+
+def test_no_verdict_from_a_fit_whose_error_exceeds_its_value():
+    from dynhet.analysis.verdicts import fit_verdict
+    rng = np.random.default_rng(3)
+    x = np.geomspace(2, 2.1, 6)                                # a narrow range: the slope undetermined
+    y = 0.5 * x ** 1.6 * (1 + 0.1 * rng.standard_normal(6))
+    f = sf.power(x, y, 0.1 * 0.5 * x ** 1.6)
+    assert f.error("s") > abs(f.p["s"])
+    assert fit_verdict(f, "s", 1.6) == "not judged: its error exceeds its value (the points do not determine it)"
+    x = np.geomspace(2, 20, 6)
+    y = 0.5 * x ** 1.6 * (1 + 0.01 * rng.standard_normal(6))
+    f = sf.power(x, y, 0.01 * y)
+    assert fit_verdict(f, "s", 1.6).startswith("agrees")

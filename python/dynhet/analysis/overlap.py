@@ -124,7 +124,11 @@ def tau_results(A, joint=None):
     A.row("τ_α(φ) power law over the narrower range φ ≥ 0.74: φ_c", "3.1, fig. taueps09", "0.82",
           fmt(fn.p["xc"], fn.error("xc"), 4) + f", γ {fmt(fn.p['g'], fn.error('g'))}, χ²/dof {fn.chi2_dof():.2g}",
           fit_verdict(fn, "xc", 0.82), f, [p for p in pts if p.phi >= 0.74], fn.note)
+    # Which of two forms fits better says nothing when neither describes
+    # the points (both chi2 improbable): not judged, with the reason.
+    neither = fp.ok and fv.ok and sf.cannot_judge(fp) and sf.cannot_judge(fv)
     A.row("τ_α(φ): which form fits better (smaller χ² over the same points)", "3.1", "VFT", better(fp, fv),
+          "not judged: neither form describes the points (both χ² improbable)" if neither else
           ("agrees" if "VFT (" in better(fp, fv) else "differs") if fp.ok and fv.ok else "not determined", f, pts)
     return fp, fv
 

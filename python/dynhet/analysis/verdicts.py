@@ -37,7 +37,12 @@ def fit_verdict(f, name, paper, transform=lambda v: v):
     why = sf.cannot_judge(f, singular)
     if why:
         return f"not judged: {why}"
-    return verdict(transform(f.p[name]), f.error(name), paper)
+    if f.dof <= 0:
+        return f"not judged: {f.n} points for {f.n - f.dof} parameters (no degree of freedom left to test the form)"
+    v, e = transform(f.p[name]), f.error(name)
+    if np.isfinite(e) and np.isfinite(v) and e > abs(v):
+        return f"not judged: its error exceeds its value (the points do not determine it)"
+    return verdict(v, e, paper)
 
 
 def fixed_xc_row(A, key, item, sec, paper, fn, pts, joint, fig):
