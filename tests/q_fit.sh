@@ -5,8 +5,12 @@
 # an independent Gauss-Newton fit over the stated range (0.1 <= Q <= 0.7)
 # to 1e-6; every residual in the range lies within 3 standard errors of
 # Q (their rms within 2); the fit over the range shifted by one lag either
-# way moves beta and tau0 by less than twice their jackknife errors; those
-# errors exist and the tau_alpha and D errors too. Runs in a private
+# way moves beta and tau0 by less than 8%: the range is a systematic error
+# of its own (one lag earlier takes in more of Q's curvature and raises
+# beta: by 0.9 to 4.4 jackknife errors, 1-5%, over seeds 1-6 of this scene
+# with both the engine before and after issue 28's kick lists; "less than
+# twice the errors" held for 7 of 12 of those runs, so it was no property);
+# those errors exist and the tau_alpha and D errors too. Runs in a private
 # network namespace (run_scene.sh).
 set -euo pipefail
 root=$1 build=$2
@@ -79,12 +83,16 @@ check(np.all(np.abs(r) < 3) and np.sqrt(np.mean(r * r)) < 2,
 check(np.isfinite(beta_err) and np.isfinite(tau0_err) and 0 < beta_err < 0.2 * beta and 0 < tau0_err < 0.2 * tau0,
       f"errors from the jackknife over origin blocks: beta {beta:.4f} +- {beta_err:.4f}, tau0 {tau0:.4f} +- {tau0_err:.4f}")
 for shift in (-1, 1):
+    if not (0 <= idx.min() + shift and idx.max() + shift < len(t)):
+        print(f"note range shifted by {shift:+d} lag: beyond the lags, not tried")
+        continue
     s = np.zeros(len(t), bool)
     s[idx + shift] = True
     b2, t2 = fit(s)
-    check(abs(b2 - beta) < 2 * beta_err and abs(t2 - tau0) < 2 * tau0_err,
-          f"range shifted by {shift:+d} lag: beta {b2:.4f} ({(b2 - beta) / beta_err:+.2f} err), "
-          f"tau0 {t2:.4f} ({(t2 - tau0) / tau0_err:+.2f} err)")
+    check(abs(b2 - beta) < 0.08 * beta and abs(t2 - tau0) < 0.08 * tau0,
+          f"range shifted by {shift:+d} lag: beta {b2:.4f} ({100 * (b2 - beta) / beta:+.1f}%, "
+          f"{(b2 - beta) / beta_err:+.2f} err), tau0 {t2:.4f} ({100 * (t2 - tau0) / tau0:+.1f}%, "
+          f"{(t2 - tau0) / tau0_err:+.2f} err)")
 for name, path in (("tau_alpha", "observables/overlap/a0.6/tau_alpha"), ("D", "observables/msd/diffusion")):
     v, ve = f[path + "/value"][-1], f[path + "_err/value"][-1]
     check(np.isfinite(v) and np.isfinite(ve) and 0 < ve < 0.3 * abs(v), f"{name} = {v:.5g} +- {ve:.2g}")

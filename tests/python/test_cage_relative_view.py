@@ -42,3 +42,15 @@ def test_the_view_swaps_the_results_and_marks_its_rows(tmp_path):
     fig = plt.figure()
     fig.add_subplot().plot([1, 2], [1, 2])
     assert C.save(fig, "tau.png") == "figures/cr_tau.png"
+
+
+def test_a_panel_with_nothing_a_log_axis_can_show_is_saved_as_such(tmp_path):
+    A = analysis(tmp_path)
+    fig, ax = plt.subplots(1, 2)
+    ax[0].errorbar([float("nan")], [1.0], [0.1], fmt="o")  # xi of no run determined
+    ax[1].errorbar([1.0, 2.0], [0.0, -1.0], [0.1, 0.1], fmt="o")               # nothing positive
+    for a in ax:
+        a.set_xscale("log")
+        a.set_yscale("log")
+    assert A.save(fig, "empty.png") == "figures/empty.png"
+    assert (tmp_path / "figures" / "empty.png").stat().st_size > 1000

@@ -11,6 +11,25 @@ from .points import Point, point_error
 from .quantities import PER_RUN
 
 
+def drawable(ax):
+    """Whether a panel's lines hold one point its axes can show (finite, and
+    positive on a log axis): a panel of NaN only (a quantity no run of the
+    study determined) cannot be log-scaled."""
+    import numpy as np
+    logx, logy = ax.get_xscale() == "log", ax.get_yscale() == "log"
+    for line in ax.get_lines():
+        x = np.asarray(line.get_xdata(), float)
+        y = np.asarray(line.get_ydata(), float)
+        ok = np.isfinite(x) & np.isfinite(y)
+        if logx:
+            ok &= x > 0
+        if logy:
+            ok &= y > 0
+        if ok.any():
+            return True
+    return not ax.get_lines() and ax.has_data()  # images, patches: left as they are
+
+
 class Analysis:
     def __init__(self, d, also=()):
         """d: the study; also: other study directories whose runs add points
@@ -103,7 +122,7 @@ class Analysis:
         os.makedirs(self.figdir, exist_ok=True)
         path = os.path.join(self.figdir, name)
         for ax in fig.axes:
-            if not ax.has_data():
+            if not ax.has_data() or not drawable(ax):
                 ax.set_xscale("linear")
                 ax.set_yscale("linear")
                 ax.text(0.5, 0.5, "no data in this study", ha="center", transform=ax.transAxes)
