@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numeric>
 #include <stdexcept>
@@ -93,19 +94,54 @@ Neighbours voronoi_neighbours(const double* pos, long n, double box) {
 }
 
 namespace {
-// out_i = from_i - (mean dr_j over i's neighbours; 0 without any): from =
-// dr gives dr^CR, from = the positions at t gives pos0 + dr^CR.
+// out_i = from_i - (mean dr_j of i's neighbours; 0 without any): from = dr
+// gives dr^CR, from = the positions at t gives pos0 + dr^CR.
+//
+// (x, y) travel as one two-lane vector (GCC's vector extension: the same
+// IEEE operation in each lane, so the same bits as two scalar sums). A row
+// of up to kRow neighbours is summed over exactly kRow slots, the slots past
+// its end multiplied by 0: no loop exit that depends on the row's length,
+// which a Voronoi row (4 to 9 long) makes unpredictable. The sums are those
+// of the plain loop bit for bit: d * 1.0 == d, d * 0.0 == +-0.0, and
+// s + +-0.0 == s for any s the sum can hold (it starts at +0.0 and is never
+// -0.0). The masked slots read the next row's indices, valid particles.
+// bench_analysis --sections cage: 1.05 -> 0.8 ms per (origin, lag) at N = 1e5.
+using Pair = double __attribute__((vector_size(16)));
+constexpr long kRow = 8;
+
+struct RowMasks {
+  Pair m[kRow + 1][kRow];
+  RowMasks() {
+    for (long c = 0; c <= kRow; ++c)
+      for (long k = 0; k < kRow; ++k) m[c][k] = k < c ? Pair{1.0, 1.0} : Pair{0.0, 0.0};
+  }
+};
+const RowMasks kMasks;
+
+Pair load(const double* p) {
+  Pair v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+
 void less_cage_mean(const double* dr, const Neighbours& v, const double* from, double* out) {
   const long n = v.size();
+  const std::int64_t* offset = v.offset.data();
+  const std::int32_t* list = v.list.data();
+  const auto listed = static_cast<std::int64_t>(v.list.size());
   for (long i = 0; i < n; ++i) {
-    const long c = v.count(i);
-    double mx = 0, my = 0;
-    for (std::int64_t k = v.offset[i]; k < v.offset[i + 1]; ++k) {
-      const std::int32_t j = v.list[k];
-      mx += dr[2 * j], my += dr[2 * j + 1];
+    const std::int64_t o = offset[i];
+    const long c = static_cast<long>(offset[i + 1] - o);
+    Pair s{0.0, 0.0};
+    if (c <= kRow && o + kRow <= listed) {
+      const Pair* mask = kMasks.m[c];
+      for (long k = 0; k < kRow; ++k) s += load(dr + 2 * std::int64_t{list[o + k]}) * mask[k];
+    } else {
+      for (long k = 0; k < c; ++k) s += load(dr + 2 * std::int64_t{list[o + k]});
     }
-    out[2 * i] = from[2 * i] - (c > 0 ? mx / c : 0.0);
-    out[2 * i + 1] = from[2 * i + 1] - (c > 0 ? my / c : 0.0);
+    const double cd = c > 0 ? double(c) : 1.0; // no neighbour: s is 0, out = from
+    const Pair r = load(from + 2 * i) - s / Pair{cd, cd};
+    std::memcpy(out + 2 * i, &r, sizeof r);
   }
 }
 } // namespace
