@@ -272,7 +272,7 @@ private:
       m.lag_lo = b.ok() ? b.lo : -1, m.lag_hi = b.ok() ? b.hi : -1, m.lag_weight = b.ok() ? b.w : kNaN;
       m.lag_third = -1; // no interpolation error from a third lag (interpolate, below)
       fill_at_lag(c, m.lag_index, b, m);
-      out().publish(dynhet::cutoff_channel(dynhet::kChanClusters, m.cutoff_a, m.cage_relative), &m);
+      publish(dynhet::cutoff_channel(dynhet::kChanClusters, m.cutoff_a, m.cage_relative), m);
       if (final)
         std::fprintf(stderr,
                      "clusters_node%s: a=%g tau_alpha=%.4g lag %.4g (%s): slow <N_c>=%.4g d_f=%.3g kappa=%.3g; "

@@ -97,6 +97,13 @@ void FrameNode::input_ended() {
 }
 
 void FrameNode::reject(const std::string& channel, const std::string& why) {
+  if (unauthenticated_reason(why)) { // the bus's: counted apart, never used
+    ++status_.messages_unauthenticated;
+    if (status_.messages_unauthenticated <= 10 || status_.messages_unauthenticated % 1000 == 0)
+      std::fprintf(stderr, "%s_node: dropped a message on %s (%s; %d so far)\n", name_.c_str(), channel.c_str(),
+                   why.c_str(), status_.messages_unauthenticated);
+    return;
+  }
   ++status_.messages_rejected;
   status_.last_rejection = channel + ": " + why;
   if (status_.messages_rejected <= 10 || status_.messages_rejected % 1000 == 0)
@@ -110,7 +117,9 @@ template <class Msg, class Fn>
 static void guarded(FrameNode& node, const lcm::ReceiveBuffer* rb, const std::string& ch, Fn&& fn) {
   Msg m;
   std::string why;
-  if (!guard::safe_decode(rb->data, static_cast<int>(rb->data_size), m, why)) return node.reject(ch, why);
+  int size = 0;
+  if (!node.bus().open(ch, rb->data, rb->data_size, size, why)) return node.reject(ch, why);
+  if (!guard::safe_decode(rb->data, size, m, why)) return node.reject(ch, why);
   try {
     fn(m);
   } catch (const std::exception& e) {
@@ -293,7 +302,7 @@ void FrameNode::publish_status() {
   status_.chunks_received = assembler_.chunks_received();
   status_.pairs_done = pairs_done_;
   status_.origins_held = static_cast<int32_t>(origins_.size());
-  out_.publish(node_status_channel(name_), &status_);
+  publish(node_status_channel(name_), status_);
   last_status_ = Clock::now();
 }
 
@@ -409,6 +418,13 @@ int node_main(const std::string& program, const std::string& description, NodeFa
   app.add_option("--lcm-url", url, "LCM URL to read from (file://LOG?speed=0 replays a log)");
   app.add_option("--publish-url", publish_url, "LCM URL to publish on (default: the input bus)");
   app.add_option("--run-id", run_id, "only this run (default: the first one seen)");
+  std::string key_file;
+  bool unauthenticated = false;
+  app.add_option("--key-file", key_file,
+                 "the run's key (32 bytes, mode 0600; run_scene.sh writes DIR/bus.key): every message received is "
+                 "checked with it before it is decoded, every message published is tagged (docs/bus.md); default $DYNHET_KEY_FILE")
+      ->envname("DYNHET_KEY_FILE");
+  app.add_flag("--unauthenticated", unauthenticated, "no key: an open bus, on purpose (tests, tools)");
   app.add_option("--wait-run", wait_run, "give up after this many seconds without run info");
   app.add_option("--sim-timeout", sim_timeout, "give up if the sim is silent this long (s) during a run");
   int64_t max_queue_mib = 1024;
@@ -432,6 +448,13 @@ int node_main(const std::string& program, const std::string& description, NodeFa
     return 2;
   }
 
+  std::optional<Bus> bus;
+  try {
+    bus.emplace(Bus::from_options(program, key_file, unauthenticated));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  }
   const std::string in_url = resolve_lcm_url(url);
   const bool replay = in_url.rfind("file://", 0) == 0;
   lcm::LCM in(in_url);
@@ -445,6 +468,7 @@ int node_main(const std::string& program, const std::string& description, NodeFa
   }
 
   std::unique_ptr<FrameNode> node = make_node(out, run_id);
+  node->set_bus(*bus);
   Inbox inbox(max_queue_mib << 20);
   inbox.set_bound(kQueueMin); // until the run info sizes it (frames come only after it)
   node->attach_inbox(&inbox);
@@ -456,7 +480,7 @@ int node_main(const std::string& program, const std::string& description, NodeFa
   }
   Receiver receiver(in, inbox, replay); // stopped and joined before inbox, node and buses go
 
-  std::fprintf(stderr, "%s: ready, reading %s\n", program.c_str(), in_url.c_str());
+  std::fprintf(stderr, "%s: ready, reading %s (bus %s)\n", program.c_str(), in_url.c_str(), bus->describe());
   const auto start = FrameNode::Clock::now();
   int code = -1;
   while (code < 0 && !node->finished()) {

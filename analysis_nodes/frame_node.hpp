@@ -28,6 +28,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "dynhet/bus.hpp"
 #include "dynhet/checkpoint_t.hpp"
 #include "dynhet/chunking.hpp"
 #include "dynhet/frame_chunk_t.hpp"
@@ -58,6 +59,9 @@ public:
   virtual ~FrameNode() = default;
 
   bool finished() const { return finished_; }
+  // The bus's side of this node: its key (or none, --unauthenticated).
+  void set_bus(Bus bus) { bus_ = std::move(bus); }
+  const Bus& bus() const { return bus_; }
   bool has_run() const { return info_ != nullptr; }
   int exit_code() const { return exit_code_; }
   // The sim publishes its status every second; silence longer than
@@ -138,7 +142,8 @@ protected:
   const std::map<int, std::vector<double>>& held_origins() const { return origins_; }
   // Whether the run's scene asks for `observable`.
   bool wants(const std::string& observable) const;
-  lcm::LCM& out() { return out_; }
+  // Publishes m on the output bus, tagged with the run's key (bus.hpp).
+  template <class M> int publish(const std::string& channel, const M& m) { return bus_.publish(out_, channel, m); }
   int pairs_done() const { return pairs_done_; }
   const std::string& name() const { return name_; }
 
@@ -179,7 +184,7 @@ private:
   std::string sim_stopped_why() const;
   template <class Ar> void base_state(Ar& ar) {
     ar(origins_, last_frame_, last_time_, pairs_done_, assembler_, status_.messages_rejected, status_.chunks_rejected,
-       status_.last_rejection);
+       status_.last_rejection, status_.messages_unauthenticated);
   }
   std::string cut_dir_;
   int resume_cut_ = -1, signal_ = 0;
@@ -191,6 +196,7 @@ private:
   double saved_seconds_ = 0;
 
   lcm::LCM& out_;
+  Bus bus_ = Bus::open_bus();
   int64_t run_filter_;
   std::string name_;
   std::unique_ptr<run_info_t> info_;

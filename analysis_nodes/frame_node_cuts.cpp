@@ -97,7 +97,7 @@ void FrameNode::answer_cut(int cut, int frame, const std::string& state, int64_t
   a.bytes = bytes;
   a.write_seconds = seconds;
   a.message = message.substr(0, 400);
-  out_.publish(checkpoint_answer_channel(name_), &a);
+  publish(checkpoint_answer_channel(name_), a);
 }
 
 void FrameNode::load_cut() {

@@ -200,7 +200,7 @@ private:
     std::vector<double> frozen; // the waves' frozen shares, for the final log line
     dynhet::msd_t m = msd_->message(s, frozen);
     stamp(m, final);
-    out().publish(dynhet::result_channel(dynhet::kChanMsd, s.cage_relative), &m);
+    publish(dynhet::result_channel(dynhet::kChanMsd, s.cage_relative), m);
     if (final) msd_->log_flows(m, frozen, s.says());
   }
   void publish_chi4(const Measures& s, bool final) {
@@ -229,7 +229,7 @@ private:
         m.tau4_err.push_back(r.tau4_err);
       }
       m.n_values = static_cast<int32_t>(m.chi4.size());
-      out().publish(dynhet::cutoff_channel(dynhet::kChanChi4, m.cutoff_a, s.cage_relative), &m);
+      publish(dynhet::cutoff_channel(dynhet::kChanChi4, m.cutoff_a, s.cage_relative), m);
     }
   }
 
@@ -244,14 +244,14 @@ private:
     dynhet::displacement_t m = s.displacement->message(s.acc[0].result().tau_alpha, info().cutoff_a[0]);
     stamp(m, final);
     m.cage_relative = s.cage_relative;
-    out().publish(dynhet::result_channel(dynhet::kChanDisplacement, s.cage_relative), &m);
+    publish(dynhet::result_channel(dynhet::kChanDisplacement, s.cage_relative), m);
   }
 
   void publish_results(bool final) override {
     if (bonds_) {
       dynhet::bond_breaking_t m = bonds_->message();
       stamp(m, final);
-      out().publish(dynhet::kChanBondBreaking, &m);
+      publish(dynhet::kChanBondBreaking, m);
       if (final)
         std::fprintf(stderr, "overlap_node: bond breaking (a1 = %g, a2 = %g, %.3g bonds per particle): tau_B=%.5g +- %.2g\n",
                      m.a1, m.a2, m.bonds_per_particle, m.tau_b, m.tau_b_err);
@@ -284,7 +284,7 @@ private:
       for (int k = 0; k < info().n_origins; ++k) m.t0.push_back(info().frame_time[info().origin_frame[k]]);
       m.tau_alpha_t0 = an::tau_alpha_per_origin(s.acc[c], info().lag_time, info().n_origins);
       m.n_t0 = static_cast<int32_t>(m.t0.size());
-      out().publish(dynhet::cutoff_channel(dynhet::kChanOverlap, m.cutoff_a, s.cage_relative), &m);
+      publish(dynhet::cutoff_channel(dynhet::kChanOverlap, m.cutoff_a, s.cage_relative), m);
       if (final)
         std::fprintf(stderr, "overlap_node%s: a=%g tau_alpha=%.5g +- %.2g (%d pairs)\n", s.says(), m.cutoff_a,
                      m.tau_alpha, m.tau_alpha_err, pairs_done());

@@ -233,7 +233,7 @@ private:
     m.n_lag_values = static_cast<int32_t>(m.s4_lag.size());
     m.n_lag_fits = static_cast<int32_t>(m.xi_lag.size());
     const char* cr = c.cr ? " (cage-relative)" : "";
-    if (out().publish(dynhet::cutoff_channel(dynhet::kChanS4, m.cutoff_a, c.cr), &m) != 0)
+    if (publish(dynhet::cutoff_channel(dynhet::kChanS4, m.cutoff_a, c.cr), m) != 0)
       std::fprintf(stderr, "s4_node: could not publish S4 (%d bytes)\n", m.getEncodedSize());
     if (final)
       std::fprintf(stderr, "s4_node%s: a=%g t_s4=%.4g (tau_alpha %.4g; %s), whole box xi=%.4g +- %.2g chi0=%.4g +- %.2g, chi4=%.4g +- %.2g (%d origins)\n",

@@ -189,8 +189,13 @@ def main():
 
         print(f"bench_bus: N = {n}: the sim alone", file=sys.stderr)
         alone_log = os.path.join(a.work, f"alone_{n}.log")
+        key = os.path.join(a.work, "bench.key")  # the sim alone tags its frames as the live one does
+        if not os.path.exists(key):
+            fd = os.open(key, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o600)
+            os.write(fd, os.urandom(32))
+            os.close(fd)
         rc, mem_alone = run_watched([os.path.join(ROOT, "launch_scripts/netns.sh"), os.path.join(bin_, "sim_node"),
-                                     scene, "--lcm-url", url], alone_log)
+                                     scene, "--lcm-url", url, "--key-file", key], alone_log)
         if rc != 0:
             sys.exit(f"bench_bus: sim alone failed (exit {rc}), see {alone_log}")
         alone = production(alone_log)

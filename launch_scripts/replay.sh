@@ -5,7 +5,8 @@
 # results on a private bus, where the recorder picks them up (run info and
 # status it reads from the log too).
 #
-# Usage: launch_scripts/replay.sh LOG [LOG2 ...] --out DIR [--run-id ID] [--no-build]
+# Usage: launch_scripts/replay.sh LOG [LOG2 ...] --out DIR [--run-id ID] [--key-file KEY]
+#                                 [--only-verified] [--no-build]
 #        several logs: the segments of one run interrupted and resumed
 #        (run_scene.sh --record LOG writes LOG, LOG.2, ...), in order; they
 #        are played as one (a frame the next segment publishes again, from
@@ -15,17 +16,27 @@
 # A log holding several runs needs --run-id. Before it starts, the replay
 # says how many of the run's frames the log lacks; a replay of an
 # incomplete log is itself marked incomplete.
+#   --key-file KEY   the recorded run's key (default: bus.key beside the
+#                    first LOG, where run_scene.sh --record DIR/LOG leaves
+#                    it). Every message of the log is checked against it
+#                    first (docs/bus.md): a log with any message that does
+#                    not verify (no tag, a wrong one, a replayed copy) is
+#                    refused, and the processes check each one again
+#   --only-verified  instead, play only the messages that verify, and say
+#                    how many did not
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
-log="" out="" build_first=1 run_id="" list=0 segments=()
+log="" out="" build_first=1 run_id="" list=0 segments=() key_file="" only_verified=0
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
   --no-build) build_first=0; shift ;;
   --run-id) run_id=$2; shift 2 ;;
+  --key-file) key_file=$2; shift 2 ;;
+  --only-verified) only_verified=1; shift ;;
   --list) list=1; shift ;;
   -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;;
   -*) echo "replay: unknown option $1" >&2; exit 2 ;;
@@ -52,6 +63,30 @@ if ((list)); then exec /usr/bin/python3 "$runs" "$log"; fi
 if [[ -z $run_id ]]; then
   run_id=$(/usr/bin/python3 "$runs" "$log" --only) || exit 2
 fi
+# The recorded run's key: every message of the log is checked against it.
+if [[ -z $key_file ]]; then
+  key_file=$(dirname "${segments[0]}")/bus.key
+  [[ -f $key_file ]] || { echo "replay: no key for ${segments[0]}: give the recorded run's key with --key-file (run_scene.sh wrote it to the run's DIR/bus.key)" >&2; exit 2; }
+fi
+key_file=$(cd "$(dirname "$key_file")" && pwd)/$(basename "$key_file")
+if [[ -z ${DYNHET_IN_NETNS:-} ]]; then
+  mkdir -p "$out"
+  if ((only_verified)); then
+    verified=$(cd "$out" && pwd)/verified.lcmlog
+    said=$(/usr/bin/python3 "$root/launch_scripts/lcmlog_verify.py" "$log" --key-file "$key_file" --keep "$verified") && rc=0 || rc=$?
+    ((rc <= 1)) || { echo "replay: $said" >&2; exit 2; }
+    echo "replay: $log: $said; playing only those that verify ($verified)" >&2
+    log=$verified
+  else
+    said=$(/usr/bin/python3 "$root/launch_scripts/lcmlog_verify.py" "$log" --key-file "$key_file") && rc=0 || rc=$?
+    if ((rc != 0)); then
+      echo "replay: $log: $said" >&2
+      ((rc != 1)) || echo "replay: refused: the log holds messages that do not verify with $key_file (--only-verified plays the rest)" >&2
+      exit 2
+    fi
+    echo "replay: $log: $said" >&2
+  fi
+fi
 summary=$(/usr/bin/python3 "$runs" "$log" --run-id "$run_id") || exit 2
 echo "replay: $summary" >&2
 read -r whole expected < <(sed -E 's/.*, ([0-9]+) of ([0-9]+) frames.*/\1 \2/' <<<"$summary")
@@ -64,7 +99,7 @@ out=$(cd "$out" && pwd)
 
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then
   ((build_first)) && BUILD_DIR=$build "$root/launch_scripts/setup.sh"
-  exec "$root/launch_scripts/netns.sh" "$0" "$log" --out "$out" --run-id "$run_id" --no-build
+  exec "$root/launch_scripts/netns.sh" "$0" "$log" --out "$out" --run-id "$run_id" --key-file "$key_file" --no-build
 fi
 
 # Which nodes ran: the observables named in the run info of the log. The
@@ -72,12 +107,14 @@ fi
 nodes=$("$bin/recorder" --list-nodes "$log") || { echo "replay: cannot read run info from $log" >&2; exit 1; }
 bus="udpm://239.255.76.67:7670?ttl=0&recv_buf_size=4194304"
 
-"$bin/recorder" --lcm-url "$bus" --from-log "$log" --out "$out/run.h5" --run-id "$run_id" 2>"$out/recorder.log" &
+"$bin/recorder" --lcm-url "$bus" --from-log "$log" --out "$out/run.h5" --run-id "$run_id" --key-file "$key_file" \
+  2>"$out/recorder.log" &
 rec=$!
 for _ in $(seq 100); do grep -q ready "$out/recorder.log" && break; sleep 0.1; done
 status=0
 for n in $nodes; do
-  "$bin/$n" --lcm-url "file://$log?speed=0" --publish-url "$bus" --run-id "$run_id" 2>"$out/$n.log" || {
+  "$bin/$n" --lcm-url "file://$log?speed=0" --publish-url "$bus" --run-id "$run_id" --key-file "$key_file" \
+    2>"$out/$n.log" || {
     echo "replay: $n failed; log $out/$n.log" >&2; tail -3 "$out/$n.log" >&2; status=1; }
 done
 wait $rec || { echo "replay: recorder failed; log $out/recorder.log" >&2; tail -3 "$out/recorder.log" >&2; status=1; }

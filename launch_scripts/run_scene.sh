@@ -47,6 +47,13 @@
 #                   checkpoint's). Sim, nodes and recorder all get it, so
 #                   they take only this run's messages: two runs on one bus
 #                   never cross
+#   --key-file KEY  the run's key (default DIR/bus.key, created when missing:
+#                   32 random bytes, mode 0600). Every process tags each
+#                   message it publishes with it and drops every message
+#                   whose tag does not verify (docs/bus.md). A run split over
+#                   hosts (--role) needs the same key on both: copy the
+#                   analysis host's DIR/bus.key to the sim's host (scp -p,
+#                   keeping mode 0600) and give it there with --key-file
 #   --author NAME   run.h5's h5md/author name (default: $DYNHET_AUTHOR,
 #                   else $USER, else "unknown")
 #   --author-email ADDRESS  run.h5's h5md/author email (default: none)
@@ -56,6 +63,7 @@ build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
 scene="" out="" bus=private url="" record="" build_first=1 plots=1 resume="" run_id="" role=all author="" author_email=""
+key_file=""
 fresh=0 no_cuts=0 test_node_delay=${DYNHET_TEST_NODE_DELAY:-} test_sim_delay=${DYNHET_TEST_SIM_DELAY:-}
 while (($#)); do
   case "$1" in
@@ -70,6 +78,7 @@ while (($#)); do
   --no-plots) plots=0; shift ;;
   --resume) resume=$2; shift 2 ;;
   --run-id) run_id=$2; shift 2 ;;
+  --key-file) key_file=$2; shift 2 ;;
   --role) role=$2; shift 2 ;;
   --author) author=$2; shift 2 ;;
   --author-email) author_email=$2; shift 2 ;;
@@ -117,6 +126,7 @@ if [[ ($bus == private || $bus == tcpq) && -z ${DYNHET_IN_NETNS:-} ]]; then
   [[ -z $url ]] || args+=(--url "$url")
   [[ -z $record ]] || args+=(--record "$record")
   [[ -z $run_id ]] || args+=(--run-id "$run_id")
+  [[ -z $key_file ]] || args+=(--key-file "$(realpath -m "$key_file")")
   [[ -z $author ]] || args+=(--author "$author")
   [[ -z $author_email ]] || args+=(--author-email "$author_email")
   ((fresh == 0)) || args+=(--fresh)
@@ -132,6 +142,7 @@ if [[ $role == all && -z $resume && $no_cuts == 0 ]]; then
   cuts=$out/checkpoints
   if ((fresh)); then
     rm -rf "$cuts"/cut-* "$cuts"/recorder.journal "$out/run.h5"
+    [[ -n $key_file ]] || rm -f "$out/bus.key" # a new run, a new key
     # (not the scene to run, when it is DIR's own: the study runner's)
     [[ $(realpath "$scene") == $(realpath -m "$out/scene.toml") ]] || rm -f "$out/scene.toml"
   fi
@@ -217,6 +228,18 @@ elif [[ -z $run_id ]]; then
 fi
 [[ $run_id =~ ^[1-9][0-9]*$ ]] || { echo "run_scene: --run-id must be a positive integer, not $run_id" >&2; exit 2; }
 
+# The run's key: every message on the bus is tagged with it (docs/bus.md).
+if [[ -z $key_file ]]; then
+  [[ $role != sim ]] || { echo "run_scene: --role sim needs --key-file KEY: the run's key, copied from the analysis host's DIR/bus.key" >&2; exit 2; }
+  key_file=$out/bus.key
+  if [[ ! -e $key_file ]]; then
+    (umask 077 && head -c 32 /dev/urandom >"$key_file.tmp" && mv "$key_file.tmp" "$key_file")
+    [[ $role != analysis ]] || echo "run_scene: the run's key is $key_file: copy it to the sim's host (scp -p) and give it there with --key-file" >&2
+  fi
+fi
+[[ -f $key_file ]] || { echo "run_scene: no key file $key_file" >&2; exit 2; }
+key=(--key-file "$key_file")
+
 start() { # name, then the command; waits for its "ready" line
   # On resume the log goes on: only the lines after this start's own
   # separator count (an earlier attempt's "ready" is not this process's),
@@ -241,7 +264,7 @@ start() { # name, then the command; waits for its "ready" line
 
 echo "run_scene: ${scene:-resuming $resume} -> $out (bus $bus, $url, run $run_id, role $role)" >&2
 if [[ $role == sim ]]; then # the sim alone; the analysis host records and plots
-  "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" --pace-nodes --checkpoint "$out/checkpoint.h5" \
+  "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" "${key[@]}" --pace-nodes --checkpoint "$out/checkpoint.h5" \
     --checkpoint-before-frames "$out/checkpoint_before_frames.h5" 2> >(tee ${resume:+-a} "$out/sim_node.log" >&2)
   exit $?
 fi
@@ -263,10 +286,10 @@ fi
 wait_run=(); [[ $role == analysis ]] && wait_run=(--wait-run 900)
 authorship=(); [[ -z $author ]] || authorship+=(--author "$author")
 [[ -z $author_email ]] || authorship+=(--author-email "$author_email")
-start recorder "$bin/recorder" --out "$out/run.h5" --run-id "$run_id" "${wait_run[@]}" "${authorship[@]}" \
+start recorder "$bin/recorder" --out "$out/run.h5" --run-id "$run_id" "${key[@]}" "${wait_run[@]}" "${authorship[@]}" \
   "${cut_args[@]}" "${resume_cut[@]}"
 node_delay=(); [[ -z $test_node_delay ]] || node_delay=(--test-frame-delay "$test_node_delay")
-for n in $nodes; do start "$n" "$bin/$n" --run-id "$run_id" "${wait_run[@]}" "${cut_args[@]}" "${resume_cut[@]}" "${node_delay[@]}"; done
+for n in $nodes; do start "$n" "$bin/$n" --run-id "$run_id" "${key[@]}" "${wait_run[@]}" "${cut_args[@]}" "${resume_cut[@]}" "${node_delay[@]}"; done
 if [[ -n $record ]]; then
   # lcm-logger says nothing when it is ready. The nodes publish their status
   # every second from the start: once the log holds anything (it is flushed
@@ -281,14 +304,14 @@ fi
 # sim_node.log); with --role analysis it runs on another host.
 set +e
 if [[ $role == analysis ]]; then
-  echo "run_scene: waiting for run $run_id's sim on the bus (start it with --role sim --run-id $run_id)" >&2
+  echo "run_scene: waiting for run $run_id's sim on the bus (start it with --role sim --run-id $run_id --key-file KEY, KEY a copy of $key_file)" >&2
   sim_rc=0
 elif [[ -n $cuts ]]; then
   # In the background, watched with the others: a process that dies takes
   # the run down at once (killed: the last whole cut is the restart point).
   if ((${#resume_cut[@]})); then echo "---- resumed from cut ${resume_cut[1]}" >>"$out/sim_node.log"; else : >"$out/sim_node.log"; fi
   sim_delay=(); [[ -z $test_sim_delay ]] || sim_delay=(--test-frame-delay "$test_sim_delay")
-  "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" --pace-nodes --checkpoint "$out/checkpoint.h5" \
+  "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" "${key[@]}" --pace-nodes --checkpoint "$out/checkpoint.h5" \
     --checkpoint-before-frames "$out/checkpoint_before_frames.h5" "${cut_args[@]}" "${resume_cut[@]}" "${sim_delay[@]}" \
     2> >(trap '' TERM INT; exec tee -a "$out/sim_node.log" >&2) &
   sim_pid=$!
@@ -321,7 +344,7 @@ elif [[ -n $cuts ]]; then
     fi
   fi
 else
-  "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" --pace-nodes --checkpoint "$out/checkpoint.h5" \
+  "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" "${key[@]}" --pace-nodes --checkpoint "$out/checkpoint.h5" \
     --checkpoint-before-frames "$out/checkpoint_before_frames.h5" 2> >(tee ${resume:+-a} "$out/sim_node.log" >&2)
   sim_rc=$?
 fi

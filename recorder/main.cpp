@@ -38,6 +38,7 @@
 #include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
 
+#include "dynhet/bus.hpp"
 #include "dynhet/flow_control.hpp"
 #include "dynhet/lcm_url.hpp"
 #include "dynhet/scene.hpp"
@@ -64,6 +65,8 @@ struct Options {
   std::string checkpoint_dir;
   int resume_cut = -1;
   double cut_wait = 300; // after a signal: how long to wait for the next cut
+  std::string key_file;
+  bool unauthenticated = false;
 };
 
 // The one channel each message may come on (lcm_url.hpp: one channel per
@@ -94,15 +97,19 @@ std::string channel_of(const dynhet::displacement_t &m) {
 // other, and the clocks that decide when to stop waiting.
 class Session {
 public:
-  Session(lcm::LCM &lcm, const Options &o)
-      : lcm_(lcm), opt_(o), rec_(o.out, DYNHET_VERSION, o.author, o.author_email), start_(Clock::now()) {
-    if (!o.checkpoint_dir.empty()) cuts_ = std::make_unique<dynhet::RecorderCuts>(lcm, o.checkpoint_dir);
+  Session(lcm::LCM &lcm, dynhet::Bus bus, const Options &o)
+      : lcm_(lcm), bus_(std::move(bus)), opt_(o), rec_(o.out, DYNHET_VERSION, o.author, o.author_email),
+        start_(Clock::now()) {
+    if (!o.checkpoint_dir.empty()) cuts_ = std::make_unique<dynhet::RecorderCuts>(lcm, bus_, o.checkpoint_dir);
   }
 
   int run();
 
 private:
   lcm::LCM &lcm_;
+  // The run's key: every message checked before it is decoded, the journal
+  // replayed through the same checks (the same verdicts in the same order).
+  dynhet::Bus bus_;
   Options opt_;
   dynhet::RunRecorder rec_;
   std::unique_ptr<lcm::LogFile> log_;
@@ -165,7 +172,9 @@ private:
     if (cuts_ && !replaying_) cuts_->journal().append(ch, data, static_cast<uint32_t>(size));
     Msg m;
     std::string why;
-    if (!dynhet::guard::safe_decode(data, size, m, why)) return reject(ch, why);
+    int lcm_bytes = 0;
+    if (!bus_.open(ch, data, static_cast<std::size_t>(size), lcm_bytes, why)) return reject(ch, why);
+    if (!dynhet::guard::safe_decode(data, lcm_bytes, m, why)) return reject(ch, why);
     if (const std::string own = channel_of(m); ch != own)
       return reject(ch, "not this message's channel, which is " + own.substr(0, 80));
     try {
@@ -175,6 +184,13 @@ private:
     }
   }
   void reject(const std::string &ch, const std::string &why) {
+    if (dynhet::unauthenticated_reason(why)) {
+      rec_.message_unauthenticated(ch, why);
+      if (rec_.messages_unauthenticated() <= 10 || rec_.messages_unauthenticated() % 1000 == 0)
+        std::fprintf(stderr, "recorder: dropped a message on %s (%s; %lld so far)\n", ch.c_str(), why.c_str(),
+                     static_cast<long long>(rec_.messages_unauthenticated()));
+      return;
+    }
     rec_.message_rejected(ch, why);
     if (rec_.messages_rejected() <= 10 || rec_.messages_rejected() % 1000 == 0)
       std::fprintf(stderr, "recorder: dropped a message on %s (%s; %lld so far)\n", ch.c_str(), why.c_str(),
@@ -231,8 +247,8 @@ void Session::subscribe() {
          this)
       ->setQueueCapacity(10000);
   // The launch scripts wait for this line before starting the sim.
-  std::fprintf(stderr, "recorder: ready, waiting for run info%s%s\n", log_ ? " in " : "",
-               log_ ? opt_.from_log.c_str() : "");
+  std::fprintf(stderr, "recorder: ready, waiting for run info%s%s (bus %s)\n", log_ ? " in " : "",
+               log_ ? opt_.from_log.c_str() : "", bus_.describe());
 }
 
 void Session::take_run(const dynhet::run_info_t &m) {
@@ -339,7 +355,9 @@ void Session::take_checkpoint(const lcm::ReceiveBuffer *rb, const std::string &c
   if (!cuts_ || !rec_.has_run()) return;
   dynhet::checkpoint_t m;
   std::string why;
-  if (!dynhet::guard::safe_decode(rb->data, static_cast<int>(rb->data_size), m, why)) return reject(ch, why);
+  int lcm_bytes = 0;
+  if (!bus_.open(ch, rb->data, rb->data_size, lcm_bytes, why)) return reject(ch, why);
+  if (!dynhet::guard::safe_decode(rb->data, lcm_bytes, m, why)) return reject(ch, why);
   if (m.run_id != rec_.run_id()) return;
   if (const std::string bad = dynhet::checkpoint_problem(m, rec_.n_frames()); !bad.empty())
     return reject(ch, "checkpoint: " + bad);
@@ -433,8 +451,10 @@ void Session::publish_own_status(const std::string &state, const std::string &me
   own_.frames_lost = rec_.frames_lost();
   own_.chunks_received = rec_.chunks_received();
   own_.messages_rejected = static_cast<int32_t>(std::min<int64_t>(rec_.messages_rejected(), INT32_MAX));
+  own_.messages_unauthenticated =
+      static_cast<int32_t>(std::min<int64_t>(rec_.messages_unauthenticated(), INT32_MAX));
   own_.message = message;
-  lcm_.publish(dynhet::node_status_channel(dynhet::kRecorderNode), &own_);
+  bus_.publish(lcm_, dynhet::node_status_channel(dynhet::kRecorderNode), own_);
   last_own_status_ = Clock::now();
 }
 
@@ -469,7 +489,10 @@ int list_nodes(const std::string &log_path) {
   while (const lcm::LogEvent *e = log.readNextEvent()) {
     dynhet::run_info_t run;
     std::string why;
-    if (e->channel != dynhet::kChanRun || !dynhet::guard::safe_decode(e->data, e->datalen, run, why) ||
+    // Only to name the nodes replay.sh starts: the tag is not checked here
+    // (the replayed run's processes check every message).
+    if (e->channel != dynhet::kChanRun ||
+        !dynhet::guard::safe_decode(e->data, static_cast<int>(dynhet::lcm_bytes_of(e->data, e->datalen)), run, why) ||
         !dynhet::run_info_problem(run).empty())
       continue;
     std::string line;
@@ -498,6 +521,11 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   app.add_option("--wait-run", o.wait_run, "seconds to wait for the run info")->capture_default_str();
   app.add_option("--run-id", o.run_id, "record only this run (default: the first one seen)");
+  app.add_option("--key-file", o.key_file,
+                 "the run's key (32 bytes, mode 0600; run_scene.sh writes DIR/bus.key): every message is checked "
+                 "with it before it is decoded, the recorder's own are tagged (docs/bus.md); default $DYNHET_KEY_FILE")
+      ->envname("DYNHET_KEY_FILE");
+  app.add_flag("--unauthenticated", o.unauthenticated, "no key: an open bus, on purpose (tests, tools)");
   app.add_option("--author", o.author,
                  "the file's h5md/author name (default: $DYNHET_AUTHOR, else $USER, else \"unknown\")");
   app.add_option("--author-email", o.author_email, "the file's h5md/author email (default: none)");
@@ -512,6 +540,13 @@ int main(int argc, char **argv) {
   CLI11_PARSE(app, argc, argv);
   if (!list_log.empty()) return list_nodes(list_log);
   if (o.out.empty()) return app.exit(CLI::RequiredError("--out"));
+  std::optional<dynhet::Bus> bus;
+  try {
+    bus.emplace(dynhet::Bus::from_options("recorder", o.key_file, o.unauthenticated));
+  } catch (const std::exception &e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  }
 
   const std::string url = dynhet::resolve_lcm_url(o.url);
   lcm::LCM lcm(url);
@@ -521,7 +556,7 @@ int main(int argc, char **argv) {
   }
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
-  Session session(lcm, o);
+  Session session(lcm, *bus, o);
   const int code = session.run();
   // Its last status (the sim may pace on it) reaches the bus before it ends
   // (tcpq: dynhet/lcm_exit.hpp).

@@ -117,7 +117,7 @@ void RecorderCuts::answer(int cut, int frame, const std::string& state, int64_t 
   a.bytes = bytes;
   a.write_seconds = seconds;
   a.message = message.substr(0, 400);
-  lcm_.publish(checkpoint_answer_channel(kRecorderNode), &a);
+  bus_.publish(lcm_, checkpoint_answer_channel(kRecorderNode), a);
 }
 
 RecorderCuts::Resumed RecorderCuts::read_and_replay(

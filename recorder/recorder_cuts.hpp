@@ -17,6 +17,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "dynhet/bus.hpp"
 #include "dynhet/checkpoint_t.hpp"
 #include "dynhet/run_info_t.hpp"
 #include "journal.hpp"
@@ -25,7 +26,7 @@ namespace dynhet {
 
 class RecorderCuts {
 public:
-  RecorderCuts(lcm::LCM& lcm, std::string dir) : lcm_(lcm), dir_(std::move(dir)) {}
+  RecorderCuts(lcm::LCM& lcm, Bus bus, std::string dir) : lcm_(lcm), bus_(std::move(bus)), dir_(std::move(dir)) {}
   const std::string& dir() const { return dir_; }
   std::string journal_path() const { return dir_ + "/recorder.journal"; }
   Journal& journal() { return journal_; }
@@ -67,6 +68,7 @@ private:
   Resumed read_and_replay(int cut, const std::function<void(const std::string&, const uint8_t*, uint32_t)>& replay);
 
   lcm::LCM& lcm_;
+  Bus bus_;
   std::string dir_;
   Journal journal_;
   int64_t run_id_ = 0;

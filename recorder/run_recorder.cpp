@@ -162,6 +162,7 @@ bool RunRecorder::on_sim_status(const sim_status_t &m) {
   if (ended(m.phase) && m.frames_published > 0)
     frames_published_ = std::max(frames_published_, std::min(m.frames_published, info_->n_frames));
   completion_.sim_phase(m.phase, m.message);
+  sim_unauthenticated_ = m.messages_unauthenticated;
   return true;
 }
 
@@ -542,6 +543,9 @@ void RunRecorder::write_summary(const std::vector<std::string> &missing) {
     if (info_->keep_frames) writer_->set_attribute("", "frames_lost_recorder", assembler_.frames_lost());
     writer_->set_attribute("", "messages_rejected_recorder", rejected_);
     writer_->set_attribute("", "last_rejection_recorder", last_rejection_);
+    writer_->set_attribute("", "messages_unauthenticated_recorder", unauthenticated_);
+    writer_->set_attribute("", "last_unauthenticated_recorder", last_unauthenticated_);
+    writer_->set_attribute("", "messages_unauthenticated_sim", sim_unauthenticated_);
     for (const auto &[key, n] : nodes_) {
       const node_status_t &s = n.latest;
       const std::string g = "observables/nodes/" + key;
@@ -555,6 +559,7 @@ void RunRecorder::write_summary(const std::vector<std::string> &missing) {
       writer_->set_attribute(g, "messages_rejected", s.messages_rejected);
       writer_->set_attribute(g, "chunks_rejected", s.chunks_rejected);
       writer_->set_attribute(g, "last_rejection", s.last_rejection);
+      writer_->set_attribute(g, "messages_unauthenticated", s.messages_unauthenticated);
     }
   });
 }

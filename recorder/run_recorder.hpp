@@ -90,6 +90,13 @@ public:
     last_rejection_ = channel + ": " + why;
   }
   int64_t messages_rejected() const { return rejected_; }
+  // A message the bus dropped (no tag, a wrong one, a replay: bus.hpp):
+  // counted apart from the malformed ones, never used.
+  void message_unauthenticated(const std::string &channel, const std::string &why) {
+    ++unauthenticated_;
+    last_unauthenticated_ = channel + ": " + why;
+  }
+  int64_t messages_unauthenticated() const { return unauthenticated_; }
   // Each write is flushed (results survive a kill); a journal replayed on
   // resume is written whole first and flushed once (flush_each(true) after
   // it flushes what was written): a flush per message made a 64 MB journal
@@ -128,7 +135,9 @@ private:
   std::set<std::string> started_;
   std::optional<int64_t> node_clock_zero_;      // utime of the first node status
   int write_errors_ = 0;
-  int64_t rejected_ = 0;
+  int64_t rejected_ = 0, unauthenticated_ = 0;
+  std::string last_unauthenticated_;
+  int32_t sim_unauthenticated_ = 0; // the sim's own count, from its last status
   // Free space the recorder keeps on the file system of its file, so that
   // it can still mark the file incomplete and close it when the disk fills.
   static constexpr int64_t kDiskReserve = int64_t{4} << 20;

@@ -14,9 +14,9 @@
 
 namespace dynhet {
 
-CutCoordinator::CutCoordinator(lcm::LCM& lcm, std::string dir, int64_t run_id, std::string scene_text,
+CutCoordinator::CutCoordinator(lcm::LCM& lcm, Bus bus, std::string dir, int64_t run_id, std::string scene_text,
                                std::vector<std::string> parts)
-    : lcm_(lcm), dir_(std::move(dir)), run_id_(run_id), scene_(std::move(scene_text)),
+    : lcm_(lcm), bus_(std::move(bus)), dir_(std::move(dir)), run_id_(run_id), scene_(std::move(scene_text)),
       scene_hash_(dynhet::scene_hash(scene_)), parts_(std::move(parts)) {
   std::filesystem::create_directories(dir_);
   const std::vector<int> cuts = list_cuts(dir_);
@@ -66,14 +66,19 @@ void CutCoordinator::request(int cut, const Pending& p) {
   m.process = "sim";
   m.state = "save";
   m.message = p.stop ? "stop" : "";
-  lcm_.publish(kChanCheckpoint, &m);
+  bus_.publish(lcm_, kChanCheckpoint, m);
   pending_[cut].asked = Clock::now();
 }
 
 void CutCoordinator::on_answer(const lcm::ReceiveBuffer* rb, const std::string& channel) {
   checkpoint_t m;
   std::string why;
-  if (!guard::safe_decode(rb->data, static_cast<int>(rb->data_size), m, why)) return; // untrusted: dropped
+  int size = 0;
+  if (!bus_.open(channel, rb->data, rb->data_size, size, why)) {
+    ++unauthenticated_;
+    return;
+  }
+  if (!guard::safe_decode(rb->data, size, m, why)) return; // untrusted: dropped
   if (m.run_id != run_id_ || channel != checkpoint_answer_channel(m.process)) return;
   if (!checkpoint_problem(m, INT32_MAX - 1).empty()) return;
   auto it = pending_.find(m.cut);
@@ -116,7 +121,7 @@ bool CutCoordinator::complete(int cut, Pending& p) {
   m.utime = utime_now();
   m.run_id = run_id_, m.cut = cut, m.frame = p.frame, m.sim_time = p.time;
   m.process = "sim", m.state = "whole";
-  lcm_.publish(kChanCheckpoint, &m);
+  bus_.publish(lcm_, kChanCheckpoint, m);
   return true;
 }
 

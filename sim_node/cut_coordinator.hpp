@@ -24,13 +24,15 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "dynhet/bus.hpp"
+
 namespace dynhet {
 
 class CutCoordinator {
 public:
   // `parts`: the processes whose parts make a cut whole, the sim ("sim")
   // included. Cut numbers continue after the folder's highest.
-  CutCoordinator(lcm::LCM& lcm, std::string dir, int64_t run_id, std::string scene_text,
+  CutCoordinator(lcm::LCM& lcm, Bus bus, std::string dir, int64_t run_id, std::string scene_text,
                  std::vector<std::string> parts);
   ~CutCoordinator();
 
@@ -48,6 +50,7 @@ public:
   // abort() says so.
   bool wait_whole(int cut, double timeout, const std::function<bool()>& abort = {});
   int last_whole() const { return last_whole_; }
+  long unauthenticated() const { return unauthenticated_; } // answers dropped by the bus
   int newest_open() const; // -1: none
   static constexpr size_t kMaxOpen = 60; // the nodes keep 64
   // Wall-clock seconds since the last cut was taken (or since the start).
@@ -67,6 +70,7 @@ private:
   bool complete(int cut, Pending& p); // false: not whole (yet)
 
   lcm::LCM& lcm_;
+  Bus bus_;
   std::string dir_;
   int64_t run_id_;
   std::string scene_;
@@ -76,6 +80,7 @@ private:
   int last_whole_frame_ = -1, previous_whole_frame_ = -1;
   std::map<int, Pending> pending_;
   lcm::Subscription* sub_ = nullptr;
+  long unauthenticated_ = 0;
   Clock::time_point last_take_ = Clock::now();
 };
 

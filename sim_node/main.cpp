@@ -12,6 +12,7 @@
 #include <csignal>
 #include <cstdio>
 #include <map>
+#include <optional>
 #include <random>
 #include <string>
 #include <thread>
@@ -24,6 +25,7 @@
 #include "pacer.hpp"
 #include "reporter.hpp"
 #include "cut_coordinator.hpp"
+#include "dynhet/bus.hpp"
 #include "dynhet/cut.hpp"
 #include "dynhet/state_archive.hpp"
 #include "dynhet/chunking.hpp"
@@ -255,6 +257,13 @@ int main(int argc, char** argv) {
                "runs of the same dynamics from it equal the runs that equilibrate themselves, bit for bit");
   app.add_option("--lcm-url", url, "LCM URL (default $LCM_DEFAULT_URL or " + std::string(dynhet::kDefaultLcmUrl) + ")");
   app.add_option("--run-id", run_id, "run id (default: random)");
+  std::string key_file;
+  bool unauthenticated = false;
+  app.add_option("--key-file", key_file,
+                 "the run's key (32 bytes, mode 0600; run_scene.sh writes DIR/bus.key): every message is tagged "
+                 "with it and every message received is checked (docs/bus.md); default $DYNHET_KEY_FILE")
+      ->envname("DYNHET_KEY_FILE");
+  app.add_flag("--unauthenticated", unauthenticated, "no key: an open bus, on purpose (tests, tools)");
   bool pace = false;
   app.add_flag("--pace-nodes", pace,
                "flow control: hold each frame until the scene's nodes, and the recorder when the scene keeps the "
@@ -370,6 +379,14 @@ int main(int argc, char** argv) {
   }
   if (run_id == 0) run_id = static_cast<int64_t>(std::random_device{}() & 0x7fffffff) << 20 ^ getpid();
 
+  std::optional<dynhet::Bus> bus_or;
+  try {
+    bus_or.emplace(dynhet::Bus::from_options("sim_node", key_file, unauthenticated));
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return 2;
+  }
+  const dynhet::Bus& bus = *bus_or;
   const std::string bus_url = dynhet::resolve_lcm_url(url);
   lcm::LCM lcm(bus_url);
   const bool tcpq = dynhet::is_tcpq_url(bus_url);
@@ -380,12 +397,12 @@ int main(int argc, char** argv) {
   std::signal(SIGINT, on_signal);
   std::signal(SIGTERM, on_signal);
 
-  Reporter rep(lcm, run_id, isatty(STDERR_FILENO));
+  Reporter rep(lcm, bus, run_id, isatty(STDERR_FILENO));
   auto fail = [&](const std::string& why) {
     if (rep.msg().phase != "interrupted") rep.msg().phase = "failed";
     rep.msg().message = why;
     rep.msg().utime = utime_now();
-    for (int i = 0; i < 3; ++i) lcm.publish(dynhet::kChanSimStatus, &rep.msg());
+    for (int i = 0; i < 3; ++i) bus.publish(lcm, dynhet::kChanSimStatus, rep.msg());
     std::fprintf(stderr, "\nsim_node: %s\n", why.c_str());
   };
 
@@ -395,9 +412,9 @@ int main(int argc, char** argv) {
     const dynhet::engine::Params p = engine_params(scene);
     dynhet::engine::Engine eng(p);
     std::fprintf(stderr,
-                 "sim_node: run %lld, N=%ld phi=%.4f eps=%.3f L=%.4f, kicks %s (%.4g per particle per unit time, "
-                 "pairs: %s)\n",
-                 static_cast<long long>(run_id), eng.size(), scene.packing_fraction, scene.restitution,
+                 "sim_node: run %lld (bus %s), N=%ld phi=%.4f eps=%.3f L=%.4f, kicks %s (%.4g per particle per "
+                 "unit time, pairs: %s)\n",
+                 static_cast<long long>(run_id), bus.describe(), eng.size(), scene.packing_fraction, scene.restitution,
                  eng.box_length(), p.driving && scene.restitution < 1 ? "on" : "off", p.kick_rate,
                  scene.kick_pairs == "any" ? "any two particles"
                                            : ("neighbours within " + std::to_string(scene.kick_reach)).c_str());
@@ -411,7 +428,7 @@ int main(int argc, char** argv) {
     auto last_info = Clock::now();
     auto publish_info = [&] {
       info.utime = utime_now();
-      lcm.publish(dynhet::kChanRun, &info);
+      bus.publish(lcm, dynhet::kChanRun, info);
       last_info = Clock::now();
     };
     publish_info();
@@ -483,7 +500,7 @@ int main(int argc, char** argv) {
       std::vector<std::string> parts{"sim"};
       for (const auto& n : dynhet::nodes_for(scene.observables)) parts.push_back(n.substr(0, n.size() - 5));
       parts.push_back(dynhet::kRecorderNode);
-      cuts = std::make_unique<dynhet::CutCoordinator>(lcm, cut_root, run_id, scene.text, parts);
+      cuts = std::make_unique<dynhet::CutCoordinator>(lcm, bus, cut_root, run_id, scene.text, parts);
     }
     // At a synchronised time: a cut after the last frame published.
     auto take_cut = [&](bool stop) {
@@ -584,7 +601,8 @@ int main(int argc, char** argv) {
       for (const auto& n : dynhet::nodes_for(scene.observables)) paced.push_back(n.substr(0, n.size() - 5));
       if (scene.keep_frames) paced.push_back(dynhet::kRecorderNode); // it writes every frame
     }
-    Pacer pacer(lcm, run_id, paced, eng.size());
+    Pacer pacer(lcm, bus, run_id, paced, eng.size());
+    rep.count_unauthenticated([&] { return pacer.unauthenticated() + (cuts ? cuts->unauthenticated() : 0); });
     // Where the production's wall time goes (the last lines of the log;
     // bench/bench_bus.py reads them): simulating, waiting for paced nodes,
     // publishing frames.
@@ -624,7 +642,7 @@ int main(int argc, char** argv) {
         chunk.n_values = 2 * ranges[c].count;
         chunk.position.assign(xy.begin() + 2 * ranges[c].first,
                               xy.begin() + 2 * (ranges[c].first + ranges[c].count));
-        lcm.publish(dynhet::kChanFrame, &chunk);
+        bus.publish(lcm, dynhet::kChanFrame, chunk);
         // Pace multi-chunk frames so receivers' socket buffers keep up:
         // 300 us after a chunk of up to 8192 particles (an unpaced
         // lcm-logger keeps up with small chunks at that pace: at 5 us per

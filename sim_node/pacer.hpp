@@ -11,6 +11,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "dynhet/flow_control.hpp"
+#include "dynhet/bus.hpp"
 #include "dynhet/lcm_exit.hpp"
 #include "dynhet/lcm_guard.hpp"
 #include "dynhet/lcm_url.hpp"
@@ -30,8 +31,8 @@ namespace dynhet {
 // warning (its losses are then its own, and counted).
 class Pacer {
 public:
-  Pacer(lcm::LCM& lcm, int64_t run_id, std::vector<std::string> nodes, long n_particles)
-      : lcm_(lcm), run_id_(run_id) {
+  Pacer(lcm::LCM& lcm, Bus bus, int64_t run_id, std::vector<std::string> nodes, long n_particles)
+      : lcm_(lcm), bus_(std::move(bus)), run_id_(run_id) {
     for (auto& n : nodes) nodes_[n] = Node{};
     window_ = pacing_window_frames(n_particles);
     // Each node's own channel (DYNHET_NODE_STATUS_<node>; node names hold
@@ -43,6 +44,7 @@ public:
     for (lcm::Subscription* s : subs_) lcm_.unsubscribe(s);
   }
   long window() const { return window_; }
+  long unauthenticated() const { return unauthenticated_; } // node statuses dropped by the bus
   // Waits until frame f may go out; `idle` is called every ~20 ms meanwhile.
   template <class Idle> void before_frame(int f, Idle&& idle) {
     if (nodes_.empty()) return;
@@ -92,7 +94,12 @@ private:
   void on_status(const lcm::ReceiveBuffer* rb, const std::string& channel) {
     node_status_t m;
     std::string why;
-    if (!guard::safe_decode(rb->data, static_cast<int>(rb->data_size), m, why)) return;
+    int size = 0;
+    if (!bus_.open(channel, rb->data, rb->data_size, size, why)) { // never paced by it
+      ++unauthenticated_;
+      return;
+    }
+    if (!guard::safe_decode(rb->data, size, m, why)) return;
     if (m.run_id != run_id_ || channel != node_status_channel(m.node)) return; // not this node's own
     auto it = nodes_.find(m.node);
     if (it == nodes_.end()) return;
@@ -103,9 +110,11 @@ private:
     n.last = Clock::now();
   }
   lcm::LCM& lcm_;
+  Bus bus_;
   int64_t run_id_;
   std::map<std::string, Node> nodes_;
   long window_ = 1;
+  long unauthenticated_ = 0;
   std::vector<lcm::Subscription*> subs_;
   Clock::time_point start_ = Clock::now();
 };

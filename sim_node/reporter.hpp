@@ -4,6 +4,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -11,6 +12,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "dynhet/engine/engine.hpp"
+#include "dynhet/bus.hpp"
 #include "dynhet/lcm_url.hpp"
 #include "dynhet/sim_status_t.hpp"
 #include "dynhet/stats.hpp"
@@ -30,11 +32,14 @@ inline std::string hms(double s) {
 class Reporter {
   using Clock = std::chrono::steady_clock;
 public:
-  Reporter(lcm::LCM& lcm, int64_t run_id, bool tty) : lcm_(lcm), tty_(tty) {
+  Reporter(lcm::LCM& lcm, Bus bus, int64_t run_id, bool tty) : lcm_(lcm), bus_(std::move(bus)), tty_(tty) {
     msg_.run_id = run_id;
     msg_.eta_seconds = -1;
   }
   sim_status_t& msg() { return msg_; }
+  // Where the count of messages the bus dropped comes from (the pacer's
+  // and the cut coordinator's subscriptions), read at each publish.
+  void count_unauthenticated(std::function<long()> f) { unauthenticated_ = std::move(f); }
 
   // Adds what happened since the last sample (every slice of events, at
   // most a few N events apart) to the pressure and collision-frequency
@@ -69,7 +74,9 @@ public:
     msg_.n_tc = c.tc;
     msg_.kinetic_energy = ke;
     if (dpub > 0 && remaining_sim_time >= 0) msg_.eta_seconds = remaining_sim_time / (dpub / dt);
-    lcm_.publish(kChanSimStatus, &msg_);
+    if (unauthenticated_)
+      msg_.messages_unauthenticated = static_cast<int32_t>(std::min<long>(unauthenticated_(), INT32_MAX));
+    bus_.publish(lcm_, kChanSimStatus, msg_);
     print();
     last_ = Clock::now();
     last_sim_ = e.time();
@@ -102,6 +109,8 @@ public:
 
 private:
   lcm::LCM& lcm_;
+  Bus bus_;
+  std::function<long()> unauthenticated_;
   bool tty_;
   sim_status_t msg_{};
   Clock::time_point last_ = Clock::now();

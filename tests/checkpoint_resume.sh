@@ -7,6 +7,8 @@ set -euo pipefail
 root=$1 bin=$2
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then exec "$root/launch_scripts/netns.sh" bash "$0" "$@"; fi
 tmp=$(mktemp -d)
+(umask 077 && head -c 32 /dev/urandom >"$tmp/bus.key") # the run's key (docs/bus.md)
+export DYNHET_KEY_FILE=$tmp/bus.key
 trap 'rm -rf "$tmp"' EXIT
 cd "$tmp"
 cat >scene.toml <<'TOML'

@@ -27,7 +27,8 @@ for attempt in 1 2 3; do
   /usr/bin/python3 "$root/tests/check_h5md.py" "$tmp/live/run.h5" --author "E2E Tester"
   [[ -s $tmp/live/overlap.png && -s $tmp/live/chi4.png && -s $tmp/live/msd.png && -s $tmp/live/displacement.png &&
      -s $tmp/live/clusters.png && -s $tmp/live/s4.png ]] || { echo "FAIL: no plot"; exit 1; }
-  if DYNHET_AUTHOR="E2E Replay" bash "$root/launch_scripts/replay.sh" "$tmp/run.lcmlog" --out "$tmp/replay1" --no-build; then
+  if DYNHET_AUTHOR="E2E Replay" bash "$root/launch_scripts/replay.sh" "$tmp/run.lcmlog" --out "$tmp/replay1" --no-build \
+    --key-file "$tmp/live/bus.key"; then
     break
   fi
   grep -q "lost by the recorder" "$tmp/replay1/recorder.log" 2>/dev/null ||
@@ -36,7 +37,8 @@ for attempt in 1 2 3; do
   echo "e2e: lcm-logger missed frames (attempt $attempt):"; grep "lost" "$tmp/replay1/recorder.log"
 done
 
-DYNHET_AUTHOR="E2E Replay" bash "$root/launch_scripts/replay.sh" "$tmp/run.lcmlog" --out "$tmp/replay2" --no-build
+DYNHET_AUTHOR="E2E Replay" bash "$root/launch_scripts/replay.sh" "$tmp/run.lcmlog" --out "$tmp/replay2" --no-build \
+  --key-file "$tmp/live/bus.key"
 /usr/bin/python3 "$root/tests/check_h5md.py" "$tmp/replay2/run.h5" --author "E2E Replay"
 /usr/bin/python3 "$root/tests/compare_runs.py" "$tmp/live/run.h5" "$tmp/replay1/run.h5" "$tmp/replay2/run.h5"
 echo PASS

@@ -11,6 +11,8 @@ if [[ -z ${DYNHET_IN_NETNS:-} ]]; then exec "$root/launch_scripts/netns.sh" bash
 export BUILD_DIR=$build
 export LCM_DEFAULT_URL='udpm://239.255.76.67:7697?ttl=0'
 tmp=$(mktemp -d)
+(umask 077 && head -c 32 /dev/urandom >"$tmp/bus.key") # the run's key (docs/bus.md)
+export DYNHET_KEY_FILE=$tmp/bus.key
 disk=$tmp/disk
 mkdir -p "$disk"
 mount -t tmpfs -o size=12m tmpfs "$disk"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Every LCM message is untrusted input. In a private network namespace:
 # 1. a clean tiny run (run_scene.sh, run id 4242);
-# 2. the same scene as run 4243 while tests/hostile_publisher.cpp sends
+# 2. the same scene as run 4243 while tests/hostile_publisher.cpp, holding
+#    the run's key (a process of the run gone wrong), sends
 #    every class of bad message for it (random bytes after each type's
 #    fingerprint on every channel, impossible array lengths, run info with
 #    indices out of range, chunks that overflow, size a frame at 2^30
@@ -10,15 +11,24 @@
 #    no process dies, the run is complete, every node and the recorder
 #    count what they dropped, and the results equal the clean run's bit
 #    for bit;
-# 3. the same scene as run 4244 while hostile_publisher --relay republishes
+# 3. the authenticated bus (issue 30; docs/bus.md): an attacker that knows
+#    the run id but not the key sends all of the above and well-formed
+#    "done" statuses of the run (run 4245); with --tamper (run 4246) it sends
+#    every message of the run back as a replay, without its tag and with
+#    its content changed under the genuine tag. Every one is dropped and
+#    counted as unauthenticated (the recorder, each node, and the sim for
+#    the node statuses it paces on), none as malformed, and the results
+#    equal the clean run's bit for bit;
+# 4. the same scene as run 4244 while hostile_publisher --relay republishes
 #    every result and node status, byte for byte, on another source's
-#    channel (the other cutoff's, another node's): the recorder drops and
-#    counts each copy (its channel disagrees with its cutoff or node), the
-#    sim paces on the true statuses only, and the results equal the clean
-#    run's bit for bit;
-# 4. two runs at once on one bus (the tiny scene and the same with another
-#    seed): both complete, the first equal to the clean run bit for bit;
-# 5. a recorder killed (SIGKILL) mid-run leaves a readable run.h5 that says
+#    channel (the other cutoff's, another node's): the tag covers the
+#    channel, so the recorder drops and counts each copy as
+#    unauthenticated, the sim paces on the true statuses only, and the
+#    results equal the clean run's bit for bit;
+# 5. two runs at once on one bus (the tiny scene and the same with another
+#    seed), each with its own key: both complete, the first equal to the
+#    clean run bit for bit, and each drops the other's messages;
+# 6. a recorder killed (SIGKILL) mid-run leaves a readable run.h5 that says
 #    incomplete, and run_scene.sh exits non-zero.
 set -euo pipefail
 root=$1 build=$2 hostile=$3
@@ -44,7 +54,9 @@ complete() { $py -c "import h5py, sys; sys.exit(0 if int(h5py.File(sys.argv[1], 
   { tail -20 "$tmp/clean.log"; exit 1; }
 check 'complete "$tmp/clean/run.h5"' "clean run complete"
 
-"$hostile" "$LCM_DEFAULT_URL" 4243 60 --forge-done >"$tmp/hostile.log" 2>&1 &
+mkdir -p "$tmp/attacked"
+(umask 077 && head -c 32 /dev/urandom >"$tmp/attacked/bus.key") # the run's key, which the insider holds
+"$hostile" "$LCM_DEFAULT_URL" 4243 60 --forge-done --key-file "$tmp/attacked/bus.key" >"$tmp/hostile.log" 2>&1 &
 hp=$!
 sleep 0.5
 "${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/attacked" --run-id 4243 >"$tmp/attacked.log" 2>&1 && rc=0 || rc=$?
@@ -60,14 +72,51 @@ $py - "$tmp/attacked/run.h5" >"$tmp/counts.txt" <<'PY' || true
 import h5py, sys
 f = h5py.File(sys.argv[1], "r")
 text = lambda v: v.decode() if isinstance(v, bytes) else str(v)  # fixed-length strings read as bytes
-print("recorder", int(f.attrs["messages_rejected_recorder"]), text(f.attrs["last_rejection_recorder"]))
+print("recorder", int(f.attrs["messages_rejected_recorder"]), 0, int(f.attrs["messages_unauthenticated_recorder"]),
+      text(f.attrs["last_rejection_recorder"]))
 for n, g in f["observables/nodes"].items():
-    print(n, int(g.attrs["messages_rejected"]), int(g.attrs["chunks_rejected"]), text(g.attrs["last_rejection"]))
+    print(n, int(g.attrs["messages_rejected"]), int(g.attrs["chunks_rejected"]), int(g.attrs["messages_unauthenticated"]),
+          text(g.attrs["last_rejection"]))
 PY
 cat "$tmp/counts.txt"
 check '[[ $(awk "\$1 == \"recorder\" && \$2 > 100" "$tmp/counts.txt" | wc -l) == 1 ]]' "the recorder counted the bad messages it dropped"
 check '[[ $(awk "\$1 != \"recorder\" && \$2 > 50 && \$3 > 10" "$tmp/counts.txt" | wc -l) == 3 ]]' \
   "each of the 3 nodes counted the bad messages and chunks it dropped"
+check '[[ $(awk "\$4 == 0" "$tmp/counts.txt" | wc -l) == 4 ]]' "the insider's messages all passed the bus (none unauthenticated)"
+
+# The authenticated bus: attackers without the key.
+unauth() { # run.h5 -> "recorder sim overlap s4 clusters rejected" counts
+  $py -c "
+import h5py, sys
+f = h5py.File(sys.argv[1], 'r')
+n = f['observables/nodes']
+rejected = int(f.attrs['messages_rejected_recorder']) + sum(int(n[k].attrs['messages_rejected']) for k in n)
+print(int(f.attrs['messages_unauthenticated_recorder']), int(f.attrs['messages_unauthenticated_sim']),
+      *(int(n[k].attrs['messages_unauthenticated']) for k in ('overlap', 's4', 'clusters')), rejected)" "$1"
+}
+"$hostile" "$LCM_DEFAULT_URL" 4245 60 --forge-done >"$tmp/outsider.log" 2>&1 &
+hp=$!
+sleep 0.5
+"${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/outsider" --run-id 4245 >"$tmp/outsider_run.log" 2>&1 && rc=0 || rc=$?
+kill $hp 2>/dev/null || true
+read -r ur us uo u4 uc rej < <(unauth "$tmp/outsider/run.h5" 2>/dev/null || echo "0 0 0 0 0 -1")
+echo "attacker without the key: unauthenticated dropped by recorder $ur, sim $us, overlap $uo, s4 $u4, clusters $uc; malformed $rej"
+check '[[ $rc == 0 ]] && complete "$tmp/outsider/run.h5"' "attacker without the key: the run completes (exit $rc)"
+check '(( ur > 100 && uo > 100 && u4 > 100 && uc > 100 && rej == 0 ))' \
+  "attacker without the key: the recorder and every node drop all its messages as unauthenticated, none reach the content checks"
+check 'same "$tmp/clean/run.h5" "$tmp/outsider/run.h5"' "attacker without the key: results equal the clean run's bit for bit"
+"$hostile" "$LCM_DEFAULT_URL" 4246 60 --tamper >"$tmp/tamper.log" 2>&1 &
+hp=$!
+sleep 0.5
+"${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/tampered" --run-id 4246 >"$tmp/tampered_run.log" 2>&1 && rc=0 || rc=$?
+kill $hp 2>/dev/null || true
+wait $hp 2>/dev/null || true
+read -r ur us uo u4 uc rej < <(unauth "$tmp/tampered/run.h5" 2>/dev/null || echo "0 0 0 0 0 -1")
+echo "$(cat "$tmp/tamper.log"): unauthenticated dropped by recorder $ur, sim $us, overlap $uo, s4 $u4, clusters $uc; malformed $rej"
+check '[[ $rc == 0 ]] && complete "$tmp/tampered/run.h5"' "replayed, untagged and changed copies of the run's messages: the run completes (exit $rc)"
+check '(( ur > 100 && us > 10 && uo > 50 && u4 > 50 && uc > 50 && rej == 0 ))' \
+  "replayed, untagged and changed copies: dropped and counted as unauthenticated by the recorder, the sim (node statuses) and every node"
+check 'same "$tmp/clean/run.h5" "$tmp/tampered/run.h5"' "replayed, untagged and changed copies: results equal the clean run's bit for bit"
 
 # Genuine messages on another source's channel.
 "$hostile" "$LCM_DEFAULT_URL" 4244 60 --relay >"$tmp/relay.log" 2>&1 &
@@ -81,7 +130,7 @@ read -r dropped last < <($py -c "
 import h5py, sys
 f = h5py.File(sys.argv[1], 'r')
 t = lambda v: v.decode() if isinstance(v, bytes) else str(v)
-print(int(f.attrs['messages_rejected_recorder']), t(f.attrs['last_rejection_recorder']).replace(' ', '_'))" \
+print(int(f.attrs['messages_unauthenticated_recorder']), t(f.attrs['last_unauthenticated_recorder']).replace(' ', '_'))" \
   "$tmp/relayed/run.h5" 2>/dev/null || echo "0 none")
 echo "relayed ${relayed:-?} messages on other sources' channels; the recorder dropped $dropped (last: $last)"
 check '[[ $rc == 0 ]] && complete "$tmp/relayed/run.h5"' "relayed run: complete (run_scene.sh exit $rc)"
@@ -92,8 +141,8 @@ check '[[ $rc == 0 ]] && complete "$tmp/relayed/run.h5"' "relayed run: complete 
 # machine, so up to 5% here), and those the relay sends before it hears the
 # recorder's "done" (it relays nothing after that). None may be taken:
 # the results are checked bit for bit below.
-check '(( ${relayed:-0} > 300 && dropped <= relayed && 20 * dropped >= 19 * relayed )) && [[ $last == *channel,_which_is* ]]' \
-  "relayed run: the recorder dropped and counted every copy on another source's channel"
+check '(( ${relayed:-0} > 300 && dropped <= relayed && 20 * dropped >= 19 * relayed )) && [[ $last == *tag_does_not_match* ]]' \
+  "relayed run: the recorder dropped and counted every copy on another source's channel (the tag covers the channel)"
 check 'same "$tmp/clean/run.h5" "$tmp/relayed/run.h5"' "relayed run: results equal the clean run's bit for bit"
 
 # Two runs at once on one bus.
@@ -106,6 +155,10 @@ check '[[ $ra == 0 && $rb == 0 ]] && complete "$tmp/two_a/run.h5" && complete "$
   "two runs at once on one bus: both complete (exits $ra, $rb)"
 check 'same "$tmp/clean/run.h5" "$tmp/two_a/run.h5"' "two runs at once: the first equals the clean run bit for bit"
 check '! same "$tmp/two_a/run.h5" "$tmp/two_b/run.h5"' "two runs at once: the second has its own results"
+read -r ua _ uoa _ < <(unauth "$tmp/two_a/run.h5" 2>/dev/null || echo "0 0 0 0")
+read -r ub _ uob _ < <(unauth "$tmp/two_b/run.h5" 2>/dev/null || echo "0 0 0 0")
+check '(( ua > 0 && ub > 0 && uoa > 0 && uob > 0 ))' \
+  "two runs at once, two keys: each run's recorder and nodes drop the other's messages as unauthenticated ($ua, $ub, $uoa, $uob)"
 # A killed recorder: the file it leaves says incomplete (set at creation).
 sed 's/^origins = 4/origins = 40/' "$root/scenes/tiny.toml" >"$tmp/long.toml"
 "${run[@]}" "$tmp/long.toml" --out "$tmp/killed" --run-id 6001 >"$tmp/killed.log" 2>&1 &

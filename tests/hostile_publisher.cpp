@@ -20,6 +20,21 @@
 // other cutoff's, a0.6 <-> a1, the tiny scene's; another node's): genuine
 // messages whose channel disagrees with their own cutoff or node, which the
 // recorder and the sim must drop (channels carry one source each).
+//
+// The bus is authenticated (bus.hpp): without --key-file this publisher is
+// an attacker that knows the run id but not the run's key, and every
+// message it sends must be dropped as unauthenticated before any check of
+// its content. With --key-file KEY it holds the key (a process of the run
+// gone wrong): its messages pass the bus and meet the checks of their
+// content, as above.
+//
+// With --tamper (no key) it forges from the run's own traffic: every
+// message of the run it hears it sends back three ways on the same
+// channel: byte for byte (a replay), without its tag (a well-formed
+// message of this run, as an attacker who knows the run id writes one),
+// and with one byte of its content changed under the genuine tag. All
+// three must be dropped and counted, and the sim must not be paced by the
+// forged node statuses.
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -35,6 +50,7 @@
 
 #include <lcm/lcm-cpp.hpp>
 
+#include "dynhet/bus_auth.hpp"
 #include "dynhet/checkpoint_t.hpp"
 #include "dynhet/chi4_t.hpp"
 #include "dynhet/clusters_t.hpp"
@@ -49,6 +65,26 @@
 #include "dynhet/sim_status_t.hpp"
 
 namespace {
+
+// --key-file: everything sent is tagged with the run's key (an insider).
+std::unique_ptr<dynhet::BusSigner> g_signer;
+
+void send(lcm::LCM& lcm, const std::string& ch, const void* data, unsigned n) {
+  if (!g_signer) {
+    lcm.publish(ch, data, n);
+    return;
+  }
+  std::vector<uint8_t> b(static_cast<const uint8_t*>(data), static_cast<const uint8_t*>(data) + n);
+  b.resize(n + dynhet::kBusTagBytes);
+  g_signer->tag(ch, b.data(), n);
+  lcm.publish(ch, b.data(), static_cast<unsigned>(b.size()));
+}
+template <class M> void send(lcm::LCM& lcm, const std::string& ch, const M* m) {
+  const int n = m->getEncodedSize();
+  std::vector<uint8_t> b(n);
+  m->encode(b.data(), 0, n);
+  send(lcm, ch, b.data(), static_cast<unsigned>(n));
+}
 
 // Big-endian writer for hand-made encodings.
 struct Bytes {
@@ -71,7 +107,7 @@ template <class T> void random_after_fingerprint(lcm::LCM& lcm, const char* ch, 
   m.i64(T::getHash());
   const int n = static_cast<int>(gen() % 400);
   for (int i = 0; i < n; ++i) m.b.push_back(static_cast<uint8_t>(gen()));
-  lcm.publish(ch, m.b.data(), static_cast<unsigned>(m.b.size()));
+  send(lcm, ch, m.b.data(), static_cast<unsigned>(m.b.size()));
 }
 
 // A frame chunk header of run `run`, then n_values as declared and `have`
@@ -91,7 +127,7 @@ void chunk(lcm::LCM& lcm, int64_t run, int frame, int n_particles, int index, in
   m.i32(count);
   m.i32(n_values);
   for (int i = 0; i < have; ++i) m.f64(value);
-  lcm.publish("DYNHET_FRAME", m.b.data(), static_cast<unsigned>(m.b.size()));
+  send(lcm, "DYNHET_FRAME", m.b.data(), static_cast<unsigned>(m.b.size()));
 }
 
 dynhet::run_info_t bad_run_info(int64_t run) {
@@ -174,26 +210,79 @@ private:
   bool recorder_done_ = false;
 };
 
+// Sends every message of the run back three ways (--tamper): a replay, the
+// content without its tag, the content changed under the genuine tag.
+class Tamper {
+public:
+  explicit Tamper(lcm::LCM& lcm) : lcm_(lcm) {
+    lcm_.subscribe("DYNHET_.*", &Tamper::on_message, this)->setQueueCapacity(100000);
+  }
+  long forged() const { return forged_; }
+
+private:
+  void on_message(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+    const auto* p = static_cast<const uint8_t*>(rb->data);
+    const std::string bytes(reinterpret_cast<const char*>(p), rb->data_size);
+    if (!seen_.insert(bytes).second) return; // its own copies, back over the bus
+    const size_t n = rb->data_size;
+    if (n < dynhet::kBusTagBytes + 8 || std::memcmp(p + n - dynhet::kBusTagBytes, "DHT1", 4) != 0) return;
+    if (ch == "DYNHET_NODE_STATUS_recorder") {
+      dynhet::node_status_t m;
+      if (m.decode(p, 0, static_cast<int>(n - dynhet::kBusTagBytes)) > 0 && (m.state == "done" || m.state == "failed"))
+        recorder_done_ = true;
+    }
+    if (recorder_done_) return;
+    std::string replay = bytes, untagged = bytes.substr(0, n - dynhet::kBusTagBytes);
+    std::string changed = bytes;
+    changed[8 + (n - dynhet::kBusTagBytes - 8) / 2] ^= 0x01; // in the content, past the fingerprint
+    for (const std::string* f : {&replay, &untagged, &changed}) {
+      seen_.insert(*f);
+      lcm_.publish(ch, f->data(), static_cast<unsigned>(f->size()));
+      ++forged_;
+    }
+  }
+  lcm::LCM& lcm_;
+  std::set<std::string> seen_;
+  long forged_ = 0;
+  bool recorder_done_ = false;
+};
+
 } // namespace
 
 int main(int argc, char** argv) {
   if (argc < 4) {
-    std::fprintf(stderr, "usage: hostile_publisher URL RUN_ID SECONDS [--forge-done | --relay]\n");
+    std::fprintf(stderr, "usage: hostile_publisher URL RUN_ID SECONDS [--forge-done | --relay | --tamper] "
+                         "[--key-file KEY]\n");
     return 2;
   }
   lcm::LCM lcm(argv[1]);
   if (!lcm.good()) return 3;
   const int64_t run = std::stoll(argv[2]);
   const double seconds = std::stod(argv[3]);
-  const bool forge_done = argc > 4 && std::string(argv[4]) == "--forge-done";
-  if (argc > 4 && std::string(argv[4]) == "--relay") {
-    Relay relay(lcm);
+  bool forge_done = false, relay = false, tamper = false;
+  for (int i = 4; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--forge-done") forge_done = true;
+    else if (a == "--relay") relay = true;
+    else if (a == "--tamper") tamper = true;
+    else if (a == "--key-file" && i + 1 < argc) g_signer = std::make_unique<dynhet::BusSigner>(dynhet::BusKey::load(argv[++i]));
+    else {
+      std::fprintf(stderr, "hostile_publisher: unknown argument %s\n", a.c_str());
+      return 2;
+    }
+  }
+  if (relay || tamper) {
     std::signal(SIGTERM, on_signal);
     std::signal(SIGINT, on_signal);
     const auto t0 = std::chrono::steady_clock::now();
+    std::unique_ptr<Relay> r;
+    std::unique_ptr<Tamper> t;
+    if (relay) r = std::make_unique<Relay>(lcm);
+    else t = std::make_unique<Tamper>(lcm);
     while (!g_stop && std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < seconds)
       lcm.handleTimeout(100);
-    std::printf("hostile_publisher: relayed %ld messages to another source's channel\n", relay.relayed());
+    if (r) std::printf("hostile_publisher: relayed %ld messages to another source's channel\n", r->relayed());
+    else std::printf("hostile_publisher: forged %ld messages from the run's own\n", t->forged());
     return 0;
   }
   std::mt19937_64 gen(12345);
@@ -224,20 +313,20 @@ int main(int argc, char** argv) {
     dynhet::checkpoint_t ck{};
     ck.run_id = run;
     ck.process = "sim", ck.state = "save", ck.cut = 999999 - static_cast<int>(rounds % 7), ck.frame = 0;
-    lcm.publish("DYNHET_CHECKPOINT", &ck);
+    send(lcm, "DYNHET_CHECKPOINT", &ck);
     ck.cut = static_cast<int>(rounds % 5), ck.frame = 55; // an early number, a late frame
-    lcm.publish("DYNHET_CHECKPOINT", &ck);
+    send(lcm, "DYNHET_CHECKPOINT", &ck);
     ck.sim_time = nan;
-    lcm.publish("DYNHET_CHECKPOINT", &ck);
+    send(lcm, "DYNHET_CHECKPOINT", &ck);
     ck.sim_time = 1, ck.process = "../../etc", ck.state = "saved";
-    lcm.publish("DYNHET_CHECKPOINT_overlap", &ck);
+    send(lcm, "DYNHET_CHECKPOINT_overlap", &ck);
     ck.process = "sim", ck.state = "explode";
-    lcm.publish("DYNHET_CHECKPOINT", &ck);
+    send(lcm, "DYNHET_CHECKPOINT", &ck);
     for (const char* p : {"overlap", "s4", "clusters", "recorder"}) {
       ck.process = p, ck.state = "saved", ck.frame = static_cast<int>(rounds % 56);
       for (int c = 0; c < 3; ++c) {
         ck.cut = c;
-        lcm.publish(std::string("DYNHET_CHECKPOINT_") + p, &ck);
+        send(lcm, std::string("DYNHET_CHECKPOINT_") + p, &ck);
       }
     }
     // Declared lengths the message cannot hold: negative, and 2^31 - 1.
@@ -252,23 +341,23 @@ int main(int argc, char** argv) {
     chunk(lcm, run, 4, 300, 0, 3, 0, 128, 256, 256, nan);
     // Run info of this run with indices out of range.
     dynhet::run_info_t bad = bad_run_info(run);
-    lcm.publish("DYNHET_RUN", &bad);
+    send(lcm, "DYNHET_RUN", &bad);
     // Another run: its run info, a chunk and a "done".
     dynhet::run_info_t other = bad_run_info(run + 1);
     other.origin_frame = {0};
     other.pair_frame = {1, 2};
-    lcm.publish("DYNHET_RUN", &other);
+    send(lcm, "DYNHET_RUN", &other);
     chunk(lcm, run + 1, 0, 300, 0, 3, 0, 128, 256, 256, 1.0);
     dynhet::sim_status_t done{};
     done.run_id = run + 1;
     done.phase = "done";
-    lcm.publish("DYNHET_SIM_STATUS", &done);
+    send(lcm, "DYNHET_SIM_STATUS", &done);
     if (forge_done) {
       // This run's "done", saying every frame (or a negative count) is out:
       // nodes must neither end early nor give up frames still coming.
       done.run_id = run;
       done.frames_published = rounds % 2 ? INT32_MAX : -7;
-      lcm.publish("DYNHET_SIM_STATUS", &done);
+      send(lcm, "DYNHET_SIM_STATUS", &done);
     }
     ++rounds;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));

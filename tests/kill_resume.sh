@@ -192,6 +192,7 @@ bash "$root/launch_scripts/run_scene.sh" "$tmp/scene.toml" --out "$out" --run-id
   --test-node-delay 0.1 --record "$tmp/seg.lcmlog" >>"$out.log" 2>&1 || true
 check '[[ -s $tmp/seg.lcmlog && -s $tmp/seg.lcmlog.2 ]]' "each segment has its log (seg.lcmlog, seg.lcmlog.2)"
 bash "$root/launch_scripts/replay.sh" "$tmp/seg.lcmlog" "$tmp/seg.lcmlog.2" --out "$tmp/replayed" --no-build \
+  --key-file "$out/bus.key" \
   >"$tmp/replayed.log" 2>&1 || true
 check 'PYTHONPATH="$root/tests" $py -c "
 import sys

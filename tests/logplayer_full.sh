@@ -42,6 +42,7 @@ for attempt in 1 2 3; do
 done
 [[ -n $(result_counts "$tmp/live/recorder.log") ]] || { echo "FAIL the recorder says no messages per channel"; exit 1; }
 nodes=$("$bin/recorder" --list-nodes "$tmp/run.lcmlog")
+export DYNHET_KEY_FILE=$tmp/live/bus.key # the recorded run's key: the played messages carry its tags
 export LCM_DEFAULT_URL='udpm://239.255.76.67:7732?ttl=0&recv_buf_size=4194304'
 
 play() { # out dir, then the nodes to start: the recorder listens, the whole log is played

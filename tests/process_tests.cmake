@@ -71,7 +71,7 @@ set_tests_properties(q_fit_follows_the_data PROPERTIES LABELS process TIMEOUT 12
 # equal a clean run's bit for bit; a forged "done" does not end a node
 # early; two runs at once on one bus do not cross.
 add_executable(hostile_publisher hostile_publisher.cpp)
-target_link_libraries(hostile_publisher PRIVATE dynhet_lcmtypes)
+target_link_libraries(hostile_publisher PRIVATE dynhet_lcmtypes dynhet_common)
 add_test(NAME hostile_messages
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/hostile.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR} $<TARGET_FILE:hostile_publisher>)
 set_tests_properties(hostile_messages PROPERTIES LABELS process TIMEOUT 300)

@@ -4,6 +4,10 @@
 # without --run-id the replay is refused with the list; --run-id replays
 # that run bit for bit like its live run; a log that lacks frames is said
 # to before the replay starts, and the replay ends incomplete (non-zero).
+# The bus is authenticated (docs/bus.md): each run has its own key, so the
+# joined log holds messages that run 222's key does not verify: refused,
+# unless --only-verified (then run 222 alone is played); a log with a
+# replayed copy of a message, or a byte of one changed, is refused.
 # Private network namespaces throughout.
 set -euo pipefail
 root=$1 build=$2
@@ -32,7 +36,13 @@ check 'grep -q "run 111: N = 300, 56 of 56 frames whole" "$tmp/list.txt" && grep
   "--list names both runs and their frames"
 "${replay[@]}" "$tmp/two.lcmlog" --out "$tmp/r0" --no-build >"$tmp/r0.log" 2>&1 && rc=0 || rc=$?
 check '[[ $rc == 2 ]] && grep -q "holds 2 runs; choose one with --run-id" "$tmp/r0.log"' "a log of two runs without --run-id is refused (exit $rc)"
-"${replay[@]}" "$tmp/two.lcmlog" --out "$tmp/r222" --run-id 222 --no-build >"$tmp/r222.log" 2>&1 && rc=0 || rc=$?
+"${replay[@]}" "$tmp/two.lcmlog" --out "$tmp/r222x" --run-id 222 --key-file "$tmp/live222/bus.key" --no-build \
+  >"$tmp/r222x.log" 2>&1 && rc=0 || rc=$?
+check '[[ $rc == 2 ]] && grep -q "do not verify" "$tmp/r222x.log" && [[ ! -e $tmp/r222x/run.h5 ]]' \
+  "the joined log with run 222's key: refused, its other run's messages do not verify (exit $rc)"
+"${replay[@]}" "$tmp/two.lcmlog" --out "$tmp/r222" --run-id 222 --key-file "$tmp/live222/bus.key" --only-verified \
+  --no-build >"$tmp/r222.log" 2>&1 && rc=0 || rc=$?
+check 'grep -qE "[0-9]+ messages verify, [1-9][0-9]+ do not" "$tmp/r222.log"' "--only-verified says how many messages did not verify"
 check '[[ $rc == 0 ]] && PYTHONPATH="$root/tests" /usr/bin/python3 -c "
 import sys
 from compare_runs import final_results, same
@@ -53,9 +63,31 @@ while pos + 28 <= len(data):
     pos += 28 + clen + dlen
 open(sys.argv[2], "wb").write(out)
 PY
-"${replay[@]}" "$tmp/holes.lcmlog" --out "$tmp/rh" --no-build >"$tmp/rh.log" 2>&1 && rc=0 || rc=$?
+"${replay[@]}" "$tmp/holes.lcmlog" --out "$tmp/rh" --key-file "$tmp/live222/bus.key" --no-build >"$tmp/rh.log" 2>&1 && rc=0 || rc=$?
 check 'grep -q "the log lacks 2 of 56 frames of run 222" "$tmp/rh.log"' "a log lacking frames is said to before the replay"
 check '[[ $rc != 0 ]] && /usr/bin/python3 -c "import h5py, sys; sys.exit(0 if int(h5py.File(sys.argv[1], \"r\").attrs[\"complete\"]) == 0 else 1)" "$tmp/rh/run.h5"' \
   "its replay is marked incomplete and exits non-zero (exit $rc)"
+# A replayed copy of one message, and one byte of another changed: refused.
+for how in copy change; do
+  /usr/bin/python3 - "$tmp/r222.lcmlog" "$tmp/$how.lcmlog" $how <<'PY'
+import struct, sys
+data = open(sys.argv[1], "rb").read()
+out, pos, done = bytearray(), 0, False
+while pos + 28 <= len(data):
+    _, _, _, clen, dlen = struct.unpack_from(">IqqII", data, pos)
+    ev = bytearray(data[pos:pos + 28 + clen + dlen])
+    out += ev
+    if not done and data[pos + 28:pos + 28 + clen] == b"DYNHET_SIM_STATUS":
+        if sys.argv[3] == "copy":
+            out += ev  # the same message twice
+        else:
+            out[len(out) - 60] ^= 1  # a byte of its content, under the genuine tag
+        done = True
+    pos += 28 + clen + dlen
+open(sys.argv[2], "wb").write(out)
+PY
+  "${replay[@]}" "$tmp/$how.lcmlog" --out "$tmp/r$how" --key-file "$tmp/live222/bus.key" --no-build >"$tmp/r$how.log" 2>&1 && rc=0 || rc=$?
+  check '[[ $rc == 2 ]] && grep -q "do not verify" "$tmp/r$how.log"' "a log with a message ${how}d is refused (exit $rc): $(grep -o "[0-9]* messages verify.*" "$tmp/r$how.log")"
+done
 ((fail == 0)) || { cat "$tmp/list.txt"; for f in "$tmp"/r*.log "$tmp"/live*.log; do echo "== $f"; tail -n 12 "$f"; done; }
 exit $fail

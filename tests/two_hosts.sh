@@ -48,7 +48,13 @@ url='udpm://239.255.76.67:7715?ttl=1'
 ip netns exec "$nb" "${scene[@]}" --bus lan --url "$url" --role analysis --run-id 777 --out "$tmp/b" >"$tmp/b.log" 2>&1 &
 analysis=$!
 for _ in $(seq 100); do grep -q "waiting for run 777" "$tmp/b.log" 2>/dev/null && break; sleep 0.1; done
-ip netns exec "$na" "${scene[@]}" --bus lan --url "$url" --role sim --run-id 777 --out "$tmp/a" >"$tmp/a.log" 2>&1 && rc=0 || rc=$?
+# The run's key, made by the analysis host, copied to the sim's (docs/bus.md).
+check '[[ -f $tmp/b/bus.key && $(stat -c %a "$tmp/b/bus.key") == 600 ]]' "the analysis host wrote the run's key (mode 600)"
+ip netns exec "$na" "${scene[@]}" --bus lan --url "$url" --role sim --run-id 777 --out "$tmp/a" >"$tmp/a0.log" 2>&1 && rc=0 || rc=$?
+check '[[ $rc == 2 ]] && grep -q "role sim needs --key-file" "$tmp/a0.log"' "--role sim without the run's key is refused"
+mkdir -p "$tmp/a" && cp -p "$tmp/b/bus.key" "$tmp/a/copied.key"
+ip netns exec "$na" "${scene[@]}" --bus lan --url "$url" --role sim --run-id 777 --out "$tmp/a" --key-file "$tmp/a/copied.key" \
+  >"$tmp/a.log" 2>&1 && rc=0 || rc=$?
 check '[[ $rc == 0 ]]' "the sim on host A ran (exit $rc)"
 wait "$analysis" && rc=0 || rc=$?
 check '[[ $rc == 0 ]]' "the analysis on host B ended well (exit $rc)"

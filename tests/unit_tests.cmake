@@ -9,6 +9,10 @@ target_compile_definitions(test_scene PRIVATE DYNHET_SOURCE_DIR="${PROJECT_SOURC
 add_executable(test_state_archive ${CMAKE_CURRENT_SOURCE_DIR}/test_state_archive.cpp)
 target_link_libraries(test_state_archive PRIVATE dynhet_analysis dynhet_common GTest::gtest_main)
 gtest_discover_tests(test_state_archive DISCOVERY_TIMEOUT 30 PROPERTIES LABELS unit)
+# The authenticated bus: key files, tags, replays (bus_auth, bus.hpp).
+add_executable(test_bus_auth ${CMAKE_CURRENT_SOURCE_DIR}/test_bus_auth.cpp)
+target_link_libraries(test_bus_auth PRIVATE dynhet_common dynhet_lcmtypes GTest::gtest_main)
+gtest_discover_tests(test_bus_auth DISCOVERY_TIMEOUT 30 PROPERTIES LABELS unit)
 # The bounded queue between a node's receive thread and its compute thread.
 add_executable(test_inbox ${CMAKE_CURRENT_SOURCE_DIR}/test_inbox.cpp)
 target_link_libraries(test_inbox PRIVATE dynhet_node dynhet_common GTest::gtest_main)

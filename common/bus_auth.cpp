@@ -1,0 +1,183 @@
+// Keys, tags and their checks for the authenticated bus (bus_auth.hpp).
+#include "dynhet/bus_auth.hpp"
+
+#include <sodium.h>
+
+#include <cerrno>
+#include <cstring>
+#include <fcntl.h>
+#include <stdexcept>
+#include <sys/stat.h>
+#include <unistd.h>
+
+namespace dynhet {
+namespace {
+
+constexpr unsigned char kMagic[4] = {'D', 'H', 'T', '1'};
+constexpr char kDomain[] = "dynhet bus tag v1"; // with its terminating zero
+
+void init_sodium() {
+  static const int ok = sodium_init(); // thread-safe, idempotent
+  if (ok < 0) throw std::runtime_error("libsodium failed to initialise");
+}
+
+void put_u64(unsigned char* p, std::uint64_t v) {
+  for (int i = 0; i < 8; ++i) p[i] = static_cast<unsigned char>(v >> (8 * i));
+}
+std::uint64_t get_u64(const unsigned char* p) {
+  std::uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v |= std::uint64_t{p[i]} << (8 * i);
+  return v;
+}
+
+// The tag of (channel, head = magic | sender | sequence, payload).
+void compute_tag(const BusKey& key, const std::string& channel, const unsigned char* head, const void* payload,
+                 std::size_t n, unsigned char* tag) {
+  crypto_generichash_state st;
+  crypto_generichash_init(&st, key.data(), BusKey::kBytes, 32);
+  crypto_generichash_update(&st, reinterpret_cast<const unsigned char*>(kDomain), sizeof kDomain);
+  unsigned char len[8];
+  put_u64(len, channel.size());
+  crypto_generichash_update(&st, len, sizeof len);
+  crypto_generichash_update(&st, reinterpret_cast<const unsigned char*>(channel.data()), channel.size());
+  crypto_generichash_update(&st, head, 20);
+  crypto_generichash_update(&st, static_cast<const unsigned char*>(payload), n);
+  crypto_generichash_final(&st, tag, 32);
+  sodium_memzero(&st, sizeof st);
+}
+
+std::string errno_text() { return std::strerror(errno); }
+
+} // namespace
+
+BusKey::~BusKey() { sodium_memzero(key_.data(), key_.size()); }
+
+std::shared_ptr<const BusKey> BusKey::load(const std::string& path) {
+  init_sodium();
+  const std::string what = "key file " + path + ": ";
+  const int fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+  if (fd < 0) throw std::runtime_error(what + "cannot be opened (" + errno_text() + ")");
+  struct Closer {
+    int fd;
+    ~Closer() { ::close(fd); }
+  } closer{fd};
+  struct stat s {};
+  if (::fstat(fd, &s) != 0) throw std::runtime_error(what + "cannot be read (" + errno_text() + ")");
+  if (!S_ISREG(s.st_mode)) throw std::runtime_error(what + "not a regular file");
+  if (s.st_mode & (S_IRWXG | S_IRWXO))
+    throw std::runtime_error(what + "readable or writable by others (mode " +
+                             std::to_string((s.st_mode >> 6) & 7) + std::to_string((s.st_mode >> 3) & 7) +
+                             std::to_string(s.st_mode & 7) + "): the key must be its owner's alone (chmod 600)");
+  if (s.st_size == 0) throw std::runtime_error(what + "empty");
+  if (s.st_size != static_cast<off_t>(kBytes))
+    throw std::runtime_error(what + std::to_string(s.st_size) + " bytes, not " + std::to_string(kBytes) +
+                             " (a key is 32 random bytes: run_scene.sh writes one)");
+  std::array<unsigned char, kBytes> bytes{};
+  std::size_t got = 0;
+  while (got < kBytes) {
+    const ssize_t r = ::read(fd, bytes.data() + got, kBytes - got);
+    if (r < 0 && errno == EINTR) continue;
+    if (r <= 0) throw std::runtime_error(what + "cannot be read (" + (r < 0 ? errno_text() : "short") + ")");
+    got += static_cast<std::size_t>(r);
+  }
+  auto key = std::make_shared<const BusKey>(bytes);
+  sodium_memzero(bytes.data(), bytes.size());
+  return key;
+}
+
+void BusKey::create(const std::string& path) {
+  init_sodium();
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC | O_NOFOLLOW, 0600);
+  if (fd < 0) throw std::runtime_error("key file " + path + ": cannot be created (" + errno_text() + ")");
+  unsigned char bytes[kBytes];
+  randombytes_buf(bytes, kBytes);
+  const bool ok = ::fchmod(fd, 0600) == 0 && ::write(fd, bytes, kBytes) == static_cast<ssize_t>(kBytes) &&
+                  ::fsync(fd) == 0;
+  sodium_memzero(bytes, kBytes);
+  const std::string err = errno_text();
+  ::close(fd);
+  if (!ok) {
+    ::unlink(path.c_str());
+    throw std::runtime_error("key file " + path + ": cannot be written (" + err + ")");
+  }
+}
+
+BusSigner::BusSigner(std::shared_ptr<const BusKey> key) : key_(std::move(key)) {
+  if (!key_) throw std::invalid_argument("BusSigner: no key");
+  init_sodium();
+  randombytes_buf(&sender_, sizeof sender_);
+}
+
+void BusSigner::tag(const std::string& channel, std::uint8_t* message, std::size_t n) {
+  std::uint64_t seq;
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    seq = ++sequence_;
+  }
+  unsigned char* head = message + n;
+  std::memcpy(head, kMagic, 4);
+  put_u64(head + 4, sender_);
+  put_u64(head + 12, seq);
+  compute_tag(*key_, channel, head, message, n, head + 20);
+}
+
+BusVerifier::BusVerifier(std::shared_ptr<const BusKey> key) : key_(std::move(key)) {
+  if (!key_) throw std::invalid_argument("BusVerifier: no key");
+  init_sodium();
+}
+
+const char* BusVerifier::what(Verdict v) {
+  switch (v) {
+  case Verdict::ok: return "authentic";
+  case Verdict::untagged: return "unauthenticated: no tag of this bus";
+  case Verdict::bad_tag: return "unauthenticated: its tag does not match (not signed with this run's key)";
+  case Verdict::replayed: return "unauthenticated: a replay (this sender's sequence number was seen before)";
+  }
+  return "?";
+}
+
+BusVerifier::Verdict BusVerifier::verify(const std::string& channel, const void* data, std::size_t n,
+                                         std::size_t& payload) {
+  payload = 0;
+  if (n < kBusTagBytes) return Verdict::untagged;
+  const auto* bytes = static_cast<const unsigned char*>(data);
+  const std::size_t at = n - kBusTagBytes;
+  const unsigned char* head = bytes + at;
+  if (std::memcmp(head, kMagic, 4) != 0) return Verdict::untagged;
+  unsigned char tag[32];
+  compute_tag(*key_, channel, head, bytes, at, tag);
+  if (crypto_verify_32(tag, head + 20) != 0) return Verdict::bad_tag; // constant time
+  if (!take(get_u64(head + 4), get_u64(head + 12))) return Verdict::replayed;
+  payload = at;
+  return Verdict::ok;
+}
+
+bool BusVerifier::take(std::uint64_t sender, std::uint64_t seq) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  Window& w = windows_[sender];
+  auto bit = [&](std::uint64_t s) -> std::pair<std::uint64_t&, std::uint64_t> {
+    return {w.seen[(s % kWindow) / 64], std::uint64_t{1} << (s % 64)};
+  };
+  if (seq == 0) return false; // sequences count from 1
+  if (seq > w.top) {
+    // Forget what leaves the window: the slots of top+1 .. seq.
+    const std::uint64_t steps = seq - w.top;
+    if (steps >= kWindow) w.seen.fill(0);
+    else
+      for (std::uint64_t s = w.top + 1; s <= seq; ++s) {
+        auto [word, mask] = bit(s);
+        word &= ~mask;
+      }
+    w.top = seq;
+    auto [word, mask] = bit(seq);
+    word |= mask;
+    return true;
+  }
+  if (w.top - seq >= kWindow) return false; // too old to tell: dropped
+  auto [word, mask] = bit(seq);
+  if (word & mask) return false;
+  word |= mask;
+  return true;
+}
+
+} // namespace dynhet

@@ -1,0 +1,105 @@
+// An authenticated bus (issue 30): only the processes that hold a run's key
+// can put messages into it.
+//
+// LCM has no authentication of its own, and every process on the host (or,
+// with --bus lan, on the LAN) can publish on a run's channels with its run
+// id, which travels in clear. So each run has a secret, 32 random bytes in a
+// file only its owner can read (run_scene.sh creates DIR/bus.key), and every
+// message carries a tag after its LCM bytes:
+//
+//   LCM bytes | "DHT1" | sender (8 bytes) | sequence (8) | tag (32)
+//
+// tag = keyed BLAKE2b-256 (libsodium's crypto_generichash) over a domain
+// string, the channel's name, the sender, the sequence number and the LCM
+// bytes, which hold the run id (every dynhet message carries it). The
+// sender is 8 random bytes drawn when a process starts; its sequence counts
+// from 1. A receiver checks the tag before it decodes anything (in constant
+// time) and drops a message with no tag, a wrong tag, or a (sender,
+// sequence) it has already taken (a window of the last 1024 per sender:
+// LCM over UDP may deliver a sender's messages on different channels a
+// little out of order, never one twice).
+//
+// What it does not stop: a process restarted alone (a node resumed by hand)
+// draws a new sender, and a receiver that started after it cannot tell a
+// replay of an earlier process's message from a first copy. Such a replay
+// is a genuine message of the run, and the checks every message already
+// gets (frame numbers, cut numbers, results taken once) still apply.
+//
+// Tools that only watch (lcm-spy, lcm-logger) see the LCM bytes first and
+// ignore the tail.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <unordered_map>
+#include <vector>
+
+namespace dynhet {
+
+class BusKey {
+public:
+  static constexpr std::size_t kBytes = 32;
+  // Reads the key file: a regular file of exactly 32 bytes that neither its
+  // group nor others may read or write. Throws std::runtime_error naming
+  // the file and what is wrong with it (missing, empty, wrong size, mode).
+  static std::shared_ptr<const BusKey> load(const std::string& path);
+  // A new random key in path (created, never overwritten; mode 0600;
+  // flushed to disk). Throws if path exists or cannot be written.
+  static void create(const std::string& path);
+  // From bytes (tests).
+  explicit BusKey(const std::array<unsigned char, kBytes>& bytes) : key_(bytes) {}
+  ~BusKey();
+  BusKey(const BusKey&) = delete;
+  BusKey& operator=(const BusKey&) = delete;
+  const unsigned char* data() const { return key_.data(); }
+
+private:
+  std::array<unsigned char, kBytes> key_{};
+};
+
+constexpr std::size_t kBusTagBytes = 4 + 8 + 8 + 32; // what a tag adds to a message
+
+// Tags messages for one process (one sender); thread-safe.
+class BusSigner {
+public:
+  explicit BusSigner(std::shared_ptr<const BusKey> key);
+  // Writes the tag of message[0, n) (the LCM encoding) at message + n:
+  // message must hold n + kBusTagBytes bytes.
+  void tag(const std::string& channel, std::uint8_t* message, std::size_t n);
+  std::uint64_t sender() const { return sender_; }
+
+private:
+  std::shared_ptr<const BusKey> key_;
+  std::uint64_t sender_;
+  std::mutex mutex_;
+  std::uint64_t sequence_ = 0;
+};
+
+// Checks the tags of messages received on one process's subscriptions;
+// thread-safe.
+class BusVerifier {
+public:
+  enum class Verdict { ok, untagged, bad_tag, replayed };
+  explicit BusVerifier(std::shared_ptr<const BusKey> key);
+  // ok: the message is genuine and new; its LCM bytes are the first
+  // `payload` bytes. Anything else: drop it (what() says why).
+  Verdict verify(const std::string& channel, const void* data, std::size_t n, std::size_t& payload);
+  static const char* what(Verdict v);
+  static constexpr std::uint64_t kWindow = 1024;
+
+private:
+  struct Window {
+    std::uint64_t top = 0;                      // highest sequence taken
+    std::array<std::uint64_t, kWindow / 64> seen{}; // bit (s % kWindow): s taken, for s in (top - kWindow, top]
+  };
+  bool take(std::uint64_t sender, std::uint64_t sequence);
+  std::shared_ptr<const BusKey> key_;
+  std::mutex mutex_;
+  std::unordered_map<std::uint64_t, Window> windows_;
+};
+
+} // namespace dynhet

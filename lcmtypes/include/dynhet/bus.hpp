@@ -1,0 +1,101 @@
+// A process's side of the authenticated bus (dynhet/bus_auth.hpp, issue 30):
+// every message it publishes is tagged with the run's key, and every
+// message it receives is checked before it is decoded.
+#pragma once
+
+#include <lcm/lcm-cpp.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "dynhet/bus_auth.hpp"
+
+namespace dynhet {
+
+class Bus {
+public:
+  // The key file (--key-file) or, explicitly, none (--unauthenticated):
+  // exactly one of them. Throws std::runtime_error with a message for the
+  // user (the program's name first) otherwise, and on a bad key file.
+  static Bus from_options(const std::string& program, const std::string& key_file, bool unauthenticated) {
+    if (key_file.empty() && !unauthenticated)
+      throw std::runtime_error(program + ": --key-file FILE is required (the run's key: run_scene.sh writes "
+                                         "DIR/bus.key), or --unauthenticated to use an open bus on purpose");
+    if (!key_file.empty() && unauthenticated)
+      throw std::runtime_error(program + ": --key-file and --unauthenticated exclude each other");
+    Bus b;
+    if (!key_file.empty()) {
+      std::shared_ptr<const BusKey> key;
+      try {
+        key = BusKey::load(key_file);
+      } catch (const std::exception& e) {
+        throw std::runtime_error(program + ": " + e.what());
+      }
+      b.signer_ = std::make_shared<BusSigner>(key);
+      b.verifier_ = std::make_shared<BusVerifier>(key);
+    }
+    return b;
+  }
+  static Bus open_bus() { return Bus{}; } // unauthenticated (tests, tools)
+  explicit Bus(std::shared_ptr<const BusKey> key)
+      : signer_(std::make_shared<BusSigner>(key)), verifier_(std::make_shared<BusVerifier>(key)) {}
+
+  bool authenticated() const { return signer_ != nullptr; }
+  const char* describe() const { return authenticated() ? "authenticated (the run's key)" : "UNAUTHENTICATED"; }
+
+  // Encodes m, tags it and publishes it; LCM's result (0: sent), -1 if m
+  // does not encode.
+  template <class M> int publish(lcm::LCM& lcm, const std::string& channel, const M& m) const {
+    if (!signer_) return lcm.publish(channel, &m);
+    const int n = m.getEncodedSize();
+    if (n < 0) return -1;
+    thread_local std::vector<std::uint8_t> buf;
+    buf.resize(static_cast<std::size_t>(n) + kBusTagBytes);
+    if (m.encode(buf.data(), 0, n) != n) return -1;
+    signer_->tag(channel, buf.data(), static_cast<std::size_t>(n));
+    return lcm.publish(channel, buf.data(), static_cast<unsigned int>(buf.size()));
+  }
+
+  // The LCM bytes of a received message: true, with their length in size;
+  // false, with why, if it must be dropped (no tag, a wrong one, a replay).
+  // On an unauthenticated bus every message is taken as it is.
+  bool open(const std::string& channel, const void* data, std::size_t n, int& size, std::string& why) const {
+    if (!verifier_) {
+      size = static_cast<int>(n);
+      return true;
+    }
+    std::size_t payload = 0;
+    const BusVerifier::Verdict v = verifier_->verify(channel, data, n, payload);
+    if (v != BusVerifier::Verdict::ok) {
+      why = BusVerifier::what(v);
+      return false;
+    }
+    size = static_cast<int>(payload);
+    return true;
+  }
+
+private:
+  Bus() = default;
+  std::shared_ptr<BusSigner> signer_;
+  std::shared_ptr<BusVerifier> verifier_;
+};
+
+// The LCM bytes of a message that may carry a tag, without checking the
+// tag: only for tools that read a log to learn what it holds (which nodes a
+// replay needs); whatever takes part in a run checks with Bus::open.
+inline std::size_t lcm_bytes_of(const void* data, std::size_t n) {
+  const auto* b = static_cast<const unsigned char*>(data);
+  if (n >= kBusTagBytes && b[n - kBusTagBytes] == 'D' && b[n - kBusTagBytes + 1] == 'H' &&
+      b[n - kBusTagBytes + 2] == 'T' && b[n - kBusTagBytes + 3] == '1')
+    return n - kBusTagBytes;
+  return n;
+}
+
+// Whether a drop reason is the bus's (counted as unauthenticated) rather
+// than a malformed message's.
+inline bool unauthenticated_reason(const std::string& why) { return why.rfind("unauthenticated", 0) == 0; }
+
+} // namespace dynhet
