@@ -96,14 +96,21 @@ void FrameNode::input_ended() {
   finish(1, info_ ? "input ended before the run did" : "no run info in the input");
 }
 
+void FrameNode::note_unauthenticated(const std::string& channel, const std::string& why) {
+  ++unauthenticated_new_;
+  const int64_t n = ++unauthenticated_said_;
+  if (n <= 10 || n % 1000 == 0)
+    std::fprintf(stderr, "%s_node: dropped a message on %s (%s; %lld so far)\n", name_.c_str(), channel.c_str(),
+                 why.c_str(), static_cast<long long>(n));
+}
+
+void FrameNode::drain_unauthenticated() {
+  if (const int64_t d = unauthenticated_new_.exchange(0))
+    status_.messages_unauthenticated =
+        static_cast<int32_t>(std::min<int64_t>(int64_t{status_.messages_unauthenticated} + d, INT32_MAX));
+}
+
 void FrameNode::reject(const std::string& channel, const std::string& why) {
-  if (unauthenticated_reason(why)) { // the bus's: counted apart, never used
-    ++status_.messages_unauthenticated;
-    if (status_.messages_unauthenticated <= 10 || status_.messages_unauthenticated % 1000 == 0)
-      std::fprintf(stderr, "%s_node: dropped a message on %s (%s; %d so far)\n", name_.c_str(), channel.c_str(),
-                   why.c_str(), status_.messages_unauthenticated);
-    return;
-  }
   ++status_.messages_rejected;
   status_.last_rejection = channel + ": " + why;
   if (status_.messages_rejected <= 10 || status_.messages_rejected % 1000 == 0)
@@ -117,9 +124,8 @@ template <class Msg, class Fn>
 static void guarded(FrameNode& node, const lcm::ReceiveBuffer* rb, const std::string& ch, Fn&& fn) {
   Msg m;
   std::string why;
-  int size = 0;
-  if (!node.bus().open(ch, rb->data, rb->data_size, size, why)) return node.reject(ch, why);
-  if (!guard::safe_decode(rb->data, size, m, why)) return node.reject(ch, why);
+  // The receive thread checked the tag and queued the LCM bytes alone.
+  if (!guard::safe_decode(rb->data, static_cast<int>(rb->data_size), m, why)) return node.reject(ch, why);
   try {
     fn(m);
   } catch (const std::exception& e) {
@@ -296,6 +302,7 @@ void FrameNode::on_frame(const Frame& f) {
 }
 
 void FrameNode::publish_status() {
+  drain_unauthenticated();
   status_.utime = utime_now();
   status_.frames_whole = assembler_.frames_whole();
   status_.frames_lost = assembler_.frames_lost();
@@ -362,7 +369,10 @@ void on_node_signal(int sig) { g_node_signal = sig; }
 // of dropping.
 class Receiver {
 public:
-  Receiver(lcm::LCM& in, Inbox& inbox, bool replay) : in_(in), inbox_(inbox), replay_(replay) {
+  // Each message's tag is checked here, before it takes room in the queue:
+  // forgeries cannot crowd genuine frames out of it.
+  Receiver(lcm::LCM& in, Inbox& inbox, bool replay, FrameNode& node)
+      : in_(in), inbox_(inbox), replay_(replay), node_(node) {
     in_.subscribe(kChanRun, &Receiver::on_message, this);
     // LCM's own queue between its socket thread and handle(): deep, though
     // this thread empties it at once.
@@ -396,13 +406,16 @@ private:
   }
   void on_message(const lcm::ReceiveBuffer* rb, const std::string& ch) {
     const auto* p = static_cast<const uint8_t*>(rb->data);
-    inbox_.push(Inbox::Message{ch, std::vector<uint8_t>(p, p + rb->data_size), rb->recv_utime}, ch == kChanFrame,
-                replay_);
+    int size = 0;
+    std::string why;
+    if (!node_.bus().open(ch, rb->data, rb->data_size, size, why)) return node_.note_unauthenticated(ch, why);
+    inbox_.push(Inbox::Message{ch, std::vector<uint8_t>(p, p + size), rb->recv_utime}, ch == kChanFrame, replay_);
   }
 
   lcm::LCM& in_;
   Inbox& inbox_;
   bool replay_;
+  FrameNode& node_;
   std::atomic<bool> stop_{false};
   std::thread thread_;
 };
@@ -422,9 +435,12 @@ int node_main(const std::string& program, const std::string& description, NodeFa
   bool unauthenticated = false;
   app.add_option("--key-file", key_file,
                  "the run's key (32 bytes, mode 0600; run_scene.sh writes DIR/bus.key): every message received is "
-                 "checked with it before it is decoded, every message published is tagged (docs/bus.md); default $DYNHET_KEY_FILE")
-      ->envname("DYNHET_KEY_FILE");
+                 "checked with it before it is decoded, every message published is tagged (docs/bus.md); default $DYNHET_KEY_FILE");
   app.add_flag("--unauthenticated", unauthenticated, "no key: an open bus, on purpose (tests, tools)");
+  std::string bus_epoch;
+  app.add_option("--bus-epoch", bus_epoch,
+                 "this launch's number (run_scene.sh draws one per start and resume): only its messages are taken; "
+                 "\"any\" takes every launch's (a replay)");
   app.add_option("--wait-run", wait_run, "give up after this many seconds without run info");
   app.add_option("--sim-timeout", sim_timeout, "give up if the sim is silent this long (s) during a run");
   int64_t max_queue_mib = 1024;
@@ -450,7 +466,7 @@ int node_main(const std::string& program, const std::string& description, NodeFa
 
   std::optional<Bus> bus;
   try {
-    bus.emplace(Bus::from_options(program, key_file, unauthenticated));
+    bus.emplace(Bus::from_options(program, key_file, unauthenticated, bus_epoch));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;
@@ -478,7 +494,7 @@ int node_main(const std::string& program, const std::string& description, NodeFa
     std::signal(SIGINT, on_node_signal);
     std::signal(SIGTERM, on_node_signal);
   }
-  Receiver receiver(in, inbox, replay); // stopped and joined before inbox, node and buses go
+  Receiver receiver(in, inbox, replay, *node); // stopped and joined before inbox, node and buses go
 
   std::fprintf(stderr, "%s: ready, reading %s (bus %s)\n", program.c_str(), in_url.c_str(), bus->describe());
   const auto start = FrameNode::Clock::now();

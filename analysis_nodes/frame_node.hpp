@@ -19,6 +19,7 @@
 
 #include <optional>
 
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <map>
@@ -62,6 +63,10 @@ public:
   // The bus's side of this node: its key (or none, --unauthenticated).
   void set_bus(Bus bus) { bus_ = std::move(bus); }
   const Bus& bus() const { return bus_; }
+  // A message the receive thread dropped before it reached the queue (no
+  // tag, a wrong one, a replay: bus.hpp): counted, said (the first ten,
+  // then every thousandth), never queued. Thread-safe.
+  void note_unauthenticated(const std::string& channel, const std::string& why);
   bool has_run() const { return info_ != nullptr; }
   int exit_code() const { return exit_code_; }
   // The sim publishes its status every second; silence longer than
@@ -165,6 +170,8 @@ private:
   static constexpr double kChunkGrace = 2.0;
   void publish_status();
   void finish(int code, const std::string& why);
+  void drain_unauthenticated(); // the receive thread's count into the status (compute thread)
+  std::atomic<int64_t> unauthenticated_new_{0}, unauthenticated_said_{0};
 
   // Checkpoint cuts.
   void on_checkpoint(const checkpoint_t& m);

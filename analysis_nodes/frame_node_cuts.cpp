@@ -59,6 +59,7 @@ void FrameNode::save_cut(int frame, const Boundary& b) {
   const auto t0 = Clock::now();
   try {
     assembler_.give_up_before(frame + 1); // frames up to the boundary are settled
+    drain_unauthenticated();
     StateOut out;
     base_state(out);
     save_state(out);

@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
   std::mt19937 g(1);
   for (auto& c : k) c = static_cast<unsigned char>(g());
   auto key = std::make_shared<const dynhet::BusKey>(k);
-  dynhet::BusSigner signer(key);
+  dynhet::BusSigner signer(key, 0);
   std::printf("# one core, median of %d; tag: BusSigner::tag, check: BusVerifier::verify (a fresh window each time)\n",
               reps);
   std::printf("%12s %12s %12s %12s\n", "bytes", "tag_ms", "check_ms", "MB/s_check");
@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
     const double ts = seconds_of([&] { signer.tag("DYNHET_FRAME", m.data(), n); }, reps);
     const double tv = seconds_of(
         [&] {
-          dynhet::BusVerifier v(key);
+          dynhet::BusVerifier v(key, 0);
           std::size_t payload;
           if (v.verify("DYNHET_FRAME", m.data(), m.size(), payload) != dynhet::BusVerifier::Verdict::ok) std::abort();
         },
@@ -66,7 +66,7 @@ int main(int argc, char** argv) {
     const double ts = seconds_of([&] { for (long c = 0; c < chunks; ++c) signer.tag("DYNHET_FRAME", m.data(), bytes); }, reps);
     const double tv = seconds_of(
         [&] {
-          dynhet::BusVerifier v(key);
+          dynhet::BusVerifier v(key, 0);
           std::size_t payload;
           for (long c = 0; c < chunks; ++c) {
             signer.tag("DYNHET_FRAME", m.data(), bytes);

@@ -13,7 +13,8 @@
 namespace dynhet {
 namespace {
 
-constexpr unsigned char kMagic[4] = {'D', 'H', 'T', '1'};
+constexpr unsigned char kMagic[4] = {'D', 'H', 'T', '2'};
+constexpr std::size_t kHead = 4 + 8 + 8 + 8; // magic, epoch, sender, sequence
 constexpr char kDomain[] = "dynhet bus tag v1"; // with its terminating zero
 
 void init_sodium() {
@@ -30,7 +31,7 @@ std::uint64_t get_u64(const unsigned char* p) {
   return v;
 }
 
-// The tag of (channel, head = magic | sender | sequence, payload).
+// The tag of (channel, head = magic | epoch | sender | sequence, payload).
 void compute_tag(const BusKey& key, const std::string& channel, const unsigned char* head, const void* payload,
                  std::size_t n, unsigned char* tag) {
   crypto_generichash_state st;
@@ -40,7 +41,7 @@ void compute_tag(const BusKey& key, const std::string& channel, const unsigned c
   put_u64(len, channel.size());
   crypto_generichash_update(&st, len, sizeof len);
   crypto_generichash_update(&st, reinterpret_cast<const unsigned char*>(channel.data()), channel.size());
-  crypto_generichash_update(&st, head, 20);
+  crypto_generichash_update(&st, head, kHead);
   crypto_generichash_update(&st, static_cast<const unsigned char*>(payload), n);
   crypto_generichash_final(&st, tag, 32);
   sodium_memzero(&st, sizeof st);
@@ -102,7 +103,7 @@ void BusKey::create(const std::string& path) {
   }
 }
 
-BusSigner::BusSigner(std::shared_ptr<const BusKey> key) : key_(std::move(key)) {
+BusSigner::BusSigner(std::shared_ptr<const BusKey> key, std::uint64_t epoch) : key_(std::move(key)), epoch_(epoch) {
   if (!key_) throw std::invalid_argument("BusSigner: no key");
   init_sodium();
   randombytes_buf(&sender_, sizeof sender_);
@@ -116,14 +117,21 @@ void BusSigner::tag(const std::string& channel, std::uint8_t* message, std::size
   }
   unsigned char* head = message + n;
   std::memcpy(head, kMagic, 4);
-  put_u64(head + 4, sender_);
-  put_u64(head + 12, seq);
-  compute_tag(*key_, channel, head, message, n, head + 20);
+  put_u64(head + 4, epoch_);
+  put_u64(head + 12, sender_);
+  put_u64(head + 20, seq);
+  compute_tag(*key_, channel, head, message, n, head + kHead);
 }
 
-BusVerifier::BusVerifier(std::shared_ptr<const BusKey> key) : key_(std::move(key)) {
+BusVerifier::BusVerifier(std::shared_ptr<const BusKey> key, std::uint64_t epoch, bool any_epoch)
+    : key_(std::move(key)), epoch_(epoch), any_epoch_(any_epoch) {
   if (!key_) throw std::invalid_argument("BusVerifier: no key");
   init_sodium();
+}
+
+void BusVerifier::set_epoch(std::uint64_t epoch, bool any_epoch) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  epoch_ = epoch, any_epoch_ = any_epoch;
 }
 
 const char* BusVerifier::what(Verdict v) {
@@ -131,6 +139,8 @@ const char* BusVerifier::what(Verdict v) {
   case Verdict::ok: return "authentic";
   case Verdict::untagged: return "unauthenticated: no tag of this bus";
   case Verdict::bad_tag: return "unauthenticated: its tag does not match (not signed with this run's key)";
+  case Verdict::other_epoch:
+    return "unauthenticated: of another launch of the run (a message of an earlier segment, replayed)";
   case Verdict::replayed: return "unauthenticated: a replay (this sender's sequence number was seen before)";
   }
   return "?";
@@ -146,8 +156,12 @@ BusVerifier::Verdict BusVerifier::verify(const std::string& channel, const void*
   if (std::memcmp(head, kMagic, 4) != 0) return Verdict::untagged;
   unsigned char tag[32];
   compute_tag(*key_, channel, head, bytes, at, tag);
-  if (crypto_verify_32(tag, head + 20) != 0) return Verdict::bad_tag; // constant time
-  if (!take(get_u64(head + 4), get_u64(head + 12))) return Verdict::replayed;
+  if (crypto_verify_32(tag, head + kHead) != 0) return Verdict::bad_tag; // constant time
+  {
+    std::lock_guard<std::mutex> lock(mutex_);
+    if (!any_epoch_ && get_u64(head + 4) != epoch_) return Verdict::other_epoch;
+  }
+  if (!take(get_u64(head + 12), get_u64(head + 20))) return Verdict::replayed;
   payload = at;
   return Verdict::ok;
 }

@@ -29,7 +29,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
-log="" out="" build_first=1 run_id="" list=0 segments=() key_file="" only_verified=0
+log="" out="" build_first=1 run_id="" list=0 segments=() key_file="" only_verified=0 checked=0
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
@@ -37,6 +37,7 @@ while (($#)); do
   --run-id) run_id=$2; shift 2 ;;
   --key-file) key_file=$2; shift 2 ;;
   --only-verified) only_verified=1; shift ;;
+  --log-checked) checked=1; shift ;; # internal: the first pass checked LOG (the re-run in the namespace)
   --list) list=1; shift ;;
   -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;;
   -*) echo "replay: unknown option $1" >&2; exit 2 ;;
@@ -60,7 +61,9 @@ fi
 runs=$root/launch_scripts/lcmlog_runs.py
 if ((list)); then exec /usr/bin/python3 "$runs" "$log"; fi
 [[ -n $out ]] || { echo "usage: replay.sh LOG --out DIR [--run-id ID]" >&2; exit 2; }
-if [[ -z $run_id ]]; then
+# With --only-verified the run is chosen among the messages that verify
+# (a log of two runs, with one run's key, is then that run's).
+if [[ -z $run_id && $only_verified == 0 ]]; then
   run_id=$(/usr/bin/python3 "$runs" "$log" --only) || exit 2
 fi
 # The recorded run's key: every message of the log is checked against it.
@@ -69,7 +72,7 @@ if [[ -z $key_file ]]; then
   [[ -f $key_file ]] || { echo "replay: no key for ${segments[0]}: give the recorded run's key with --key-file (run_scene.sh wrote it to the run's DIR/bus.key)" >&2; exit 2; }
 fi
 key_file=$(cd "$(dirname "$key_file")" && pwd)/$(basename "$key_file")
-if [[ -z ${DYNHET_IN_NETNS:-} ]]; then
+if ((checked == 0)); then # on the first pass, wherever it runs (inside a namespace too)
   mkdir -p "$out"
   if ((only_verified)); then
     verified=$(cd "$out" && pwd)/verified.lcmlog
@@ -87,6 +90,9 @@ if [[ -z ${DYNHET_IN_NETNS:-} ]]; then
     echo "replay: $log: $said" >&2
   fi
 fi
+if [[ -z $run_id ]]; then
+  run_id=$(/usr/bin/python3 "$runs" "$log" --only) || exit 2
+fi
 summary=$(/usr/bin/python3 "$runs" "$log" --run-id "$run_id") || exit 2
 echo "replay: $summary" >&2
 read -r whole expected < <(sed -E 's/.*, ([0-9]+) of ([0-9]+) frames.*/\1 \2/' <<<"$summary")
@@ -99,7 +105,8 @@ out=$(cd "$out" && pwd)
 
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then
   ((build_first)) && BUILD_DIR=$build "$root/launch_scripts/setup.sh"
-  exec "$root/launch_scripts/netns.sh" "$0" "$log" --out "$out" --run-id "$run_id" --key-file "$key_file" --no-build
+  exec "$root/launch_scripts/netns.sh" "$0" "$log" --out "$out" --run-id "$run_id" --key-file "$key_file" --no-build \
+    --log-checked
 fi
 
 # Which nodes ran: the observables named in the run info of the log. The
@@ -107,13 +114,13 @@ fi
 nodes=$("$bin/recorder" --list-nodes "$log") || { echo "replay: cannot read run info from $log" >&2; exit 1; }
 bus="udpm://239.255.76.67:7670?ttl=0&recv_buf_size=4194304"
 
-"$bin/recorder" --lcm-url "$bus" --from-log "$log" --out "$out/run.h5" --run-id "$run_id" --key-file "$key_file" \
+"$bin/recorder" --lcm-url "$bus" --from-log "$log" --out "$out/run.h5" --run-id "$run_id" --key-file "$key_file" --bus-epoch any \
   2>"$out/recorder.log" &
 rec=$!
 for _ in $(seq 100); do grep -q ready "$out/recorder.log" && break; sleep 0.1; done
 status=0
 for n in $nodes; do
-  "$bin/$n" --lcm-url "file://$log?speed=0" --publish-url "$bus" --run-id "$run_id" --key-file "$key_file" \
+  "$bin/$n" --lcm-url "file://$log?speed=0" --publish-url "$bus" --run-id "$run_id" --key-file "$key_file" --bus-epoch any \
     2>"$out/$n.log" || {
     echo "replay: $n failed; log $out/$n.log" >&2; tail -3 "$out/$n.log" >&2; status=1; }
 done

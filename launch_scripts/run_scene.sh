@@ -54,6 +54,11 @@
 #                   hosts (--role) needs the same key on both: copy the
 #                   analysis host's DIR/bus.key to the sim's host (scp -p,
 #                   keeping mode 0600) and give it there with --key-file
+#   --bus-epoch E   this launch's number, carried in every message's tag
+#                   (default: drawn at random at each start and resume on
+#                   one host, so that a message recorded in one segment of
+#                   a run cannot be replayed into the next; 0 with --role,
+#                   unless both hosts are given the same E)
 #   --author NAME   run.h5's h5md/author name (default: $DYNHET_AUTHOR,
 #                   else $USER, else "unknown")
 #   --author-email ADDRESS  run.h5's h5md/author email (default: none)
@@ -63,7 +68,7 @@ build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
 scene="" out="" bus=private url="" record="" build_first=1 plots=1 resume="" run_id="" role=all author="" author_email=""
-key_file=""
+key_file="" bus_epoch=""
 fresh=0 no_cuts=0 test_node_delay=${DYNHET_TEST_NODE_DELAY:-} test_sim_delay=${DYNHET_TEST_SIM_DELAY:-}
 while (($#)); do
   case "$1" in
@@ -79,6 +84,7 @@ while (($#)); do
   --resume) resume=$2; shift 2 ;;
   --run-id) run_id=$2; shift 2 ;;
   --key-file) key_file=$2; shift 2 ;;
+  --bus-epoch) bus_epoch=$2; shift 2 ;;
   --role) role=$2; shift 2 ;;
   --author) author=$2; shift 2 ;;
   --author-email) author_email=$2; shift 2 ;;
@@ -127,6 +133,7 @@ if [[ ($bus == private || $bus == tcpq) && -z ${DYNHET_IN_NETNS:-} ]]; then
   [[ -z $record ]] || args+=(--record "$record")
   [[ -z $run_id ]] || args+=(--run-id "$run_id")
   [[ -z $key_file ]] || args+=(--key-file "$(realpath -m "$key_file")")
+  [[ -z $bus_epoch ]] || args+=(--bus-epoch "$bus_epoch")
   [[ -z $author ]] || args+=(--author "$author")
   [[ -z $author_email ]] || args+=(--author-email "$author_email")
   ((fresh == 0)) || args+=(--fresh)
@@ -142,7 +149,6 @@ if [[ $role == all && -z $resume && $no_cuts == 0 ]]; then
   cuts=$out/checkpoints
   if ((fresh)); then
     rm -rf "$cuts"/cut-* "$cuts"/recorder.journal "$out/run.h5"
-    [[ -n $key_file ]] || rm -f "$out/bus.key" # a new run, a new key
     # (not the scene to run, when it is DIR's own: the study runner's)
     [[ $(realpath "$scene") == $(realpath -m "$out/scene.toml") ]] || rm -f "$out/scene.toml"
   fi
@@ -228,17 +234,25 @@ elif [[ -z $run_id ]]; then
 fi
 [[ $run_id =~ ^[1-9][0-9]*$ ]] || { echo "run_scene: --run-id must be a positive integer, not $run_id" >&2; exit 2; }
 
-# The run's key: every message on the bus is tagged with it (docs/bus.md).
+# The run's key: every message on the bus is tagged with it (docs/bus.md);
+# --fresh starts a new run, with a new key.
 if [[ -z $key_file ]]; then
+  ((fresh == 0)) || rm -f "$out/bus.key"
   [[ $role != sim ]] || { echo "run_scene: --role sim needs --key-file KEY: the run's key, copied from the analysis host's DIR/bus.key" >&2; exit 2; }
   key_file=$out/bus.key
   if [[ ! -e $key_file ]]; then
+    rm -f "$key_file.tmp"
     (umask 077 && head -c 32 /dev/urandom >"$key_file.tmp" && mv "$key_file.tmp" "$key_file")
     [[ $role != analysis ]] || echo "run_scene: the run's key is $key_file: copy it to the sim's host (scp -p) and give it there with --key-file" >&2
   fi
 fi
 [[ -f $key_file ]] || { echo "run_scene: no key file $key_file" >&2; exit 2; }
-key=(--key-file "$key_file")
+# This launch's epoch: a receiver takes only messages of its own launch.
+if [[ -z $bus_epoch ]]; then
+  if [[ $role == all ]]; then bus_epoch=$(od -An -N8 -tu8 /dev/urandom | tr -d ' \n'); else bus_epoch=0; fi
+fi
+[[ $bus_epoch =~ ^[0-9]+$ ]] || { echo "run_scene: --bus-epoch is a non-negative integer, not $bus_epoch" >&2; exit 2; }
+key=(--key-file "$key_file" --bus-epoch "$bus_epoch")
 
 start() { # name, then the command; waits for its "ready" line
   # On resume the log goes on: only the lines after this start's own

@@ -67,6 +67,7 @@ struct Options {
   double cut_wait = 300; // after a signal: how long to wait for the next cut
   std::string key_file;
   bool unauthenticated = false;
+  std::string bus_epoch;
 };
 
 // The one channel each message may come on (lcm_url.hpp: one channel per
@@ -136,6 +137,7 @@ private:
   bool start_cuts(); // the journal, new or resumed; false: fatal_ says why
   void dispatch(const std::string &ch, const void *data, int size);
   void take_checkpoint(const lcm::ReceiveBuffer *rb, const std::string &ch);
+  void journal_epoch(); // marks the journal: what follows came under this launch's epoch
 
   void subscribe();
   bool read_log(int max_events);
@@ -298,10 +300,31 @@ bool Session::read_log(int max_events) {
 }
 
 // Where a journaled message goes: the handler of its channel's family.
+// The journal says under which launch's epoch the messages after it were
+// received ("#bus_epoch": 8 bytes, then 1 if every epoch was taken), so
+// that a replay of the journal gives each message the verdict it had.
+constexpr const char *kJournalEpoch = "#bus_epoch";
+
+void Session::journal_epoch() {
+  uint8_t b[9];
+  const uint64_t e = bus_.epoch();
+  for (int i = 0; i < 8; ++i) b[i] = static_cast<uint8_t>(e >> (8 * i));
+  b[8] = bus_.any_epoch() ? 1 : 0;
+  cuts_->journal().append(kJournalEpoch, b, sizeof b);
+}
+
 void Session::dispatch(const std::string &ch, const void *d, int n) {
   using R = dynhet::RunRecorder;
   namespace dh = dynhet;
   auto in = [&](const char *family) { return ch.rfind(family, 0) == 0; };
+  if (ch == kJournalEpoch) { // a replayed journal: the epoch of what follows
+    if (n != 9) return;
+    const auto *b = static_cast<const uint8_t *>(d);
+    uint64_t e = 0;
+    for (int i = 0; i < 8; ++i) e |= uint64_t{b[i]} << (8 * i);
+    bus_.take_epoch(e, b[8] != 0);
+    return;
+  }
   if (ch == dh::kChanRun) take_bytes<dh::run_info_t, &Session::take_run>(d, n, ch);
   else if (ch == dh::kChanSimStatus) take_bytes<dh::sim_status_t, &Session::take_sim>(d, n, ch);
   else if (ch == dh::kChanFrame) take_bytes<dh::frame_chunk_t, &Session::take_frame>(d, n, ch);
@@ -324,6 +347,7 @@ bool Session::start_cuts() {
     std::filesystem::create_directories(cuts_->dir());
     if (opt_.resume_cut < 0) {
       cuts_->journal().create(cuts_->journal_path());
+      journal_epoch();
       return true;
     }
     std::remove(opt_.out.c_str()); // rebuilt from the journal
@@ -334,6 +358,8 @@ bool Session::start_cuts() {
     });
     replaying_ = false;
     rec_.flush_each(true);
+    bus_.take_epoch(bus_.epoch(), bus_.any_epoch()); // this launch's, from here on
+    journal_epoch();
     if (!fatal_.empty()) return false;
     if (!rec_.has_run() || rec_.run_id() != r.run_id)
       throw dynhet::BadPart(r.part +
@@ -523,9 +549,11 @@ int main(int argc, char **argv) {
   app.add_option("--run-id", o.run_id, "record only this run (default: the first one seen)");
   app.add_option("--key-file", o.key_file,
                  "the run's key (32 bytes, mode 0600; run_scene.sh writes DIR/bus.key): every message is checked "
-                 "with it before it is decoded, the recorder's own are tagged (docs/bus.md); default $DYNHET_KEY_FILE")
-      ->envname("DYNHET_KEY_FILE");
+                 "with it before it is decoded, the recorder's own are tagged (docs/bus.md); default $DYNHET_KEY_FILE");
   app.add_flag("--unauthenticated", o.unauthenticated, "no key: an open bus, on purpose (tests, tools)");
+  app.add_option("--bus-epoch", o.bus_epoch,
+                 "this launch's number (run_scene.sh draws one per start and resume): only its messages are taken; "
+                 "\"any\" takes every launch's (a replay)");
   app.add_option("--author", o.author,
                  "the file's h5md/author name (default: $DYNHET_AUTHOR, else $USER, else \"unknown\")");
   app.add_option("--author-email", o.author_email, "the file's h5md/author email (default: none)");
@@ -542,7 +570,7 @@ int main(int argc, char **argv) {
   if (o.out.empty()) return app.exit(CLI::RequiredError("--out"));
   std::optional<dynhet::Bus> bus;
   try {
-    bus.emplace(dynhet::Bus::from_options("recorder", o.key_file, o.unauthenticated));
+    bus.emplace(dynhet::Bus::from_options("recorder", o.key_file, o.unauthenticated, o.bus_epoch));
   } catch (const std::exception &e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;

@@ -261,9 +261,12 @@ int main(int argc, char** argv) {
   bool unauthenticated = false;
   app.add_option("--key-file", key_file,
                  "the run's key (32 bytes, mode 0600; run_scene.sh writes DIR/bus.key): every message is tagged "
-                 "with it and every message received is checked (docs/bus.md); default $DYNHET_KEY_FILE")
-      ->envname("DYNHET_KEY_FILE");
+                 "with it and every message received is checked (docs/bus.md); default $DYNHET_KEY_FILE");
   app.add_flag("--unauthenticated", unauthenticated, "no key: an open bus, on purpose (tests, tools)");
+  std::string bus_epoch;
+  app.add_option("--bus-epoch", bus_epoch,
+                 "this launch's number (run_scene.sh draws one per start and resume): only its messages are taken; "
+                 "\"any\" takes every launch's (a replay)");
   bool pace = false;
   app.add_flag("--pace-nodes", pace,
                "flow control: hold each frame until the scene's nodes, and the recorder when the scene keeps the "
@@ -381,7 +384,7 @@ int main(int argc, char** argv) {
 
   std::optional<dynhet::Bus> bus_or;
   try {
-    bus_or.emplace(dynhet::Bus::from_options("sim_node", key_file, unauthenticated));
+    bus_or.emplace(dynhet::Bus::from_options("sim_node", key_file, unauthenticated, bus_epoch));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;

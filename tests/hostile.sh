@@ -104,6 +104,7 @@ echo "attacker without the key: unauthenticated dropped by recorder $ur, sim $us
 check '[[ $rc == 0 ]] && complete "$tmp/outsider/run.h5"' "attacker without the key: the run completes (exit $rc)"
 check '(( ur > 100 && uo > 100 && u4 > 100 && uc > 100 && rej == 0 ))' \
   "attacker without the key: the recorder and every node drop all its messages as unauthenticated, none reach the content checks"
+check '(( us > 100 ))' "attacker without the key: the sim drops its node statuses (well-formed, this run's, far ahead) as unauthenticated ($us)"
 check 'same "$tmp/clean/run.h5" "$tmp/outsider/run.h5"' "attacker without the key: results equal the clean run's bit for bit"
 "$hostile" "$LCM_DEFAULT_URL" 4246 60 --tamper >"$tmp/tamper.log" 2>&1 &
 hp=$!
@@ -117,6 +118,51 @@ check '[[ $rc == 0 ]] && complete "$tmp/tampered/run.h5"' "replayed, untagged an
 check '(( ur > 100 && us > 10 && uo > 50 && u4 > 50 && uc > 50 && rej == 0 ))' \
   "replayed, untagged and changed copies: dropped and counted as unauthenticated by the recorder, the sim (node statuses) and every node"
 check 'same "$tmp/clean/run.h5" "$tmp/tampered/run.h5"' "replayed, untagged and changed copies: results equal the clean run's bit for bit"
+# Replays alone: byte-for-byte copies of the run's messages, each dropped
+# as a replay (the recorder hears nearly every channel the copies go to).
+"$hostile" "$LCM_DEFAULT_URL" 4247 60 --tamper --replay-only >"$tmp/replays.log" 2>&1 &
+hp=$!
+sleep 0.5
+"${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/replayed" --run-id 4247 >"$tmp/replayed_run.log" 2>&1 && rc=0 || rc=$?
+kill $hp 2>/dev/null || true
+wait $hp 2>/dev/null || true
+forged=$(sed -n 's/.*forged \([0-9]*\) messages.*/\1/p' "$tmp/replays.log")
+read -r ur us uo u4 uc rej < <(unauth "$tmp/replayed/run.h5" 2>/dev/null || echo "0 0 0 0 0 -1")
+last=$($py -c "import h5py, sys; v = h5py.File(sys.argv[1], 'r').attrs['last_unauthenticated_recorder']; print(v.decode() if isinstance(v, bytes) else v)" "$tmp/replayed/run.h5" 2>/dev/null || true)
+echo "replays alone: ${forged:-?} copies sent; unauthenticated dropped by recorder $ur, sim $us, overlap $uo, s4 $u4, clusters $uc; last: $last"
+check '[[ $rc == 0 ]] && complete "$tmp/replayed/run.h5" && same "$tmp/clean/run.h5" "$tmp/replayed/run.h5"' \
+  "replayed copies alone: the run completes, results equal the clean run's bit for bit (exit $rc)"
+check '(( ${forged:-0} > 200 && 10 * ur >= 9 * forged && us > 0 && uo > 0 )) && [[ $last == *replay* ]]' \
+  "replayed copies alone: dropped as replays and counted (recorder $ur of ${forged:-?})"
+
+# Replays across a resume: an attacker keeps every message of the run's
+# first launch and sends them all again once the run, stopped by SIGTERM,
+# is resumed (another launch, another epoch). Each is dropped as a message
+# of another launch; the resumed run equals the clean one bit for bit.
+sed 's/^equilibration_time = 5.0/equilibration_time = 5.0\ncheckpoint_interval = 0.5/' "$root/scenes/tiny.toml" >"$tmp/cuts.toml"
+"${run[@]}" "$tmp/cuts.toml" --out "$tmp/cuts_clean" --run-id 4249 --no-plots >"$tmp/cuts_clean.log" 2>&1 ||
+  { tail -20 "$tmp/cuts_clean.log"; exit 1; }
+"$hostile" "$LCM_DEFAULT_URL" 4248 240 --tamper --hold >"$tmp/hold.log" 2>&1 &
+hp=$!
+sleep 0.5
+set -m
+"${run[@]}" "$tmp/cuts.toml" --out "$tmp/held" --run-id 4248 --no-plots --test-node-delay 0.1 >"$tmp/held_run.log" 2>&1 &
+run_pid=$!
+set +m
+sleep 4
+kill -TERM -- -$run_pid 2>/dev/null || true
+wait $run_pid && rc1=0 || rc1=$?
+"${run[@]}" "$tmp/cuts.toml" --out "$tmp/held" --run-id 4248 --no-plots >>"$tmp/held_run.log" 2>&1 && rc=0 || rc=$?
+kill $hp 2>/dev/null || true
+wait $hp 2>/dev/null || true
+forged=$(sed -n 's/.*forged \([0-9]*\) messages.*/\1/p' "$tmp/hold.log")
+read -r ur us uo u4 uc rej < <(unauth "$tmp/held/run.h5" 2>/dev/null || echo "0 0 0 0 0 -1")
+last=$($py -c "import h5py, sys; v = h5py.File(sys.argv[1], 'r').attrs['last_unauthenticated_recorder']; print(v.decode() if isinstance(v, bytes) else v)" "$tmp/held/run.h5" 2>/dev/null || true)
+echo "replays across a resume: ${forged:-?} messages of the first launch sent again; dropped by recorder $ur, sim $us, overlap $uo, s4 $u4, clusters $uc; last: $last"
+check '[[ $rc1 != 0 && $rc == 0 ]] && complete "$tmp/held/run.h5" && same "$tmp/cuts_clean/run.h5" "$tmp/held/run.h5"' \
+  "replays across a resume: the run stopped (exit $rc1), resumed and completed (exit $rc), results equal the clean run's bit for bit"
+check '(( ${forged:-0} > 100 && ur > 50 && uo > 0 && rej == 0 )) && [[ $last == *"another launch"* ]]' \
+  "replays across a resume: the first launch's messages dropped and counted as of another launch"
 
 # Genuine messages on another source's channel.
 "$hostile" "$LCM_DEFAULT_URL" 4244 60 --relay >"$tmp/relay.log" 2>&1 &

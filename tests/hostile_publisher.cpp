@@ -34,7 +34,15 @@
 // message of this run, as an attacker who knows the run id writes one),
 // and with one byte of its content changed under the genuine tag. All
 // three must be dropped and counted, and the sim must not be paced by the
-// forged node statuses.
+// forged node statuses. --tamper --replay-only sends the byte-for-byte
+// copies alone (each must be dropped as a replay). --tamper --hold keeps
+// every message of the run's first launch and sends them all again once
+// the run has been resumed (a later launch, another epoch): each must be
+// dropped as a message of another launch.
+//
+// Without a key it also sends, every round, well-formed statuses of every
+// node and the recorder of this run saying they are far ahead (a million
+// frames whole): the sim must not take them.
 #include <atomic>
 #include <chrono>
 #include <csignal>
@@ -42,6 +50,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <random>
 #include <set>
 #include <string>
@@ -212,9 +221,20 @@ private:
 
 // Sends every message of the run back three ways (--tamper): a replay, the
 // content without its tag, the content changed under the genuine tag.
+// The launch epoch of a tagged message (bus_auth.hpp: magic, then the
+// epoch, little-endian), or none.
+std::optional<uint64_t> epoch_of(const uint8_t* p, size_t n) {
+  if (n < dynhet::kBusTagBytes + 8 || std::memcmp(p + n - dynhet::kBusTagBytes, "DHT2", 4) != 0) return std::nullopt;
+  uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v |= uint64_t{p[n - dynhet::kBusTagBytes + 4 + i]} << (8 * i);
+  return v;
+}
+
 class Tamper {
 public:
-  explicit Tamper(lcm::LCM& lcm) : lcm_(lcm) {
+  // hold: keep the run's messages and send them all again, byte for byte,
+  // once a later launch of the run (a resume: another epoch) has its sim out.
+  Tamper(lcm::LCM& lcm, bool replay_only, bool hold) : lcm_(lcm), replay_only_(replay_only), hold_(hold) {
     lcm_.subscribe("DYNHET_.*", &Tamper::on_message, this)->setQueueCapacity(100000);
   }
   long forged() const { return forged_; }
@@ -225,7 +245,23 @@ private:
     const std::string bytes(reinterpret_cast<const char*>(p), rb->data_size);
     if (!seen_.insert(bytes).second) return; // its own copies, back over the bus
     const size_t n = rb->data_size;
-    if (n < dynhet::kBusTagBytes + 8 || std::memcmp(p + n - dynhet::kBusTagBytes, "DHT1", 4) != 0) return;
+    const std::optional<uint64_t> epoch = epoch_of(p, n);
+    if (!epoch) return;
+    if (hold_) {
+      if (!first_epoch_) first_epoch_ = epoch;
+      if (*epoch == *first_epoch_) {
+        held_.emplace_back(ch, bytes);
+      } else if (!held_.empty() && ch == "DYNHET_RUN") {
+        // The run resumed and its new sim is out (every process of the new
+        // launch listens by then): the first launch's messages, all again.
+        std::fprintf(stderr, "hostile_publisher: %s of another launch heard: sending the %zu messages of the first again\n",
+                     ch.c_str(), held_.size());
+        for (const auto& [c, b] : held_) lcm_.publish(c, b.data(), static_cast<unsigned>(b.size()));
+        forged_ += static_cast<long>(held_.size());
+        held_.clear();
+      }
+      return;
+    }
     if (ch == "DYNHET_NODE_STATUS_recorder") {
       dynhet::node_status_t m;
       if (m.decode(p, 0, static_cast<int>(n - dynhet::kBusTagBytes)) > 0 && (m.state == "done" || m.state == "failed"))
@@ -236,12 +272,16 @@ private:
     std::string changed = bytes;
     changed[8 + (n - dynhet::kBusTagBytes - 8) / 2] ^= 0x01; // in the content, past the fingerprint
     for (const std::string* f : {&replay, &untagged, &changed}) {
+      if (replay_only_ && f != &replay) continue;
       seen_.insert(*f);
       lcm_.publish(ch, f->data(), static_cast<unsigned>(f->size()));
       ++forged_;
     }
   }
   lcm::LCM& lcm_;
+  bool replay_only_, hold_;
+  std::optional<uint64_t> first_epoch_;
+  std::vector<std::pair<std::string, std::string>> held_;
   std::set<std::string> seen_;
   long forged_ = 0;
   bool recorder_done_ = false;
@@ -259,17 +299,42 @@ int main(int argc, char** argv) {
   if (!lcm.good()) return 3;
   const int64_t run = std::stoll(argv[2]);
   const double seconds = std::stod(argv[3]);
-  bool forge_done = false, relay = false, tamper = false;
+  bool forge_done = false, relay = false, tamper = false, replay_only = false, hold = false;
+  std::string key_file;
   for (int i = 4; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--forge-done") forge_done = true;
     else if (a == "--relay") relay = true;
     else if (a == "--tamper") tamper = true;
-    else if (a == "--key-file" && i + 1 < argc) g_signer = std::make_unique<dynhet::BusSigner>(dynhet::BusKey::load(argv[++i]));
+    else if (a == "--replay-only") replay_only = true;
+    else if (a == "--hold") hold = true;
+    else if (a == "--key-file" && i + 1 < argc) key_file = argv[++i];
     else {
       std::fprintf(stderr, "hostile_publisher: unknown argument %s\n", a.c_str());
       return 2;
     }
+  }
+  if (!key_file.empty()) {
+    // An insider holds the key and reads the launch's epoch off the run's
+    // own traffic (it travels in clear): wait for the first tagged message.
+    struct Epoch {
+      std::optional<uint64_t> e;
+      void on(const lcm::ReceiveBuffer* rb, const std::string&) {
+        const auto* p = static_cast<const uint8_t*>(rb->data);
+        const size_t n = rb->data_size;
+        if (!e) e = epoch_of(p, n);
+      }
+    } epoch;
+    lcm::Subscription* sub = lcm.subscribe("DYNHET_.*", &Epoch::on, &epoch);
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!epoch.e && std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < seconds)
+      lcm.handleTimeout(100);
+    lcm.unsubscribe(sub);
+    if (!epoch.e) {
+      std::fprintf(stderr, "hostile_publisher: no tagged message of the run heard\n");
+      return 1;
+    }
+    g_signer = std::make_unique<dynhet::BusSigner>(dynhet::BusKey::load(key_file), *epoch.e);
   }
   if (relay || tamper) {
     std::signal(SIGTERM, on_signal);
@@ -278,7 +343,7 @@ int main(int argc, char** argv) {
     std::unique_ptr<Relay> r;
     std::unique_ptr<Tamper> t;
     if (relay) r = std::make_unique<Relay>(lcm);
-    else t = std::make_unique<Tamper>(lcm);
+    else t = std::make_unique<Tamper>(lcm, replay_only, hold);
     while (!g_stop && std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < seconds)
       lcm.handleTimeout(100);
     if (r) std::printf("hostile_publisher: relayed %ld messages to another source's channel\n", r->relayed());
@@ -359,6 +424,16 @@ int main(int argc, char** argv) {
       done.frames_published = rounds % 2 ? INT32_MAX : -7;
       send(lcm, "DYNHET_SIM_STATUS", &done);
     }
+    if (!g_signer) // statuses of this run, far ahead: no key, so they must not pace the sim
+      for (const char* p : {"overlap", "s4", "clusters", "recorder"}) {
+        dynhet::node_status_t st{};
+        st.run_id = run;
+        st.node = p;
+        st.state = "running";
+        st.frames_expected = 56;
+        st.frames_whole = 1000000;
+        send(lcm, std::string("DYNHET_NODE_STATUS_") + p, &st);
+      }
     ++rounds;
     std::this_thread::sleep_for(std::chrono::milliseconds(20));
   }

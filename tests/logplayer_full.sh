@@ -42,16 +42,18 @@ for attempt in 1 2 3; do
 done
 [[ -n $(result_counts "$tmp/live/recorder.log") ]] || { echo "FAIL the recorder says no messages per channel"; exit 1; }
 nodes=$("$bin/recorder" --list-nodes "$tmp/run.lcmlog")
-export DYNHET_KEY_FILE=$tmp/live/bus.key # the recorded run's key: the played messages carry its tags
+# The recorded run's key: the played messages carry its tags, of the live
+# run's launch (--bus-epoch any: a played log is not this launch's).
+export DYNHET_KEY_FILE=$tmp/live/bus.key
 export LCM_DEFAULT_URL='udpm://239.255.76.67:7732?ttl=0&recv_buf_size=4194304'
 
 play() { # out dir, then the nodes to start: the recorder listens, the whole log is played
   local out=$1 rec rc; shift
   for attempt in 1 2 3; do
     rm -rf "$out" && mkdir -p "$out"
-    start "$out/recorder.log" "$bin/recorder" --out "$out/run.h5" --run-id $id
+    start "$out/recorder.log" "$bin/recorder" --out "$out/run.h5" --run-id $id --bus-epoch any
     rec=${pids[-1]}
-    for n in "$@"; do start "$out/$n.log" "$bin/$n" --run-id $id; done
+    for n in "$@"; do start "$out/$n.log" "$bin/$n" --run-id $id --bus-epoch any; done
     lcm-logplayer --lcm-url="$LCM_DEFAULT_URL" "$tmp/run.lcmlog" >"$out/player.log" 2>&1
     wait "$rec" && rc=0 || rc=$?
     # The bus may lose a played datagram on a starved machine too: the

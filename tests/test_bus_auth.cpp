@@ -92,8 +92,8 @@ TEST(BusKey, MissingEmptyShortAndOpenKeyFilesAreRefusedByName) {
 }
 
 TEST(BusTag, VerifiesWithItsKeyChannelAndBytesOnly) {
-  BusSigner s(key_of(1));
-  BusVerifier v(key_of(1)), other(key_of(2));
+  BusSigner s(key_of(1), 5);
+  BusVerifier v(key_of(1), 5), other(key_of(2), 5);
   std::size_t payload = 0;
   const auto m = signed_message(s, "DYNHET_CHI4_a0.6", "some result bytes");
   EXPECT_EQ(v.verify("DYNHET_CHI4_a0.6", m.data(), m.size(), payload), BusVerifier::Verdict::ok);
@@ -120,8 +120,8 @@ TEST(BusTag, VerifiesWithItsKeyChannelAndBytesOnly) {
 }
 
 TEST(BusTag, ACopyOfAMessageTakenIsDroppedWithinAndBeyondTheWindow) {
-  BusSigner s(key_of(3)), s2(key_of(3));
-  BusVerifier v(key_of(3));
+  BusSigner s(key_of(3), 5), s2(key_of(3), 5);
+  BusVerifier v(key_of(3), 5);
   std::size_t payload = 0;
   std::vector<std::vector<std::uint8_t>> sent;
   for (int i = 0; i < 3000; ++i) sent.push_back(signed_message(s, "CH", "m" + std::to_string(i)));
@@ -152,7 +152,7 @@ TEST(Bus, PublishedBytesAreTheLcmEncodingThenTheTag) {
   const int n = m.getEncodedSize();
   std::vector<std::uint8_t> buf(n + kBusTagBytes);
   m.encode(buf.data(), 0, n);
-  BusSigner signer(key);
+  BusSigner signer(key, 0);
   signer.tag("DYNHET_SIM_STATUS", buf.data(), n);
   int size = 0;
   std::string why;
@@ -166,6 +166,7 @@ TEST(Bus, PublishedBytesAreTheLcmEncodingThenTheTag) {
   EXPECT_FALSE(rx.open("DYNHET_SIM_STATUS", buf.data(), n, size, why)); // no tag
   EXPECT_TRUE(open.open("DYNHET_SIM_STATUS", buf.data(), n, size, why));
   EXPECT_EQ(size, n);
+  unsetenv("DYNHET_KEY_FILE");
   EXPECT_THROW(Bus::from_options("sim_node", "", false), std::runtime_error);
   EXPECT_THROW(Bus::from_options("sim_node", "/tmp/x.key", true), std::runtime_error);
   EXPECT_FALSE(Bus::from_options("sim_node", "", true).authenticated());
@@ -174,22 +175,120 @@ TEST(Bus, PublishedBytesAreTheLcmEncodingThenTheTag) {
 
 // One message tagged by the Python side (python/dynhet/bus.py, which
 // checks recorded logs for replay.sh): key 00 01 .. 1f, channel DYNHET_RUN,
-// content "dynhet", sender 0x0102030405060708, sequence 9. The C++ side
+// content "dynhet", epoch 3, sender 0x0102030405060708, sequence 9. The C++ side
 // takes it, and the same content under another channel or sequence is not
 // taken: both sides compute one function (tests/python/test_bus.py pins
 // the same bytes).
 TEST(BusTag, TheTagPythonComputesVerifiesHere) {
-  const std::string hex = "64796e68657444485431080706050403020109000000000000007da42331314e2e3cd426815e627ed843a74e"
-                          "a41ff32ca3e937166ea642548135";
+  const std::string hex = "64796e68657444485432030000000000000008070605040302010900000000000000bd9d019218b1"
+                          "5947e628224db93e06ab7c44fb6df5b978ca416db44b21eb6ce0";
   std::vector<std::uint8_t> m;
   for (std::size_t i = 0; i < hex.size(); i += 2) m.push_back(static_cast<std::uint8_t>(std::stoi(hex.substr(i, 2), nullptr, 16)));
   std::array<unsigned char, BusKey::kBytes> k{};
   for (int i = 0; i < 32; ++i) k[i] = static_cast<unsigned char>(i);
-  BusVerifier v(std::make_shared<const BusKey>(k));
+  BusVerifier v(std::make_shared<const BusKey>(k), 3);
   std::size_t payload = 0;
   EXPECT_EQ(v.verify("DYNHET_FRAME", m.data(), m.size(), payload), BusVerifier::Verdict::bad_tag);
   ASSERT_EQ(v.verify("DYNHET_RUN", m.data(), m.size(), payload), BusVerifier::Verdict::ok);
   EXPECT_EQ(std::string(m.begin(), m.begin() + payload), "dynhet");
-  m[10] ^= 1; // the sequence number's byte: 9 -> 8
+  m[6 + 4 + 8 + 8] ^= 1; // the sequence number's first byte: 9 -> 8
   EXPECT_EQ(v.verify("DYNHET_RUN", m.data(), m.size(), payload), BusVerifier::Verdict::bad_tag);
+}
+
+// Without --key-file the key comes from $DYNHET_KEY_FILE; --unauthenticated
+// wins over it; a bad key file there is refused like one given by flag.
+TEST(Bus, TheKeyFileComesFromTheEnvironmentUnlessTheBusIsOpenedOnPurpose) {
+  char tmpl[] = "/tmp/dynhet-bus-XXXXXX";
+  const std::string dir = mkdtemp(tmpl);
+  BusKey::create(dir + "/bus.key");
+  setenv("DYNHET_KEY_FILE", (dir + "/bus.key").c_str(), 1);
+  EXPECT_TRUE(Bus::from_options("recorder", "", false).authenticated());
+  EXPECT_FALSE(Bus::from_options("recorder", "", true).authenticated());
+  setenv("DYNHET_KEY_FILE", (dir + "/none.key").c_str(), 1);
+  try {
+    Bus::from_options("recorder", "", false);
+    ADD_FAILURE() << "a missing key file in $DYNHET_KEY_FILE was taken";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("recorder: key file " + dir + "/none.key: cannot be opened"), std::string::npos)
+        << e.what();
+  }
+  unsetenv("DYNHET_KEY_FILE");
+}
+
+// Bus::publish and Bus::open across a real LCM instance (memq://, in
+// process): the receiver gets the sender's encoding, decodes it whole, and
+// takes each message once.
+TEST(Bus, PublishThenOpenOverLcm) {
+  auto key = key_of(9);
+  Bus tx(key), rx(key);
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  struct Got {
+    std::vector<std::vector<std::uint8_t>> raw;
+    void on(const lcm::ReceiveBuffer* rb, const std::string&) {
+      const auto* p = static_cast<const std::uint8_t*>(rb->data);
+      raw.emplace_back(p, p + rb->data_size);
+    }
+  } got;
+  lcm.subscribe("DYNHET_SIM_STATUS", &Got::on, &got);
+  sim_status_t m{};
+  m.run_id = 77;
+  m.phase = "production";
+  ASSERT_EQ(tx.publish(lcm, "DYNHET_SIM_STATUS", m), 0);
+  ASSERT_EQ(tx.publish(lcm, "DYNHET_SIM_STATUS", m), 0);
+  while (got.raw.size() < 2 && lcm.handleTimeout(100) > 0) {
+  }
+  ASSERT_EQ(got.raw.size(), 2u);
+  EXPECT_EQ(got.raw[0].size(), static_cast<std::size_t>(m.getEncodedSize()) + kBusTagBytes);
+  for (const auto& r : got.raw) {
+    int size = 0;
+    std::string why;
+    ASSERT_TRUE(rx.open("DYNHET_SIM_STATUS", r.data(), r.size(), size, why)) << why;
+    sim_status_t back;
+    EXPECT_EQ(back.decode(r.data(), 0, size), size);
+    EXPECT_EQ(back.run_id, 77);
+    EXPECT_EQ(back.phase, "production");
+    EXPECT_FALSE(rx.open("DYNHET_SIM_STATUS", r.data(), r.size(), size, why)); // the same bytes again: a replay
+  }
+}
+
+TEST(BusTag, TheWindowsEdge) {
+  BusSigner s(key_of(10), 5);
+  std::vector<std::vector<std::uint8_t>> sent;
+  for (int i = 0; i < 1100; ++i) sent.push_back(signed_message(s, "CH", "m" + std::to_string(i))); // sequences 1..1100
+  BusVerifier v(key_of(10), 5);
+  std::size_t payload = 0;
+  ASSERT_EQ(v.verify("CH", sent[1099].data(), sent[1099].size(), payload), BusVerifier::Verdict::ok); // top 1100
+  // 1100 - 1023 = 77 (index 76) is inside the window, 1100 - 1024 = 76 (index 75) is not.
+  EXPECT_EQ(v.verify("CH", sent[76].data(), sent[76].size(), payload), BusVerifier::Verdict::ok);
+  EXPECT_EQ(v.verify("CH", sent[75].data(), sent[75].size(), payload), BusVerifier::Verdict::replayed);
+}
+
+// A receiver takes only its launch's epoch (a message of an earlier segment
+// of the run, replayed into the next, is refused); "any" takes all, and a
+// verifier switched to another epoch takes that one's.
+TEST(BusTag, OnlyThisLaunchsEpochIsTaken) {
+  BusSigner earlier(key_of(11), 41), now(key_of(11), 42);
+  BusVerifier v(key_of(11), 42), any(key_of(11), 0, true);
+  std::size_t payload = 0;
+  const auto old_msg = signed_message(earlier, "DYNHET_OVERLAP_a0.6", "a result of segment 1");
+  const auto new_msg = signed_message(now, "DYNHET_OVERLAP_a0.6", "a result of segment 2");
+  EXPECT_EQ(v.verify("DYNHET_OVERLAP_a0.6", old_msg.data(), old_msg.size(), payload), BusVerifier::Verdict::other_epoch);
+  EXPECT_EQ(v.verify("DYNHET_OVERLAP_a0.6", new_msg.data(), new_msg.size(), payload), BusVerifier::Verdict::ok);
+  EXPECT_EQ(any.verify("DYNHET_OVERLAP_a0.6", old_msg.data(), old_msg.size(), payload), BusVerifier::Verdict::ok);
+  EXPECT_EQ(any.verify("DYNHET_OVERLAP_a0.6", new_msg.data(), new_msg.size(), payload), BusVerifier::Verdict::ok);
+  // The epoch is under the tag: rewriting it breaks the tag.
+  auto moved = old_msg;
+  moved[moved.size() - kBusTagBytes + 4] = 42;
+  EXPECT_EQ(v.verify("DYNHET_OVERLAP_a0.6", moved.data(), moved.size(), payload), BusVerifier::Verdict::bad_tag);
+  BusVerifier w(key_of(11), 42);
+  w.set_epoch(41, false);
+  EXPECT_EQ(w.verify("DYNHET_OVERLAP_a0.6", old_msg.data(), old_msg.size(), payload), BusVerifier::Verdict::ok);
+  EXPECT_EQ(w.verify("DYNHET_OVERLAP_a0.6", new_msg.data(), new_msg.size(), payload), BusVerifier::Verdict::other_epoch);
+  std::string why;
+  int size = 0;
+  EXPECT_THROW(Bus::from_options("s4_node", "", true, "-3"), std::runtime_error);
+  EXPECT_THROW(Bus::from_options("s4_node", "", true, "12x"), std::runtime_error);
+  EXPECT_NO_THROW(Bus::from_options("s4_node", "", true, "any"));
+  (void)why, (void)size;
 }

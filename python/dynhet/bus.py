@@ -2,13 +2,15 @@
 common/bus_auth.cpp): a run's key file, the tag each message carries after
 its LCM bytes, and the check of a whole lcm-logger log.
 
-    LCM bytes | b"DHT1" | sender (8 bytes, little-endian) | sequence (8) | tag (32)
+    LCM bytes | b"DHT2" | epoch (8 bytes, little-endian) | sender (8) | sequence (8) | tag (32)
 
 tag = BLAKE2b-256 keyed with the run's 32-byte key (libsodium's
 crypto_generichash is BLAKE2b; hashlib's blake2b with key= is the same
 function) over b"dynhet bus tag v1\\0", the channel's length (8 bytes,
-little-endian), the channel, the 20 bytes from the magic to the sequence,
-and the LCM bytes.
+little-endian), the channel, the 28 bytes from the magic to the sequence,
+and the LCM bytes. The epoch is the launch of the run's processes that sent
+it (a log of a resumed run holds several); a log is checked for every
+epoch at once.
 """
 import hashlib
 import hmac
@@ -17,8 +19,9 @@ import stat
 import struct
 
 KEY_BYTES = 32
-TAG_BYTES = 4 + 8 + 8 + 32
-MAGIC = b"DHT1"
+TAG_BYTES = 4 + 8 + 8 + 8 + 32
+HEAD = 4 + 8 + 8 + 8
+MAGIC = b"DHT2"
 DOMAIN = b"dynhet bus tag v1\0"
 SYNC = 0xEDA1DA01
 
@@ -53,7 +56,7 @@ def load_key(path):
 
 
 def tag_of(key, channel, head, payload):
-    """The tag of (channel, head = magic | sender | sequence, payload)."""
+    """The tag of (channel, head = magic | epoch | sender | sequence, payload)."""
     ch = channel.encode("latin-1") if isinstance(channel, str) else channel
     h = hashlib.blake2b(digest_size=32, key=key)
     h.update(DOMAIN)
@@ -64,26 +67,26 @@ def tag_of(key, channel, head, payload):
     return h.digest()
 
 
-def sign(key, channel, payload, sender, sequence):
+def sign(key, channel, payload, sender, sequence, epoch=0):
     """payload with its tag: what BusSigner::tag appends (tests)."""
-    head = MAGIC + struct.pack("<QQ", sender, sequence)
+    head = MAGIC + struct.pack("<QQQ", epoch, sender, sequence)
     return bytes(payload) + head + tag_of(key, channel, head, payload)
 
 
 def verdict(key, channel, data, seen):
     """'ok', 'untagged', 'bad_tag' or 'replayed' for one message; seen: the
-    set of (sender, sequence) taken so far (updated when 'ok')."""
+    set of (epoch, sender, sequence) taken so far (updated when 'ok')."""
     n = len(data)
     if n < TAG_BYTES or data[n - TAG_BYTES:n - TAG_BYTES + 4] != MAGIC:
         return "untagged"
     at = n - TAG_BYTES
-    head = bytes(data[at:at + 20])
-    if not hmac.compare_digest(tag_of(key, channel, head, data[:at]), bytes(data[at + 20:])):
+    head = bytes(data[at:at + HEAD])
+    if not hmac.compare_digest(tag_of(key, channel, head, data[:at]), bytes(data[at + HEAD:])):
         return "bad_tag"
-    sender, seq = struct.unpack("<QQ", head[4:])
-    if (sender, seq) in seen:
+    epoch, sender, seq = struct.unpack("<QQQ", head[4:])
+    if (epoch, sender, seq) in seen:
         return "replayed"
-    seen.add((sender, seq))
+    seen.add((epoch, sender, seq))
     return "ok"
 
 

@@ -11,12 +11,12 @@ import pytest
 from dynhet import bus
 
 KEY = bytes(range(32))
-PINNED = bytes.fromhex("64796e68657444485431080706050403020109000000000000007da42331314e2e3cd426815e627ed843a74e"
-                       "a41ff32ca3e937166ea642548135")
+PINNED = bytes.fromhex("64796e68657444485432030000000000000008070605040302010900000000000000bd9d019218b1"
+                       "5947e628224db93e06ab7c44fb6df5b978ca416db44b21eb6ce0")
 
 
 def test_tag_is_the_one_the_cpp_side_checks():
-    assert bus.sign(KEY, "DYNHET_RUN", b"dynhet", 0x0102030405060708, 9) == PINNED
+    assert bus.sign(KEY, "DYNHET_RUN", b"dynhet", 0x0102030405060708, 9, epoch=3) == PINNED
     assert bus.verdict(KEY, "DYNHET_RUN", PINNED, set()) == "ok"
     assert bus.verdict(KEY, "DYNHET_FRAME", PINNED, set()) == "bad_tag"
     assert bus.verdict(bytes(32), "DYNHET_RUN", PINNED, set()) == "bad_tag"

@@ -7,23 +7,26 @@
 // file only its owner can read (run_scene.sh creates DIR/bus.key), and every
 // message carries a tag after its LCM bytes:
 //
-//   LCM bytes | "DHT1" | sender (8 bytes) | sequence (8) | tag (32)
+//   LCM bytes | "DHT2" | epoch (8 bytes) | sender (8) | sequence (8) | tag (32)
 //
 // tag = keyed BLAKE2b-256 (libsodium's crypto_generichash) over a domain
-// string, the channel's name, the sender, the sequence number and the LCM
-// bytes, which hold the run id (every dynhet message carries it). The
-// sender is 8 random bytes drawn when a process starts; its sequence counts
-// from 1. A receiver checks the tag before it decodes anything (in constant
-// time) and drops a message with no tag, a wrong tag, or a (sender,
-// sequence) it has already taken (a window of the last 1024 per sender:
-// LCM over UDP may deliver a sender's messages on different channels a
-// little out of order, never one twice).
+// string, the channel's name, the epoch, the sender, the sequence number
+// and the LCM bytes, which hold the run id (every dynhet message carries
+// it). The epoch is one launch of the run's processes (run_scene.sh draws
+// one at each start and resume, --bus-epoch): a receiver takes only its own
+// launch's, so a message recorded in an earlier segment of the run cannot
+// be replayed into a later one. The sender is 8 random bytes drawn when a
+// process starts; its sequence counts from 1. A receiver checks the tag
+// before it decodes anything (in constant time) and drops a message with no
+// tag, a wrong tag, another epoch, or a (sender, sequence) it has already
+// taken (a window of the last 1024 per sender: LCM over UDP may deliver a
+// sender's messages on different channels a little out of order, never one
+// twice).
 //
-// What it does not stop: a process restarted alone (a node resumed by hand)
-// draws a new sender, and a receiver that started after it cannot tell a
-// replay of an earlier process's message from a first copy. Such a replay
-// is a genuine message of the run, and the checks every message already
-// gets (frame numbers, cut numbers, results taken once) still apply.
+// What it does not stop: processes started by hand without --bus-epoch
+// share epoch 0, and one restarted alone draws a new sender that a receiver
+// started after it cannot tell from a first copy. Replays (replay.sh) take
+// every epoch of the log, which replay.sh checked first.
 //
 // Tools that only watch (lcm-spy, lcm-logger) see the LCM bytes first and
 // ignore the tail.
@@ -61,12 +64,13 @@ private:
   std::array<unsigned char, kBytes> key_{};
 };
 
-constexpr std::size_t kBusTagBytes = 4 + 8 + 8 + 32; // what a tag adds to a message
+constexpr std::size_t kBusTagBytes = 4 + 8 + 8 + 8 + 32; // what a tag adds to a message
 
 // Tags messages for one process (one sender); thread-safe.
 class BusSigner {
 public:
-  explicit BusSigner(std::shared_ptr<const BusKey> key);
+  // epoch: this launch's (bus_auth.hpp), carried in every tag.
+  BusSigner(std::shared_ptr<const BusKey> key, std::uint64_t epoch);
   // Writes the tag of message[0, n) (the LCM encoding) at message + n:
   // message must hold n + kBusTagBytes bytes.
   void tag(const std::string& channel, std::uint8_t* message, std::size_t n);
@@ -74,7 +78,7 @@ public:
 
 private:
   std::shared_ptr<const BusKey> key_;
-  std::uint64_t sender_;
+  std::uint64_t epoch_, sender_;
   std::mutex mutex_;
   std::uint64_t sequence_ = 0;
 };
@@ -83,12 +87,17 @@ private:
 // thread-safe.
 class BusVerifier {
 public:
-  enum class Verdict { ok, untagged, bad_tag, replayed };
-  explicit BusVerifier(std::shared_ptr<const BusKey> key);
+  enum class Verdict { ok, untagged, bad_tag, other_epoch, replayed };
+  // epoch: the only one taken; any_epoch: every epoch (a replay of a
+  // recorded log, checked as a whole first).
+  BusVerifier(std::shared_ptr<const BusKey> key, std::uint64_t epoch, bool any_epoch = false);
   // ok: the message is genuine and new; its LCM bytes are the first
   // `payload` bytes. Anything else: drop it (what() says why).
   Verdict verify(const std::string& channel, const void* data, std::size_t n, std::size_t& payload);
   static const char* what(Verdict v);
+  // Which launch's messages are taken from now on (the recorder replaying
+  // its journal takes each stretch with the epoch it was received under).
+  void set_epoch(std::uint64_t epoch, bool any_epoch);
   static constexpr std::uint64_t kWindow = 1024;
 
 private:
@@ -98,6 +107,8 @@ private:
   };
   bool take(std::uint64_t sender, std::uint64_t sequence);
   std::shared_ptr<const BusKey> key_;
+  std::uint64_t epoch_;
+  bool any_epoch_;
   std::mutex mutex_;
   std::unordered_map<std::uint64_t, Window> windows_;
 };

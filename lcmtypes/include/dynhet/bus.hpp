@@ -6,6 +6,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include <cstdint>
+#include <cstdlib>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -20,12 +21,32 @@ public:
   // The key file (--key-file) or, explicitly, none (--unauthenticated):
   // exactly one of them. Throws std::runtime_error with a message for the
   // user (the program's name first) otherwise, and on a bad key file.
-  static Bus from_options(const std::string& program, const std::string& key_file, bool unauthenticated) {
+  // Without --key-file, $DYNHET_KEY_FILE names the key; --unauthenticated
+  // wins over it. epoch (--bus-epoch): this launch's number (run_scene.sh
+  // draws one per start and resume), "" for 0, or "any" to take every
+  // launch's messages (a replay of a recorded log).
+  static Bus from_options(const std::string& program, std::string key_file, bool unauthenticated,
+                          const std::string& epoch = "") {
+    if (key_file.empty() && !unauthenticated)
+      if (const char* env = std::getenv("DYNHET_KEY_FILE"); env && *env) key_file = env;
     if (key_file.empty() && !unauthenticated)
       throw std::runtime_error(program + ": --key-file FILE is required (the run's key: run_scene.sh writes "
-                                         "DIR/bus.key), or --unauthenticated to use an open bus on purpose");
+                                         "DIR/bus.key; or $DYNHET_KEY_FILE), or --unauthenticated to use an open "
+                                         "bus on purpose");
     if (!key_file.empty() && unauthenticated)
       throw std::runtime_error(program + ": --key-file and --unauthenticated exclude each other");
+    std::uint64_t e = 0;
+    const bool any = epoch == "any";
+    if (!epoch.empty() && !any) {
+      std::size_t used = 0;
+      try {
+        e = std::stoull(epoch, &used);
+      } catch (const std::exception&) {
+        used = 0;
+      }
+      if (used != epoch.size() || epoch[0] == '-')
+        throw std::runtime_error(program + ": --bus-epoch is a non-negative integer or \"any\", not \"" + epoch + "\"");
+    }
     Bus b;
     if (!key_file.empty()) {
       std::shared_ptr<const BusKey> key;
@@ -34,16 +55,24 @@ public:
       } catch (const std::exception& e) {
         throw std::runtime_error(program + ": " + e.what());
       }
-      b.signer_ = std::make_shared<BusSigner>(key);
-      b.verifier_ = std::make_shared<BusVerifier>(key);
+      b.signer_ = std::make_shared<BusSigner>(key, e);
+      b.verifier_ = std::make_shared<BusVerifier>(key, e, any);
+      b.epoch_ = e, b.any_epoch_ = any;
     }
     return b;
   }
   static Bus open_bus() { return Bus{}; } // unauthenticated (tests, tools)
-  explicit Bus(std::shared_ptr<const BusKey> key)
-      : signer_(std::make_shared<BusSigner>(key)), verifier_(std::make_shared<BusVerifier>(key)) {}
+  explicit Bus(std::shared_ptr<const BusKey> key, std::uint64_t epoch = 0)
+      : signer_(std::make_shared<BusSigner>(key, epoch)), verifier_(std::make_shared<BusVerifier>(key, epoch)) {}
 
   bool authenticated() const { return signer_ != nullptr; }
+  std::uint64_t epoch() const { return epoch_; }
+  bool any_epoch() const { return any_epoch_; }
+  // Takes another launch's messages from now on (the recorder's journal
+  // replay: each stretch under the epoch it was received with).
+  void take_epoch(std::uint64_t epoch, bool any) const {
+    if (verifier_) verifier_->set_epoch(epoch, any);
+  }
   const char* describe() const { return authenticated() ? "authenticated (the run's key)" : "UNAUTHENTICATED"; }
 
   // Encodes m, tags it and publishes it; LCM's result (0: sent), -1 if m
@@ -81,6 +110,8 @@ private:
   Bus() = default;
   std::shared_ptr<BusSigner> signer_;
   std::shared_ptr<BusVerifier> verifier_;
+  std::uint64_t epoch_ = 0;
+  bool any_epoch_ = false;
 };
 
 // The LCM bytes of a message that may carry a tag, without checking the
@@ -89,7 +120,7 @@ private:
 inline std::size_t lcm_bytes_of(const void* data, std::size_t n) {
   const auto* b = static_cast<const unsigned char*>(data);
   if (n >= kBusTagBytes && b[n - kBusTagBytes] == 'D' && b[n - kBusTagBytes + 1] == 'H' &&
-      b[n - kBusTagBytes + 2] == 'T' && b[n - kBusTagBytes + 3] == '1')
+      b[n - kBusTagBytes + 2] == 'T' && b[n - kBusTagBytes + 3] == '2')
     return n - kBusTagBytes;
   return n;
 }
