@@ -1,5 +1,6 @@
 #include "frame_node.hpp"
 
+#include "dynhet/bus_cli.hpp"
 #include "dynhet/flow_control.hpp"
 #include "dynhet/lcm_exit.hpp"
 #include "dynhet/lcm_guard.hpp"
@@ -431,16 +432,8 @@ int node_main(const std::string& program, const std::string& description, NodeFa
   app.add_option("--lcm-url", url, "LCM URL to read from (file://LOG?speed=0 replays a log)");
   app.add_option("--publish-url", publish_url, "LCM URL to publish on (default: the input bus)");
   app.add_option("--run-id", run_id, "only this run (default: the first one seen)");
-  std::string key_file;
-  bool unauthenticated = false;
-  app.add_option("--key-file", key_file,
-                 "the run's key (32 bytes, mode 0600; run_scene.sh writes DIR/bus.key): every message received is "
-                 "checked with it before it is decoded, every message published is tagged (docs/bus.md); default $DYNHET_KEY_FILE");
-  app.add_flag("--unauthenticated", unauthenticated, "no key: an open bus, on purpose (tests, tools)");
-  std::string bus_epoch;
-  app.add_option("--bus-epoch", bus_epoch,
-                 "this launch's number (run_scene.sh draws one per start and resume): only its messages are taken; "
-                 "\"any\" takes every launch's (a replay)");
+  BusOptions bus_options;
+  add_bus_options(app, bus_options);
   app.add_option("--wait-run", wait_run, "give up after this many seconds without run info");
   app.add_option("--sim-timeout", sim_timeout, "give up if the sim is silent this long (s) during a run");
   int64_t max_queue_mib = 1024;
@@ -466,7 +459,7 @@ int node_main(const std::string& program, const std::string& description, NodeFa
 
   std::optional<Bus> bus;
   try {
-    bus.emplace(Bus::from_options(program, key_file, unauthenticated, bus_epoch));
+    bus.emplace(bus_from(program, bus_options));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;

@@ -171,6 +171,7 @@ def main():
     ap.add_argument("--port", type=int, default=7791, help="LCM port of both runs (each in its own namespace)")
     a = ap.parse_args()
     bin_ = os.path.join(a.build, "bin")
+    os.environ["BUILD_DIR"] = os.path.abspath(a.build)  # run_scene.sh's binaries are --build's too
     os.makedirs(a.work, exist_ok=True)
     rows = []
     for n in [int(float(x)) for x in a.n.split(",")]:

@@ -39,6 +39,7 @@
 #include <lcm/lcm-cpp.hpp>
 
 #include "dynhet/bus.hpp"
+#include "dynhet/bus_cli.hpp"
 #include "dynhet/flow_control.hpp"
 #include "dynhet/lcm_url.hpp"
 #include "dynhet/scene.hpp"
@@ -65,9 +66,7 @@ struct Options {
   std::string checkpoint_dir;
   int resume_cut = -1;
   double cut_wait = 300; // after a signal: how long to wait for the next cut
-  std::string key_file;
-  bool unauthenticated = false;
-  std::string bus_epoch;
+  dynhet::BusOptions bus;
 };
 
 // The one channel each message may come on (lcm_url.hpp: one channel per
@@ -547,13 +546,7 @@ int main(int argc, char **argv) {
       ->capture_default_str();
   app.add_option("--wait-run", o.wait_run, "seconds to wait for the run info")->capture_default_str();
   app.add_option("--run-id", o.run_id, "record only this run (default: the first one seen)");
-  app.add_option("--key-file", o.key_file,
-                 "the run's key (32 bytes, mode 0600; run_scene.sh writes DIR/bus.key): every message is checked "
-                 "with it before it is decoded, the recorder's own are tagged (docs/bus.md); default $DYNHET_KEY_FILE");
-  app.add_flag("--unauthenticated", o.unauthenticated, "no key: an open bus, on purpose (tests, tools)");
-  app.add_option("--bus-epoch", o.bus_epoch,
-                 "this launch's number (run_scene.sh draws one per start and resume): only its messages are taken; "
-                 "\"any\" takes every launch's (a replay)");
+  dynhet::add_bus_options(app, o.bus);
   app.add_option("--author", o.author,
                  "the file's h5md/author name (default: $DYNHET_AUTHOR, else $USER, else \"unknown\")");
   app.add_option("--author-email", o.author_email, "the file's h5md/author email (default: none)");
@@ -570,7 +563,7 @@ int main(int argc, char **argv) {
   if (o.out.empty()) return app.exit(CLI::RequiredError("--out"));
   std::optional<dynhet::Bus> bus;
   try {
-    bus.emplace(dynhet::Bus::from_options("recorder", o.key_file, o.unauthenticated, o.bus_epoch));
+    bus.emplace(dynhet::bus_from("recorder", o.bus));
   } catch (const std::exception &e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;

@@ -26,6 +26,7 @@
 #include "reporter.hpp"
 #include "cut_coordinator.hpp"
 #include "dynhet/bus.hpp"
+#include "dynhet/bus_cli.hpp"
 #include "dynhet/cut.hpp"
 #include "dynhet/state_archive.hpp"
 #include "dynhet/chunking.hpp"
@@ -257,16 +258,8 @@ int main(int argc, char** argv) {
                "runs of the same dynamics from it equal the runs that equilibrate themselves, bit for bit");
   app.add_option("--lcm-url", url, "LCM URL (default $LCM_DEFAULT_URL or " + std::string(dynhet::kDefaultLcmUrl) + ")");
   app.add_option("--run-id", run_id, "run id (default: random)");
-  std::string key_file;
-  bool unauthenticated = false;
-  app.add_option("--key-file", key_file,
-                 "the run's key (32 bytes, mode 0600; run_scene.sh writes DIR/bus.key): every message is tagged "
-                 "with it and every message received is checked (docs/bus.md); default $DYNHET_KEY_FILE");
-  app.add_flag("--unauthenticated", unauthenticated, "no key: an open bus, on purpose (tests, tools)");
-  std::string bus_epoch;
-  app.add_option("--bus-epoch", bus_epoch,
-                 "this launch's number (run_scene.sh draws one per start and resume): only its messages are taken; "
-                 "\"any\" takes every launch's (a replay)");
+  dynhet::BusOptions bus_options;
+  dynhet::add_bus_options(app, bus_options);
   bool pace = false;
   app.add_flag("--pace-nodes", pace,
                "flow control: hold each frame until the scene's nodes, and the recorder when the scene keeps the "
@@ -384,7 +377,7 @@ int main(int argc, char** argv) {
 
   std::optional<dynhet::Bus> bus_or;
   try {
-    bus_or.emplace(dynhet::Bus::from_options("sim_node", key_file, unauthenticated, bus_epoch));
+    bus_or.emplace(dynhet::bus_from("sim_node", bus_options));
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s\n", e.what());
     return 2;

@@ -94,42 +94,34 @@ rejected = int(f.attrs['messages_rejected_recorder']) + sum(int(n[k].attrs['mess
 print(int(f.attrs['messages_unauthenticated_recorder']), int(f.attrs['messages_unauthenticated_sim']),
       *(int(n[k].attrs['messages_unauthenticated']) for k in ('overlap', 's4', 'clusters')), rejected)" "$1"
 }
-"$hostile" "$LCM_DEFAULT_URL" 4245 60 --forge-done >"$tmp/outsider.log" 2>&1 &
-hp=$!
-sleep 0.5
-"${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/outsider" --run-id 4245 >"$tmp/outsider_run.log" 2>&1 && rc=0 || rc=$?
-kill $hp 2>/dev/null || true
-read -r ur us uo u4 uc rej < <(unauth "$tmp/outsider/run.h5" 2>/dev/null || echo "0 0 0 0 0 -1")
-echo "attacker without the key: unauthenticated dropped by recorder $ur, sim $us, overlap $uo, s4 $u4, clusters $uc; malformed $rej"
+under_attack() { # NAME RUN_ID HOSTILE_ARGS...: a tiny run NAME while the hostile publisher runs; sets rc,
+  # and ur us uo u4 uc rej (unauthenticated drops: recorder, sim, nodes; malformed), forged, last
+  local name=$1 id=$2; shift 2
+  "$hostile" "$LCM_DEFAULT_URL" "$id" 60 "$@" >"$tmp/$name.hostile.log" 2>&1 &
+  local hp=$!
+  sleep 0.5
+  "${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/$name" --run-id "$id" >"$tmp/$name.log" 2>&1 && rc=0 || rc=$?
+  kill $hp 2>/dev/null || true
+  wait $hp 2>/dev/null || true
+  forged=$(sed -n 's/.*forged \([0-9]*\) messages.*/\1/p' "$tmp/$name.hostile.log")
+  read -r ur us uo u4 uc rej < <(unauth "$tmp/$name/run.h5" 2>/dev/null || echo "0 0 0 0 0 -1")
+  last=$($py -c "import h5py, sys; v = h5py.File(sys.argv[1], 'r').attrs['last_unauthenticated_recorder']; print(v.decode() if isinstance(v, bytes) else v)" "$tmp/$name/run.h5" 2>/dev/null || true)
+  echo "$name: ${forged:-?} forged; unauthenticated dropped by recorder $ur, sim $us, overlap $uo, s4 $u4, clusters $uc; malformed $rej; last: $last"
+}
+under_attack outsider 4245 --forge-done
 check '[[ $rc == 0 ]] && complete "$tmp/outsider/run.h5"' "attacker without the key: the run completes (exit $rc)"
 check '(( ur > 100 && uo > 100 && u4 > 100 && uc > 100 && rej == 0 ))' \
   "attacker without the key: the recorder and every node drop all its messages as unauthenticated, none reach the content checks"
 check '(( us > 100 ))' "attacker without the key: the sim drops its node statuses (well-formed, this run's, far ahead) as unauthenticated ($us)"
 check 'same "$tmp/clean/run.h5" "$tmp/outsider/run.h5"' "attacker without the key: results equal the clean run's bit for bit"
-"$hostile" "$LCM_DEFAULT_URL" 4246 60 --tamper >"$tmp/tamper.log" 2>&1 &
-hp=$!
-sleep 0.5
-"${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/tampered" --run-id 4246 >"$tmp/tampered_run.log" 2>&1 && rc=0 || rc=$?
-kill $hp 2>/dev/null || true
-wait $hp 2>/dev/null || true
-read -r ur us uo u4 uc rej < <(unauth "$tmp/tampered/run.h5" 2>/dev/null || echo "0 0 0 0 0 -1")
-echo "$(cat "$tmp/tamper.log"): unauthenticated dropped by recorder $ur, sim $us, overlap $uo, s4 $u4, clusters $uc; malformed $rej"
+under_attack tampered 4246 --tamper
 check '[[ $rc == 0 ]] && complete "$tmp/tampered/run.h5"' "replayed, untagged and changed copies of the run's messages: the run completes (exit $rc)"
 check '(( ur > 100 && us > 10 && uo > 50 && u4 > 50 && uc > 50 && rej == 0 ))' \
   "replayed, untagged and changed copies: dropped and counted as unauthenticated by the recorder, the sim (node statuses) and every node"
 check 'same "$tmp/clean/run.h5" "$tmp/tampered/run.h5"' "replayed, untagged and changed copies: results equal the clean run's bit for bit"
 # Replays alone: byte-for-byte copies of the run's messages, each dropped
 # as a replay (the recorder hears nearly every channel the copies go to).
-"$hostile" "$LCM_DEFAULT_URL" 4247 60 --tamper --replay-only >"$tmp/replays.log" 2>&1 &
-hp=$!
-sleep 0.5
-"${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/replayed" --run-id 4247 >"$tmp/replayed_run.log" 2>&1 && rc=0 || rc=$?
-kill $hp 2>/dev/null || true
-wait $hp 2>/dev/null || true
-forged=$(sed -n 's/.*forged \([0-9]*\) messages.*/\1/p' "$tmp/replays.log")
-read -r ur us uo u4 uc rej < <(unauth "$tmp/replayed/run.h5" 2>/dev/null || echo "0 0 0 0 0 -1")
-last=$($py -c "import h5py, sys; v = h5py.File(sys.argv[1], 'r').attrs['last_unauthenticated_recorder']; print(v.decode() if isinstance(v, bytes) else v)" "$tmp/replayed/run.h5" 2>/dev/null || true)
-echo "replays alone: ${forged:-?} copies sent; unauthenticated dropped by recorder $ur, sim $us, overlap $uo, s4 $u4, clusters $uc; last: $last"
+under_attack replayed 4247 --tamper --replay-only
 check '[[ $rc == 0 ]] && complete "$tmp/replayed/run.h5" && same "$tmp/clean/run.h5" "$tmp/replayed/run.h5"' \
   "replayed copies alone: the run completes, results equal the clean run's bit for bit (exit $rc)"
 check '(( ${forged:-0} > 200 && 10 * ur >= 9 * forged && us > 0 && uo > 0 )) && [[ $last == *replay* ]]' \
