@@ -103,10 +103,13 @@ under_attack() { # NAME RUN_ID HOSTILE_ARGS...: a tiny run NAME while the hostil
   "${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/$name" --run-id "$id" >"$tmp/$name.log" 2>&1 && rc=0 || rc=$?
   kill $hp 2>/dev/null || true
   wait $hp 2>/dev/null || true
-  forged=$(sed -n 's/.*forged \([0-9]*\) messages.*/\1/p' "$tmp/$name.hostile.log")
-  read -r ur us uo u4 uc rej < <(unauth "$tmp/$name/run.h5" 2>/dev/null || echo "0 0 0 0 0 -1")
-  last=$($py -c "import h5py, sys; v = h5py.File(sys.argv[1], 'r').attrs['last_unauthenticated_recorder']; print(v.decode() if isinstance(v, bytes) else v)" "$tmp/$name/run.h5" 2>/dev/null || true)
-  echo "$name: ${forged:-?} forged; unauthenticated dropped by recorder $ur, sim $us, overlap $uo, s4 $u4, clusters $uc; malformed $rej; last: $last"
+  attack_counts "$name"
+}
+attack_counts() { # NAME: what the hostile publisher sent and what run NAME dropped (forged ur us uo u4 uc rej last)
+  forged=$(sed -n 's/.*forged \([0-9]*\) messages.*/\1/p' "$tmp/$1.hostile.log")
+  read -r ur us uo u4 uc rej < <(unauth "$tmp/$1/run.h5" 2>/dev/null || echo "0 0 0 0 0 -1")
+  last=$($py -c "import h5py, sys; v = h5py.File(sys.argv[1], 'r').attrs['last_unauthenticated_recorder']; print(v.decode() if isinstance(v, bytes) else v)" "$tmp/$1/run.h5" 2>/dev/null || true)
+  echo "$1: ${forged:-?} forged; unauthenticated dropped by recorder $ur, sim $us, overlap $uo, s4 $u4, clusters $uc; malformed $rej; last: $last"
 }
 under_attack outsider 4245 --forge-done
 check '[[ $rc == 0 ]] && complete "$tmp/outsider/run.h5"' "attacker without the key: the run completes (exit $rc)"
@@ -134,7 +137,7 @@ check '(( ${forged:-0} > 200 && 10 * ur >= 9 * forged && us > 0 && uo > 0 )) && 
 sed 's/^equilibration_time = 5.0/equilibration_time = 5.0\ncheckpoint_interval = 0.5/' "$root/scenes/tiny.toml" >"$tmp/cuts.toml"
 "${run[@]}" "$tmp/cuts.toml" --out "$tmp/cuts_clean" --run-id 4249 --no-plots >"$tmp/cuts_clean.log" 2>&1 ||
   { tail -20 "$tmp/cuts_clean.log"; exit 1; }
-"$hostile" "$LCM_DEFAULT_URL" 4248 240 --tamper --hold >"$tmp/hold.log" 2>&1 &
+"$hostile" "$LCM_DEFAULT_URL" 4248 240 --tamper --hold >"$tmp/held.hostile.log" 2>&1 &
 hp=$!
 sleep 0.5
 set -m
@@ -147,10 +150,7 @@ wait $run_pid && rc1=0 || rc1=$?
 "${run[@]}" "$tmp/cuts.toml" --out "$tmp/held" --run-id 4248 --no-plots >>"$tmp/held_run.log" 2>&1 && rc=0 || rc=$?
 kill $hp 2>/dev/null || true
 wait $hp 2>/dev/null || true
-forged=$(sed -n 's/.*forged \([0-9]*\) messages.*/\1/p' "$tmp/hold.log")
-read -r ur us uo u4 uc rej < <(unauth "$tmp/held/run.h5" 2>/dev/null || echo "0 0 0 0 0 -1")
-last=$($py -c "import h5py, sys; v = h5py.File(sys.argv[1], 'r').attrs['last_unauthenticated_recorder']; print(v.decode() if isinstance(v, bytes) else v)" "$tmp/held/run.h5" 2>/dev/null || true)
-echo "replays across a resume: ${forged:-?} messages of the first launch sent again; dropped by recorder $ur, sim $us, overlap $uo, s4 $u4, clusters $uc; last: $last"
+attack_counts held
 check '[[ $rc1 != 0 && $rc == 0 ]] && complete "$tmp/held/run.h5" && same "$tmp/cuts_clean/run.h5" "$tmp/held/run.h5"' \
   "replays across a resume: the run stopped (exit $rc1), resumed and completed (exit $rc), results equal the clean run's bit for bit"
 check '(( ${forged:-0} > 100 && ur > 50 && uo > 0 && rej == 0 )) && [[ $last == *"another launch"* ]]' \
