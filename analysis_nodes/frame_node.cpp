@@ -457,13 +457,8 @@ int node_main(const std::string& program, const std::string& description, NodeFa
     return 2;
   }
 
-  std::optional<Bus> bus;
-  try {
-    bus.emplace(bus_from(program, bus_options));
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 2;
-  }
+  const std::optional<Bus> bus = bus_or_say(program, bus_options);
+  if (!bus) return 2;
   const std::string in_url = resolve_lcm_url(url);
   const bool replay = in_url.rfind("file://", 0) == 0;
   lcm::LCM in(in_url);

@@ -51,6 +51,17 @@ std::string errno_text() { return std::strerror(errno); }
 
 } // namespace
 
+std::size_t lcm_bytes_of(const void* data, std::size_t n) {
+  const auto* b = static_cast<const unsigned char*>(data);
+  return n >= kBusTagBytes && std::memcmp(b + n - kBusTagBytes, kMagic, 4) == 0 ? n - kBusTagBytes : n;
+}
+
+std::optional<std::uint64_t> bus_epoch_of(const void* data, std::size_t n) {
+  const auto* b = static_cast<const unsigned char*>(data);
+  if (lcm_bytes_of(data, n) == n) return std::nullopt;
+  return get_u64(b + n - kBusTagBytes + 4);
+}
+
 BusKey::~BusKey() { sodium_memzero(key_.data(), key_.size()); }
 
 std::shared_ptr<const BusKey> BusKey::load(const std::string& path) {

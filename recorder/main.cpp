@@ -174,7 +174,7 @@ private:
     Msg m;
     std::string why;
     int lcm_bytes = 0;
-    if (!bus_.open(ch, data, static_cast<std::size_t>(size), lcm_bytes, why)) return reject(ch, why);
+    if (!bus_.open(ch, data, static_cast<std::size_t>(size), lcm_bytes, why)) return unauthenticated(ch, why);
     if (!dynhet::guard::safe_decode(data, lcm_bytes, m, why)) return reject(ch, why);
     if (const std::string own = channel_of(m); ch != own)
       return reject(ch, "not this message's channel, which is " + own.substr(0, 80));
@@ -184,14 +184,15 @@ private:
       reject(ch, std::string("handler: ") + e.what());
     }
   }
+  // Dropped by the bus (no tag, a wrong one, another launch's, a replay):
+  // counted apart from the malformed ones.
+  void unauthenticated(const std::string &ch, const std::string &why) {
+    rec_.message_unauthenticated(ch, why);
+    if (rec_.messages_unauthenticated() <= 10 || rec_.messages_unauthenticated() % 1000 == 0)
+      std::fprintf(stderr, "recorder: dropped a message on %s (%s; %lld so far)\n", ch.c_str(), why.c_str(),
+                   static_cast<long long>(rec_.messages_unauthenticated()));
+  }
   void reject(const std::string &ch, const std::string &why) {
-    if (dynhet::unauthenticated_reason(why)) {
-      rec_.message_unauthenticated(ch, why);
-      if (rec_.messages_unauthenticated() <= 10 || rec_.messages_unauthenticated() % 1000 == 0)
-        std::fprintf(stderr, "recorder: dropped a message on %s (%s; %lld so far)\n", ch.c_str(), why.c_str(),
-                     static_cast<long long>(rec_.messages_unauthenticated()));
-      return;
-    }
     rec_.message_rejected(ch, why);
     if (rec_.messages_rejected() <= 10 || rec_.messages_rejected() % 1000 == 0)
       std::fprintf(stderr, "recorder: dropped a message on %s (%s; %lld so far)\n", ch.c_str(), why.c_str(),
@@ -381,7 +382,7 @@ void Session::take_checkpoint(const lcm::ReceiveBuffer *rb, const std::string &c
   dynhet::checkpoint_t m;
   std::string why;
   int lcm_bytes = 0;
-  if (!bus_.open(ch, rb->data, rb->data_size, lcm_bytes, why)) return reject(ch, why);
+  if (!bus_.open(ch, rb->data, rb->data_size, lcm_bytes, why)) return unauthenticated(ch, why);
   if (!dynhet::guard::safe_decode(rb->data, lcm_bytes, m, why)) return reject(ch, why);
   if (m.run_id != rec_.run_id()) return;
   if (const std::string bad = dynhet::checkpoint_problem(m, rec_.n_frames()); !bad.empty())
@@ -561,13 +562,8 @@ int main(int argc, char **argv) {
   CLI11_PARSE(app, argc, argv);
   if (!list_log.empty()) return list_nodes(list_log);
   if (o.out.empty()) return app.exit(CLI::RequiredError("--out"));
-  std::optional<dynhet::Bus> bus;
-  try {
-    bus.emplace(dynhet::bus_from("recorder", o.bus));
-  } catch (const std::exception &e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 2;
-  }
+  const std::optional<dynhet::Bus> bus = dynhet::bus_or_say("recorder", o.bus);
+  if (!bus) return 2;
 
   const std::string url = dynhet::resolve_lcm_url(o.url);
   lcm::LCM lcm(url);

@@ -25,6 +25,7 @@
 #include "pacer.hpp"
 #include "reporter.hpp"
 #include "cut_coordinator.hpp"
+#include "initial_state.hpp"
 #include "dynhet/bus.hpp"
 #include "dynhet/bus_cli.hpp"
 #include "dynhet/cut.hpp"
@@ -89,147 +90,6 @@ dynhet::run_info_t make_run_info(const dynhet::Scene& sc, const dynhet::engine::
   m.chunk_particles = sc.chunk_particles;
   m.scene_toml = sc.text;
   return m;
-}
-
-dynhet::engine::Params engine_params(const dynhet::Scene& scene) {
-  dynhet::engine::Params p;
-  p.n_particles = scene.n_particles;
-  p.packing_fraction = scene.packing_fraction;
-  p.restitution = scene.restitution;
-  p.radius_ratio = scene.radius_ratio;
-  p.seed = scene.seed;
-  p.driving = scene.driving;
-  p.tc = scene.tc_time;
-  p.kick_rate = dynhet::scene_kick_rate(scene);
-  p.kick_pairs = scene.kick_pairs == "any" ? dynhet::engine::KickPairs::any : dynhet::engine::KickPairs::neighbours;
-  p.kick_reach = scene.kick_reach;
-  return p;
-}
-
-// The first key of the dynamics (engine parameters) in which two scenes
-// differ, or "" if a run of one continues a state of the other exactly.
-std::string dynamics_difference(const dynhet::Scene& a, const dynhet::Scene& b) {
-  if (a.n_particles != b.n_particles) return "system.n_particles";
-  if (a.packing_fraction != b.packing_fraction) return "system.packing_fraction";
-  if (a.radius_ratio != b.radius_ratio) return "system.radius_ratio";
-  if (a.seed != b.seed) return "system.seed";
-  if (a.restitution != b.restitution) return "system.restitution";
-  if (a.tc_time != b.tc_time) return "the TC model";
-  if (a.driving != b.driving) return "driving";
-  if (dynhet::scene_kick_rate(a) != dynhet::scene_kick_rate(b)) return "the kick rate (driving)";
-  if (a.kick_pairs != b.kick_pairs) return "driving.pairs";
-  if (a.kick_reach != b.kick_reach) return "driving.reach";
-  return "";
-}
-
-// system.initial_state: a prepared state of the same system (N, phi,
-// radius ratio, seed), an equilibrated state of the same dynamics (sim_node
-// --prepare-only --equilibrate), or positions from an H5MD file (velocities
-// drawn).
-void start_from(dynhet::engine::Engine& eng, const dynhet::Scene& scene) {
-  const std::string& path = scene.initial_state;
-  if (access(path.c_str(), R_OK) != 0) throw std::runtime_error(path + ": no such file (system.initial_state)");
-  if (dynhet::is_checkpoint(path)) {
-    const dynhet::Checkpoint c = dynhet::read_checkpoint(path);
-    const dynhet::Scene made = dynhet::parse_scene_text(c.scene_toml, path + " (its scene)");
-    if (c.next_frame != 0)
-      throw std::runtime_error(path + ": a checkpoint taken after frame " + std::to_string(c.next_frame - 1) +
-                               ", not a prepared state (resume a run's checkpoint with --resume)");
-    if (c.state.time != 0.0) {
-      // An equilibrated state: the run continues it, as a resumed run would.
-      const std::string d = dynamics_difference(made, scene);
-      if (!d.empty())
-        throw std::runtime_error(path + ": equilibrated with another " + d +
-                                 " than the scene's (an equilibrated state serves only runs of the same dynamics)");
-      if (c.kick_pairs != scene.kick_pairs)
-        throw std::runtime_error(path + ": equilibrated with kick pairs \"" + c.kick_pairs + "\"");
-      if (c.state.time > scene.equilibration_time)
-        throw std::runtime_error(path + ": equilibrated to t = " + std::to_string(c.state.time) +
-                                 ", beyond the scene's run.equilibration_time = " +
-                                 std::to_string(scene.equilibration_time));
-      eng.restore(c.state);
-      return;
-    }
-    auto differs = [&](const char* key, const std::string& was, const std::string& is) {
-      if (was != is)
-        throw std::runtime_error(path + ": prepared for system." + key + " = " + was + ", the scene has " + is);
-    };
-    differs("n_particles", std::to_string(made.n_particles), std::to_string(scene.n_particles));
-    differs("packing_fraction", std::to_string(made.packing_fraction), std::to_string(scene.packing_fraction));
-    differs("radius_ratio", std::to_string(made.radius_ratio), std::to_string(scene.radius_ratio));
-    differs("seed", std::to_string(made.seed), std::to_string(scene.seed));
-    if (made.packing_fraction != scene.packing_fraction || made.radius_ratio != scene.radius_ratio)
-      throw std::runtime_error(path + ": prepared for another packing fraction or radius ratio (they differ "
-                               "beyond the digits shown)");
-    eng.start_prepared(c.state);
-    return;
-  }
-  std::vector<double> x, y;
-  dynhet::read_h5md_positions(path, eng.size(), eng.box_length(), x, y);
-  try {
-    eng.place(x, y);
-  } catch (const std::invalid_argument& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
-  eng.thermalize(1.0);
-  eng.begin();
-}
-
-// --prepare-only: compression and velocities, written as a checkpoint at
-// t = 0. With --equilibrate: then the scene's dynamics up to the last
-// checkpoint slot (a multiple of run.checkpoint_interval) at or before
-// run.equilibration_time, synchronised at every slot as a run is, and the
-// state there: a run of the same dynamics from it equals, bit for bit, the
-// run that equilibrates itself. The scene's own initial_state (a prepared
-// or a shorter equilibrated state) is the start if it has one.
-int prepare_only(const dynhet::Scene& scene, const std::string& path, bool equilibrate) {
-  try {
-    dynhet::engine::Engine eng(engine_params(scene));
-    const auto t0 = Clock::now();
-    const bool tty = isatty(STDERR_FILENO);
-    if (!equilibrate) {
-      eng.compress([&](double phi) {
-        if (tty) std::fprintf(stderr, "\rsim_node: compressing, phi = %.4f", phi);
-      });
-      eng.thermalize(1.0);
-      dynhet::write_checkpoint(path, {scene.text, 0, 0, scene.kick_pairs, eng.state()});
-      std::fprintf(stderr, "\nsim_node: prepared state (N=%ld, phi=%.4f, seed %llu) in %.1f s -> %s\n", eng.size(),
-                   eng.packing_fraction(), static_cast<unsigned long long>(scene.seed), seconds_since(t0),
-                   path.c_str());
-      return 0;
-    }
-    if (!scene.initial_state.empty()) {
-      start_from(eng, scene);
-    } else {
-      eng.prepare([&](double phi) {
-        if (tty) std::fprintf(stderr, "\rsim_node: compressing, phi = %.4f", phi);
-      });
-    }
-    const double interval = scene.checkpoint_interval;
-    const double t_end = std::floor(scene.equilibration_time / interval + 1e-9) * interval;
-    const double t_start = eng.time();
-    for (int64_t slot = static_cast<int64_t>(std::floor(t_start / interval + 0.5)) + 1; slot * interval <= t_end + 1e-12 * interval;
-         ++slot) {
-      while (!eng.run_until(slot * interval, 1000000)) {
-        if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
-        if (tty)
-          std::fprintf(stderr, "\rsim_node: equilibrating, t = %.6g of %.6g (%.1f s)", eng.time(), t_end,
-                       seconds_since(t0));
-      }
-      eng.synchronize();
-    }
-    if (eng.time() == 0.0)
-      throw std::runtime_error("run.equilibration_time = " + std::to_string(scene.equilibration_time) +
-                               " is shorter than one run.checkpoint_interval: nothing to equilibrate");
-    dynhet::write_checkpoint(path, {scene.text, 0, 0, scene.kick_pairs, eng.state()});
-    std::fprintf(stderr, "\nsim_node: equilibrated state (N=%ld, phi=%.4f, eps=%.3f, seed %llu) from t = %.6g to "
-                 "%.6g in %.1f s -> %s\n", eng.size(), eng.packing_fraction(), scene.restitution,
-                 static_cast<unsigned long long>(scene.seed), t_start, eng.time(), seconds_since(t0), path.c_str());
-    return 0;
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "\nsim_node: %s\n", e.what());
-    return 1;
-  }
 }
 
 } // namespace
@@ -343,7 +203,7 @@ int main(int argc, char** argv) {
     // The engine's own refusals (a box too small for its cells, ...) are
     // the scene's: made here, not at run time.
     try {
-      dynhet::engine::Engine probe(engine_params(scene));
+      dynhet::engine::Engine probe(dynhet::engine_params(scene));
     } catch (const std::exception& e) {
       std::fprintf(stderr, "sim_node: invalid scene (1 problem):\n  %s: system: %s\n", scene_path.c_str(), e.what());
       return 2;
@@ -371,17 +231,12 @@ int main(int argc, char** argv) {
   if (!prepare_path.empty()) {
     std::signal(SIGINT, on_signal);
     std::signal(SIGTERM, on_signal);
-    return prepare_only(scene, prepare_path, equilibrate);
+    return dynhet::prepare_only(scene, prepare_path, equilibrate, g_signal);
   }
   if (run_id == 0) run_id = static_cast<int64_t>(std::random_device{}() & 0x7fffffff) << 20 ^ getpid();
 
-  std::optional<dynhet::Bus> bus_or;
-  try {
-    bus_or.emplace(dynhet::bus_from("sim_node", bus_options));
-  } catch (const std::exception& e) {
-    std::fprintf(stderr, "%s\n", e.what());
-    return 2;
-  }
+  const std::optional<dynhet::Bus> bus_or = dynhet::bus_or_say("sim_node", bus_options);
+  if (!bus_or) return 2;
   const dynhet::Bus& bus = *bus_or;
   const std::string bus_url = dynhet::resolve_lcm_url(url);
   lcm::LCM lcm(bus_url);
@@ -405,7 +260,7 @@ int main(int argc, char** argv) {
   bool checkpoint_written = !resume_path.empty();
   int code = 0;
   try {
-    const dynhet::engine::Params p = engine_params(scene);
+    const dynhet::engine::Params p = dynhet::engine_params(scene);
     dynhet::engine::Engine eng(p);
     std::fprintf(stderr,
                  "sim_node: run %lld (bus %s), N=%ld phi=%.4f eps=%.3f L=%.4f, kicks %s (%.4g per particle per "
@@ -448,7 +303,7 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "sim_node: resumed at t=%.10g, frame %d, from %s\n", eng.time(),
                    resumed.next_frame, resume_path.c_str());
     } else if (!scene.initial_state.empty()) {
-      start_from(eng, scene);
+      dynhet::start_from(eng, scene);
       std::fprintf(stderr, "sim_node: started from %s (max overlap %.2g)\n", scene.initial_state.c_str(),
                    std::max(0.0, eng.max_overlap()));
     } else {

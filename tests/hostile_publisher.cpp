@@ -221,15 +221,6 @@ private:
 
 // Sends every message of the run back three ways (--tamper): a replay, the
 // content without its tag, the content changed under the genuine tag.
-// The launch epoch of a tagged message (bus_auth.hpp: magic, then the
-// epoch, little-endian), or none.
-std::optional<uint64_t> epoch_of(const uint8_t* p, size_t n) {
-  if (n < dynhet::kBusTagBytes + 8 || std::memcmp(p + n - dynhet::kBusTagBytes, "DHT2", 4) != 0) return std::nullopt;
-  uint64_t v = 0;
-  for (int i = 0; i < 8; ++i) v |= uint64_t{p[n - dynhet::kBusTagBytes + 4 + i]} << (8 * i);
-  return v;
-}
-
 class Tamper {
 public:
   // hold: keep the run's messages and send them all again, byte for byte,
@@ -245,8 +236,8 @@ private:
     const std::string bytes(reinterpret_cast<const char*>(p), rb->data_size);
     if (!seen_.insert(bytes).second) return; // its own copies, back over the bus
     const size_t n = rb->data_size;
-    const std::optional<uint64_t> epoch = epoch_of(p, n);
-    if (!epoch) return;
+    const std::optional<uint64_t> epoch = dynhet::bus_epoch_of(p, n);
+    if (!epoch || n < dynhet::kBusTagBytes + 8) return; // tagged, with a fingerprint to leave alone
     if (hold_) {
       if (!first_epoch_) first_epoch_ = epoch;
       if (*epoch == *first_epoch_) {
@@ -322,7 +313,7 @@ int main(int argc, char** argv) {
       void on(const lcm::ReceiveBuffer* rb, const std::string&) {
         const auto* p = static_cast<const uint8_t*>(rb->data);
         const size_t n = rb->data_size;
-        if (!e) e = epoch_of(p, n);
+        if (!e) e = dynhet::bus_epoch_of(p, n);
       }
     } epoch;
     lcm::Subscription* sub = lcm.subscribe("DYNHET_.*", &Epoch::on, &epoch);

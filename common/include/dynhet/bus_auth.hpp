@@ -37,6 +37,7 @@
 #include <cstdint>
 #include <memory>
 #include <mutex>
+#include <optional>
 #include <string>
 #include <unordered_map>
 #include <vector>
@@ -65,6 +66,14 @@ private:
 };
 
 constexpr std::size_t kBusTagBytes = 4 + 8 + 8 + 8 + 32; // what a tag adds to a message
+
+// Reading a message's tail without checking its tag: only for tools that
+// look at a log (which nodes a replay needs) or at the bus (tests); what
+// takes part in a run checks with BusVerifier.
+// The LCM bytes of a message that may carry a tag (all of it if none).
+std::size_t lcm_bytes_of(const void* data, std::size_t n);
+// The launch epoch a tagged message says it is of; none if untagged.
+std::optional<std::uint64_t> bus_epoch_of(const void* data, std::size_t n);
 
 // Tags messages for one process (one sender); thread-safe.
 class BusSigner {

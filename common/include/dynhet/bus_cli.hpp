@@ -5,6 +5,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include <cstdio>
+#include <optional>
 #include <string>
 
 #include "dynhet/bus.hpp"
@@ -27,9 +29,15 @@ inline void add_bus_options(CLI::App& app, BusOptions& o) {
                  "\"any\" takes every launch's (a replay)");
 }
 
-// Throws std::runtime_error with a message for the user (Bus::from_options).
-inline Bus bus_from(const std::string& program, const BusOptions& o) {
-  return Bus::from_options(program, o.key_file, o.unauthenticated, o.epoch);
+// The bus these options make, or none after saying why on stderr (a key
+// file refused, neither a key nor --unauthenticated: Bus::from_options).
+inline std::optional<Bus> bus_or_say(const std::string& program, const BusOptions& o) {
+  try {
+    return Bus::from_options(program, o.key_file, o.unauthenticated, o.epoch);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s\n", e.what());
+    return std::nullopt;
+  }
 }
 
 } // namespace dynhet

@@ -114,19 +114,4 @@ private:
   bool any_epoch_ = false;
 };
 
-// The LCM bytes of a message that may carry a tag, without checking the
-// tag: only for tools that read a log to learn what it holds (which nodes a
-// replay needs); whatever takes part in a run checks with Bus::open.
-inline std::size_t lcm_bytes_of(const void* data, std::size_t n) {
-  const auto* b = static_cast<const unsigned char*>(data);
-  if (n >= kBusTagBytes && b[n - kBusTagBytes] == 'D' && b[n - kBusTagBytes + 1] == 'H' &&
-      b[n - kBusTagBytes + 2] == 'T' && b[n - kBusTagBytes + 3] == '2')
-    return n - kBusTagBytes;
-  return n;
-}
-
-// Whether a drop reason is the bus's (counted as unauthenticated) rather
-// than a malformed message's.
-inline bool unauthenticated_reason(const std::string& why) { return why.rfind("unauthenticated", 0) == 0; }
-
 } // namespace dynhet
