@@ -199,8 +199,14 @@ private:
   std::map<int, Boundary> pending_cuts_; // asked for, not yet saved: frame -> cuts
   int saved_frame_ = -2;                  // the boundary of the last part saved (-2: none)
   int first_pending_frame() const;           // the earliest frame a pending cut is after (INT32_MAX: none)
-  int64_t saved_bytes_ = 0;
-  double saved_seconds_ = 0;
+  // The boundaries saved (the 64 latest): the sim asks again every second
+  // for a cut a slower process has not saved yet, and the answer to a
+  // boundary this node is past stays "saved".
+  struct SavedPart {
+    int64_t bytes = 0;
+    double seconds = 0;
+  };
+  std::map<int, SavedPart> saved_parts_; // frame -> its part
 
   lcm::LCM& out_;
   Bus bus_ = Bus::open_bus();

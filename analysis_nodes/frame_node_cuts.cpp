@@ -24,7 +24,8 @@ void FrameNode::on_checkpoint(const checkpoint_t& m) {
   // part, whichever cut asks for it: requests for a boundary already saved
   // are answered from it, and a flood of requests for one boundary costs
   // one part. The 64 nearest boundaries are kept (a flood of far ones goes).
-  if (m.frame == saved_frame_) return answer_cut(m.cut, m.frame, "saved", saved_bytes_, saved_seconds_, "");
+  if (const auto s = saved_parts_.find(m.frame); s != saved_parts_.end())
+    return answer_cut(m.cut, m.frame, "saved", s->second.bytes, s->second.seconds, "");
   Boundary& b = pending_cuts_[m.frame];
   if (std::find(b.cuts.begin(), b.cuts.end(), m.cut) == b.cuts.end() && b.cuts.size() < 16) b.cuts.push_back(m.cut);
   b.stop = b.stop || m.message == "stop";
@@ -70,11 +71,13 @@ void FrameNode::save_cut(int frame, const Boundary& b) {
     h.scene_hash = scene_hash(info_->scene_toml);
     write_part(path, h, out.bytes());
     saved_frame_ = frame;
-    saved_bytes_ = static_cast<int64_t>(out.bytes().size());
-    saved_seconds_ = std::chrono::duration<double>(Clock::now() - t0).count();
+    const SavedPart part{static_cast<int64_t>(out.bytes().size()),
+                         std::chrono::duration<double>(Clock::now() - t0).count()};
+    saved_parts_[frame] = part;
+    if (saved_parts_.size() > 64) saved_parts_.erase(saved_parts_.begin());
     std::fprintf(stderr, "%s_node: checkpoint: cut %d after frame %d saved (%.1f MB in %.2f s)\n", name_.c_str(),
-                 b.cuts.front(), frame, saved_bytes_ / 1e6, saved_seconds_);
-    for (int cut : b.cuts) answer_cut(cut, frame, "saved", saved_bytes_, saved_seconds_, "");
+                 b.cuts.front(), frame, part.bytes / 1e6, part.seconds);
+    for (int cut : b.cuts) answer_cut(cut, frame, "saved", part.bytes, part.seconds, "");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "%s_node: checkpoint: cut %d NOT saved: %s\n", name_.c_str(), b.cuts.front(), e.what());
     for (int cut : b.cuts) answer_cut(cut, frame, "failed", 0, 0, e.what());
@@ -115,6 +118,7 @@ void FrameNode::load_cut() {
     load_state(in);
     if (!in.at_end()) throw BadPart(path + ": " + std::to_string(bytes.size() - in.offset()) + " bytes left over");
     saved_frame_ = h.frame;
+    saved_parts_[h.frame] = SavedPart{static_cast<int64_t>(bytes.size()), 0};
     std::fprintf(stderr, "%s_node: resumed from cut %d after frame %d (t = %.10g): %d frames whole, %d lost, %d "
                  "pairs done, %zu origins held\n", name_.c_str(), h.cut, h.frame, last_time_,
                  assembler_.frames_whole(), assembler_.frames_lost(), pairs_done_, origins_.size());

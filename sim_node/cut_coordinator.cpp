@@ -86,6 +86,9 @@ void CutCoordinator::on_answer(const lcm::ReceiveBuffer* rb, const std::string& 
   if (m.state == "saved") {
     it->second.saved.insert(m.process);
   } else if (m.state == "failed") {
+    // A process that said "saved" has its part on disk (complete() checks):
+    // a later "failed" answers a request sent again, or is not its own.
+    if (it->second.saved.count(m.process)) return;
     std::fprintf(stderr, "\nsim_node: checkpoint cut %d: %s could not save its part (%s); the restart point stays "
                  "cut %d\n", m.cut, m.process.c_str(), m.message.c_str(), last_whole_);
     pending_.erase(it);

@@ -366,6 +366,14 @@ int main(int argc, char** argv) {
                    seconds_since(t0));
       return c;
     };
+    // While waiting for a cut to be whole the sim goes on publishing its
+    // status (once a second): the nodes that have saved it wait for the sim,
+    // and give up on one silent for their --sim-timeout (a slow or starved
+    // node or recorder can take longer than that to catch up).
+    auto keep_talking = [&] {
+      rep.update(eng, t_end - eng.time());
+      return false;
+    };
     auto cut_due = [&] {
       return cuts && (g_signal || scene.checkpoint_wall_interval <= 0 ||
                       cuts->seconds_since_take() >= scene.checkpoint_wall_interval);
@@ -409,7 +417,7 @@ int main(int argc, char** argv) {
             if (g_signal) {
               checkpoint_written = true;
               const int before = cuts->last_whole();
-              if (c >= 0 && cuts->wait_whole(c, cut_wait))
+              if (c >= 0 && cuts->wait_whole(c, cut_wait, keep_talking))
                 throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
                                          "; checkpoint cut " + std::to_string(c) + " after frame " +
                                          std::to_string(next_frame - 1) + " (t=" + std::to_string(eng.time()) +
@@ -512,7 +520,7 @@ int main(int argc, char** argv) {
     // The cuts still open are whole once the nodes have caught up: a run
     // that dies after the sim ends then loses nothing the sim did.
     if (cuts && cuts->newest_open() >= 0 &&
-        !cuts->wait_whole(cuts->newest_open(), cut_wait, [] { return g_signal != 0; })) {
+        !cuts->wait_whole(cuts->newest_open(), cut_wait, [&] { return keep_talking() || g_signal != 0; })) {
       if (g_signal) {
         checkpoint_written = true;
         throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
