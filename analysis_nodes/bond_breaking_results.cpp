@@ -80,11 +80,14 @@ bond_breaking_t BondBreaking::message() const {
     if (a.count()) m.c_b[j] = a.mean(), m.c_b_err[j] = a.standard_error();
   }
   // tau_B: where C_B crosses 1/e (as tau_alpha), its error a jackknife over
-  // blocks of origins spanning it.
+  // blocks of origins spanning it; none where the run's origins do not hold
+  // kMinJackknifeBlocks such blocks (a bond lives many origin spacings: the
+  // capped blocks gave errors a third of the seeds' spread, docs/analysis.md),
+  // and a study then takes the spread of its seeds.
   auto tau = [&](const std::vector<double>& c) { return std::vector<double>{an::crossing_time(m.lag_time, c, std::exp(-1.0))}; };
   m.tau_b = tau(m.c_b)[0];
   m.tau_b_err = kNan;
-  if (std::isfinite(m.tau_b)) {
+  if (std::isfinite(m.tau_b) && an::origin_blocks_span(m.tau_b, origin_spacing(run_), no)) {
     const int block = an::origin_block(m.tau_b, origin_spacing(run_), no);
     const auto e = an::origin_jackknife(c_b_, no, nl, tau, block);
     if (e.size() == 1) m.tau_b_err = e[0];

@@ -158,6 +158,16 @@ TEST(Fits, OriginBlocksSpanTheLongestLag) {
   EXPECT_EQ(origin_block(0.5, 1.0, 24), 1);
   EXPECT_EQ(origin_block(NAN, 1.0, 24), 1);
   EXPECT_EQ(origin_block(3.0, 0.0, 24), 1);
+  // Whether those blocks span the lag: tau_B of 8 spacings over 8 origins
+  // does not (the run quotes no error of it), 2 spacings over 8 does.
+  EXPECT_FALSE(origin_blocks_span(8.0, 1.0, 8));
+  EXPECT_FALSE(origin_blocks_span(2.5, 1.0, 8));
+  EXPECT_TRUE(origin_blocks_span(2.0, 1.0, 8));
+  EXPECT_TRUE(origin_blocks_span(6.0, 1.0, 24));
+  EXPECT_FALSE(origin_blocks_span(6.5, 1.0, 24));
+  EXPECT_TRUE(origin_blocks_span(0.5, 1.0, 3)); // one origin per block
+  EXPECT_TRUE(origin_blocks_span(NAN, 1.0, 8));
+  EXPECT_TRUE(origin_blocks_span(3.0, 0.0, 8));
 }
 
 TEST(Fits, OriginJackknifeWithBlocksAsLongAsTheCorrelationMatchesTheSpread) {

@@ -125,6 +125,11 @@ int origin_block(double longest_lag, double origin_spacing, int n_origins) {
   return std::clamp(span, 1, std::max(1, n_origins / kMinJackknifeBlocks));
 }
 
+bool origin_blocks_span(double longest_lag, double origin_spacing, int n_origins) {
+  if (!(origin_spacing > 0) || !std::isfinite(longest_lag) || !(longest_lag > 0)) return true;
+  return std::ceil(longest_lag / origin_spacing - 1e-9) <= std::max(1, n_origins / kMinJackknifeBlocks);
+}
+
 std::vector<int> overlap_fit_lags(const std::vector<double>& q, double q_lo, double q_hi) {
   std::vector<int> out;
   for (size_t j = 0; j < q.size(); ++j)

@@ -54,6 +54,13 @@ std::vector<double> origin_jackknife(const std::vector<double>& table, int n_ori
 // is not finite.
 constexpr int kMinJackknifeBlocks = 4;
 int origin_block(double longest_lag, double origin_spacing, int n_origins);
+// Whether origin_block's blocks span the lag (it was not capped): only then
+// are the blocks nearly independent. Where an estimate's correlation time
+// covers more origins than kMinJackknifeBlocks blocks allow (tau_B, a bond
+// living many origin spacings), the capped jackknife is smaller than the
+// spread of independent runs, and the run cannot give an error of its own.
+// True where the spacing is unknown (<= 0) or the lag is not finite.
+bool origin_blocks_span(double longest_lag, double origin_spacing, int n_origins);
 
 // Minimises |r(p)|^2 for residuals r already divided by their errors.
 struct LmResult {
