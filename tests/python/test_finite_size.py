@@ -8,7 +8,7 @@ import numpy as np
 
 matplotlib.use("Agg")
 
-from dynhet.analysis.finite_size import MIN_SHELLS, size_verdict, write_finite_size, xi_shells  # noqa: E402
+from dynhet.analysis.finite_size import MIN_SHELLS, size_verdict, spread_ratio, write_finite_size, xi_shells  # noqa: E402
 from dynhet.analysis.points import Point  # noqa: E402
 from dynhet.analysis.study import Analysis  # noqa: E402
 
@@ -78,3 +78,37 @@ def test_the_report_on_three_sizes(tmp_path):
     row = next(l for l in text.splitlines() if l.startswith("| τ_α — cage-relative |"))
     assert "converged from N = 4096 on" in row
     assert (tmp_path / "docs" / "finite_size" / "fs_tau_alpha.png").stat().st_size > 1000
+    # seeds 1 apart, errors 1: the spread is sqrt(2) / 1 at every N
+    row = next(l for l in text.splitlines() if l.startswith("| τ_α |") and "(1)" in l)
+    assert row.count("1.41 ± 1.00 (1)") == 3
+
+
+def test_spread_ratio_pools_the_seeds_against_the_quoted_errors():
+    # Two points: seeds 10, 12 (error 1) and 20, 20, 23 (error 1.5): the
+    # squared deviations over e^2 sum to 2 + 6 / 2.25, over 1 + 2 dof.
+    pts = []
+    for vals, err in (((10.0, 12.0), 1.0), ((20.0, 20.0, 23.0), 1.5)):
+        p = Point(("neighbours", 0.9, 0.79, 4096))
+        for seed, v in enumerate(vals, 1):
+            p.runs.append({"seed": seed, "cut": {0.6: {"tau_alpha": v, "tau_alpha_err": err}}})
+        pts.append(p)
+    tau = lambda r, cr=False: (r["cut"][0.6]["tau_alpha"], r["cut"][0.6]["tau_alpha_err"])
+    r, u, dof, unquoted = spread_ratio(pts, tau)
+    assert dof == 3 and unquoted == 0
+    assert math.isclose(r, math.sqrt((2.0 + 6.0 / 2.25) / 3)) and math.isclose(u, r / math.sqrt(6))
+    # Seeds drawn with exactly their quoted spread give about 1.
+    rng = np.random.default_rng(5)
+    pts = []
+    for k in range(200):
+        p = Point(("neighbours", 0.9, 0.79, 4096))
+        for seed in (1, 2, 3):
+            p.runs.append({"seed": seed, "cut": {0.6: {"tau_alpha": 50 + rng.normal(0, 2.0), "tau_alpha_err": 2.0}}})
+        pts.append(p)
+    r, u, dof, _ = spread_ratio(pts, tau)
+    assert dof == 400 and abs(r - 1.0) < 3 * u
+    # Runs without an error are counted, not pooled.
+    p = Point(("neighbours", 0.9, 0.79, 4096))
+    p.runs += [{"seed": 1, "cut": {0.6: {"tau_alpha": 1.0, "tau_alpha_err": math.nan}}},
+               {"seed": 2, "cut": {0.6: {"tau_alpha": 2.0, "tau_alpha_err": math.nan}}}]
+    r, _, dof, unquoted = spread_ratio([p], tau)
+    assert math.isnan(r) and dof == 0 and unquoted == 2

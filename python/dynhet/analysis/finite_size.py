@@ -117,6 +117,61 @@ def size_verdict(ns, vals, errs):
             None, drift, derr)
 
 
+def spread_ratio(points, fn, cr=False):
+    """Are the quoted errors honest at this N? The seeds' spread against the
+    errors the runs quote, pooled over points as bench/seed_spread.py pools it:
+    ratio^2 = sum_p sum_s (x_s - mean_p)^2 / e_p^2 / sum_p (K_p - 1), e_p the
+    mean quoted error of point p's K_p seeds (runs without a finite error left
+    out). About 1 for honest errors; its own uncertainty ratio / sqrt(2 dof).
+    Returns (ratio, uncertainty, dof, runs without a quoted error)."""
+    num, dof, unquoted = 0.0, 0, 0
+    for p in points:
+        vals = p.values(lambda r: fn(r, cr))
+        unquoted += sum(1 for _, v, e in vals if np.isfinite(v) and not (np.isfinite(e) and e > 0))
+        ok = [(v, e) for _, v, e in vals if np.isfinite(v) and np.isfinite(e) and e > 0]
+        if len(ok) < 2:
+            continue
+        x = np.array([v for v, _ in ok])
+        e = float(np.mean([e for _, e in ok]))
+        num += float(((x - x.mean()) ** 2).sum()) / e ** 2
+        dof += len(ok) - 1
+    if dof == 0:
+        return math.nan, math.nan, 0, unquoted
+    r = math.sqrt(num / dof)
+    return r, r / math.sqrt(2 * dof), dof, unquoted
+
+
+def spread_section(multi, multi_cr):
+    """Issue 27, item 5: per N, the pooled seed-spread ratio of tau_alpha,
+    tau_alpha^CR, tau_B and chi4^P over the densities run there."""
+    ns = sorted({n for d in multi.values() for n in d})
+    rows = []
+    for name, _, fn, has_cr_version, _ in QUANTITIES[:2 + len(SUBBOX_SIZES)]:
+        for cr in ((False, True) if has_cr_version else (False,)):
+            src = multi_cr if cr else multi
+            cells, any_data = [], False
+            for n in ns:
+                r, u, dof, unq = spread_ratio([d[n] for d in src.values() if n in d], fn, cr)
+                if dof:
+                    any_data = True
+                    cells.append(f"{r:.2f} ± {u:.2f} ({dof})")
+                else:
+                    cells.append("no error quoted" if unq else "—")
+                    any_data = any_data or unq > 0
+            if any_data:
+                rows.append(f"| {name}{' — cage-relative' if cr else ''} | " + " | ".join(cells) + " |")
+    if not rows:
+        return []
+    return ["## Error bars against the spread of seeds", "",
+            "Per N, pooled over the densities run there: the standard deviation of the seeds of a point over "
+            "the mean error its runs quote (`spread_ratio`, bench/seed_spread.py's ratio), ± its own uncertainty "
+            "(ratio / sqrt(2 dof)), degrees of freedom in brackets. About 1 where the quoted errors are honest; "
+            "above 1 they are too small. \"No error quoted\": the runs give none (tau_B where its jackknife "
+            "blocks cannot span it: docs/analysis.md), and the cells above use the seeds' spread.", "",
+            "| quantity | " + " | ".join(f"N = {n}" for n in ns) + " |",
+            "|---|" + "---|" * len(ns)] + rows + [""]
+
+
 def cell(m):
     v, _, _, n = m
     return "—" if not np.isfinite(v) else f"{fmt(v, point_error(m))}" + ("" if n > 1 else " ¹")
@@ -208,6 +263,7 @@ def write_finite_size(A, path, command):
             seeds += "; cage-relative rows: " + ", ".join(f"N {n}: {len(p.runs)}" for n, p in sorted(crs.items()))
         L += ["", f"Runs (seeds) per N: {seeds}.", ""]
     if multi:
+        L += spread_section(multi, multi_cr)
         L += ["## Plots", ""]
         for name, slug, fn, has_cr_version, log_y in QUANTITIES:
             f = plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr)
