@@ -10,46 +10,20 @@ Usage: lcmlog_runs.py LOG              one line per run: id, N, frames in the lo
        lcmlog_runs.py LOG --only       the id of the only run; exit 1 (with the list) if there are several
        lcmlog_runs.py LOG --channels   the messages per channel, one 'CHANNEL COUNT' a line
 """
-import mmap
 import os
 import struct
 import sys
 
-SYNC = 0xEDA1DA01
-
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from dynhet.lcmlog import events  # noqa: E402
 
 HEAD = 128  # the bytes of a message its headers need (run_info_t: 92, frame_chunk_t: 60)
-
-
-def events(path):
-    """(channel, the message's first HEAD bytes, its length) per event. The log
-    is mapped, not read: a log of a large run holds gigabytes of frames, and
-    only their headers are looked at."""
-    with open(path, "rb") as f:
-        if os.fstat(f.fileno()).st_size == 0:
-            return
-        with mmap.mmap(f.fileno(), 0, access=mmap.ACCESS_READ) as data:
-            pos, n = 0, len(data)
-            while pos + 28 <= n:
-                sync, _event, _utime, clen, dlen = struct.unpack_from(">IqqII", data, pos)
-                if sync != SYNC:  # resynchronise on damage
-                    nxt = data.find(struct.pack(">I", SYNC), pos + 1)
-                    if nxt < 0:
-                        return
-                    pos = nxt
-                    continue
-                pos += 28
-                if pos + clen + dlen > n:
-                    return
-                channel = data[pos:pos + clen].decode("latin-1")
-                yield channel, data[pos + clen:pos + clen + min(dlen, HEAD)], dlen
-                pos += clen + dlen
 
 
 def scan(path):
     """{run_id: {"n": N, "frames": n_frames, "chunks": {frame: set(chunk)}, "count": {frame: chunk_count}}}"""
     runs = {}
-    for channel, d, size in events(path):
+    for channel, d, size, _ in events(path, head=HEAD):
         if channel == "DYNHET_RUN" and size >= 92:
             # hash utime run_id n_particles box phi eps radius[2] mass[2] n_small n_frames
             run_id, n = struct.unpack_from(">qi", d, 16)
@@ -90,7 +64,7 @@ def main():
     args = sys.argv[2:]
     if args[:1] == ["--channels"]:
         counts = {}
-        for channel, _d, _size in events(sys.argv[1]):
+        for channel, _d, _size, _ in events(sys.argv[1], head=0):
             counts[channel] = counts.get(channel, 0) + 1
         for channel in sorted(counts):
             print(channel, counts[channel])

@@ -18,12 +18,13 @@ import os
 import stat
 import struct
 
+from . import lcmlog
+
 KEY_BYTES = 32
 TAG_BYTES = 4 + 8 + 8 + 8 + 32
 HEAD = 4 + 8 + 8 + 8
 MAGIC = b"DHT2"
 DOMAIN = b"dynhet bus tag v1\0"
-SYNC = 0xEDA1DA01
 
 
 class KeyError_(Exception):
@@ -90,33 +91,6 @@ def verdict(key, channel, data, seen):
     return "ok"
 
 
-def events(path):
-    """(raw event bytes, channel, data) of each event of an lcm-logger log,
-    read in order (a damaged stretch is skipped to the next sync word)."""
-    sync_bytes = struct.pack(">I", SYNC)
-    with open(path, "rb") as f:
-        while True:
-            head = f.read(28)
-            if len(head) < 28:
-                return
-            sync, _event, _utime, clen, dlen = struct.unpack(">IqqII", head)
-            if sync != SYNC:  # resynchronise on damage
-                f.seek(f.tell() - 27)
-                buf = f.read(1 << 20)
-                i = buf.find(sync_bytes)
-                if i < 0:
-                    if len(buf) < (1 << 20):
-                        return
-                    f.seek(f.tell() - 3)
-                    continue
-                f.seek(f.tell() - len(buf) + i)
-                continue
-            body = f.read(clen + dlen)
-            if len(body) < clen + dlen:
-                return
-            yield head + body, body[:clen].decode("latin-1"), body[clen:]
-
-
 def check_log(path, key, keep=None):
     """Counts of each verdict over every message of the log on dynhet's
     channels (DYNHET_*; others, LCM's own LCM_SELF_TEST say, are counted as
@@ -126,7 +100,7 @@ def check_log(path, key, keep=None):
     seen = set()
     out = open(keep, "wb") if keep else None
     try:
-        for raw, channel, data in events(path):
+        for channel, data, _size, raw in lcmlog.events(path, raw=out is not None):
             if not channel.startswith("DYNHET_"):
                 counts["other"] += 1
                 continue

@@ -8,7 +8,7 @@ import struct
 
 import pytest
 
-from dynhet import bus
+from dynhet import bus, lcmlog
 
 KEY = bytes(range(32))
 PINNED = bytes.fromhex("64796e68657444485432030000000000000008070605040302010900000000000000bd9d019218b1"
@@ -46,7 +46,7 @@ def test_key_files_are_refused_by_name(tmp_path):
 
 def event(channel, data, number):
     ch = channel.encode()
-    return struct.pack(">IqqII", bus.SYNC, number, 1000 + number, len(ch), len(data)) + ch + data
+    return struct.pack(">IqqII", lcmlog.SYNC, number, 1000 + number, len(ch), len(data)) + ch + data
 
 
 def test_a_log_is_counted_and_what_verifies_is_kept(tmp_path):
@@ -64,3 +64,16 @@ def test_a_log_is_counted_and_what_verifies_is_kept(tmp_path):
     c = bus.check_log(str(log), KEY, str(kept))
     assert c == {"ok": 5, "untagged": 1, "bad_tag": 1, "replayed": 1, "other": 1}
     assert kept.read_bytes() == b"".join(events[:5])
+
+
+def test_the_log_reader_skips_damage_and_stops_at_a_truncated_event(tmp_path):
+    evs = [event("DYNHET_RUN", b"x" * 200, 0), event("DYNHET_FRAME", b"frame one", 1),
+           event("DYNHET_FRAME", b"frame two", 2)]
+    log = tmp_path / "damaged.lcmlog"
+    # garbage between the first two events, the last one cut short
+    log.write_bytes(evs[0] + b"\x00garbage\xed" + evs[1] + evs[2][:-3])
+    got = list(lcmlog.events(str(log), head=16, raw=True))
+    assert [(c, d, n) for c, d, n, _ in got] == [("DYNHET_RUN", b"x" * 16, 200), ("DYNHET_FRAME", b"frame one", 9)]
+    assert [r for *_, r in got] == evs[:2]
+    (tmp_path / "empty.lcmlog").write_bytes(b"")
+    assert list(lcmlog.events(str(tmp_path / "empty.lcmlog"))) == []
