@@ -7,7 +7,7 @@ tiled 3 x 3, taken for the central copy and folded back to particle indices.
 
   dr_i^CR = dr_i - mean over j in V_i(t0) of dr_j
 
-Checked: overlap_cr Q(t) and tau_alpha per cutoff, s4_cr by check_run.py's
+Checked: overlap_cr Q(t) and tau_alpha per cutoff, s4_cr by check_spatial.py's
 exact sums with the cage-relative weights, clusters_cr by its brute force
 with slow and fast chosen by |dr^CR|, msd_cr (all and small
 particles), chi4_cr of the whole box (N times the variance of Q over
@@ -27,8 +27,8 @@ from scipy.spatial import Delaunay
 from scipy.special import j0
 
 # The checks and tau's crossing as check_run.py has them (one list of failures).
-import check_run  # noqa: E402
-from check_run import check, crossing_time, failures  # noqa: E402
+from check_common import check, crossing_time, failures  # noqa: E402
+from check_spatial import check_clusters, check_s4  # noqa: E402
 
 
 def voronoi_neighbours(x, L):
@@ -138,17 +138,17 @@ def main(path):
         # with Voronoi cages.
         check(abs(short - (1 + inv_n)) < 0.1, f"msd_cr / msd at the shortest lag {short:.3f}: about 1 + <1/N_i> = "
               f"{1 + inv_n:.3f}")
-    if "s4_cr" in obs:  # S4 of the cage-relative weights, by the exact sums of check_run.py
+    if "s4_cr" in obs:  # S4 of the cage-relative weights, by the exact sums of check_spatial.py
         lag = obs["schedule"]["lag_time"][()]
         for name, g in obs["s4_cr"].items():
-            check_run.check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, lag,
-                               dr_of=lambda k, j: dr_cr[k, j], overlap="overlap_cr", need_fit=False)
-    if "clusters_cr" in obs:  # slow and fast clusters by |dr^CR|, by check_run.py's brute force
+            check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, lag,
+                     dr_of=lambda k, j: dr_cr[k, j], overlap="overlap_cr", need_fit=False)
+    if "clusters_cr" in obs:  # slow and fast clusters by |dr^CR|, by check_spatial.py's brute force
         import tomllib
         text = f["parameters/scene_toml"][()]
         scene = tomllib.loads(text.decode() if isinstance(text, bytes) else str(text))
-        check_run.check_clusters(f, unwrapped, L, origin_frame, pair_frame, obs["schedule"]["lag_time"][()], scene,
-                                 group="clusters_cr", dr_of=lambda k, j: dr_cr[k, j])
+        check_clusters(f, unwrapped, L, origin_frame, pair_frame, obs["schedule"]["lag_time"][()], scene,
+                       group="clusters_cr", dr_of=lambda k, j: dr_cr[k, j])
     if "msd" in obs:
         small = species == np.min(species)
         radius = f["parameters/run_info"].attrs.get("radius") if "parameters/run_info" in f else None
