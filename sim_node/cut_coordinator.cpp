@@ -40,6 +40,7 @@ double CutCoordinator::seconds_since_take() const {
 }
 
 int CutCoordinator::take(int frame, double t, const std::vector<uint8_t>& sim_payload, bool stop) {
+  if (!broken_.empty()) return -1;
   const int cut = next_cut_++;
   last_take_ = Clock::now();
   std::filesystem::create_directories(cut_dir(dir_, cut));
@@ -108,6 +109,19 @@ bool CutCoordinator::complete(int cut, Pending& p) {
         p.saved.erase(who);
         if (p.said.insert(who).second)
           std::fprintf(stderr, "\nsim_node: checkpoint cut %d: no usable part of %s\n", cut, b.c_str());
+        // A part from another build will not do at any cut: stop waiting.
+        try {
+          const PartHeader h = read_part_header(part_path(dir_, cut, who, p.frame));
+          if (h.build != build_id() && broken_.empty())
+            broken_ = who + " writes its parts from another build (" + h.build + "; this sim is " + build_id() +
+                      "): start every process of a run from one build";
+        } catch (const std::exception&) { // unreadable: another answer may yet bring it
+        }
+      }
+      if (!broken_.empty()) {
+        std::fprintf(stderr, "\nsim_node: checkpoint cuts are off for this run: %s. The run goes on; its restart "
+                     "point stays cut %d\n", broken_.c_str(), last_whole_);
+        pending_.clear();
       }
       return false;
     }
@@ -139,6 +153,7 @@ void CutCoordinator::poll() {
       it = pending_.erase(it);
       continue;
     }
+    if (!broken_.empty()) return; // complete() dropped every open cut
     if (std::chrono::duration<double>(Clock::now() - p.asked).count() > 1.0) request(it->first, p);
     ++it;
   }

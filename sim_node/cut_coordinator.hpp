@@ -42,7 +42,13 @@ public:
   // the previous cut stays the restart point.
   // `stop`: the sim stops after this cut (a signal): the request says so
   // ("stop"), and every process that has had a signal stops after saving it.
+  // Returns -1 (and takes nothing) once cuts are off (broken()).
   int take(int frame, double t, const std::vector<uint8_t>& sim_payload, bool stop = false);
+  // Why no cut of this run can be whole, or "": a process writes its parts
+  // from another build (its part's header says which), and a part from
+  // another build is never read back. Said once; the open cuts are dropped
+  // and no more are taken, so nothing waits for them.
+  const std::string& broken() const { return broken_; }
   // Handles the answers that have come (no wait) and repeats requests that
   // are a second old; marks cuts whole.
   void poll();
@@ -81,6 +87,7 @@ private:
   std::map<int, Pending> pending_;
   lcm::Subscription* sub_ = nullptr;
   long unauthenticated_ = 0;
+  std::string broken_;
   Clock::time_point last_take_ = Clock::now();
 };
 

@@ -361,6 +361,7 @@ int main(int argc, char** argv) {
       dynhet::engine::State st = eng.state();
       out(next_frame, phase, st, rep);
       const int c = cuts->take(next_frame - 1, eng.time(), out.bytes(), stop);
+      if (c < 0) return c; // cuts are off (said once)
       std::fprintf(stderr, "%ssim_node: checkpoint: cut %d after frame %d at t=%.10g (sim part %.1f MB in %.2f s)\n",
                    isatty(STDERR_FILENO) ? "\n" : "", c, next_frame - 1, eng.time(), out.bytes().size() / 1e6,
                    seconds_since(t0));
@@ -375,7 +376,7 @@ int main(int argc, char** argv) {
       return false;
     };
     auto cut_due = [&] {
-      return cuts && (g_signal || scene.checkpoint_wall_interval <= 0 ||
+      return cuts && cuts->broken().empty() && (g_signal || scene.checkpoint_wall_interval <= 0 ||
                       cuts->seconds_since_take() >= scene.checkpoint_wall_interval);
     };
 

@@ -22,3 +22,9 @@ gtest_discover_tests(test_inbox DISCOVERY_TIMEOUT 30 PROPERTIES LABELS unit)
 add_test(NAME launch_scripts_help
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/script_help.sh ${PROJECT_SOURCE_DIR})
 set_tests_properties(launch_scripts_help PROPERTIES LABELS unit TIMEOUT 120)
+# The sim's side of checkpoint cuts over memq:// (sim_node/cut_coordinator.cpp).
+add_executable(test_cut_coordinator ${CMAKE_CURRENT_SOURCE_DIR}/test_cut_coordinator.cpp
+  ${PROJECT_SOURCE_DIR}/sim_node/cut_coordinator.cpp)
+target_include_directories(test_cut_coordinator PRIVATE ${PROJECT_SOURCE_DIR}/sim_node)
+target_link_libraries(test_cut_coordinator PRIVATE dynhet_common dynhet_lcmtypes GTest::gtest_main)
+gtest_discover_tests(test_cut_coordinator DISCOVERY_TIMEOUT 30 PROPERTIES LABELS unit)
