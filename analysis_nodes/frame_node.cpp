@@ -496,6 +496,11 @@ int node_main(const std::string& program, const std::string& description, NodeFa
       break;
     }
     if (const int sig = g_node_signal.exchange(0)) {
+      if (!node->has_run()) { // no run yet: nothing to save, and no cut will come
+        std::fprintf(stderr, "%s: signal %d before any run info: stopped, nothing to save\n", program.c_str(), sig);
+        code = FrameNode::kInterrupted;
+        break;
+      }
       std::fprintf(stderr, "%s: signal %d: stopping after the sim's next checkpoint cut\n", program.c_str(), sig);
       node->signal_received(sig);
     }

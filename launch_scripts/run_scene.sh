@@ -63,6 +63,12 @@
 #                   else $USER, else "unknown")
 #   --author-email ADDRESS  run.h5's h5md/author email (default: none)
 set -euo pipefail
+# A signal before the run's processes start (checking the scene, finding
+# the last whole cut: seconds on a busy machine) changes nothing that the
+# same command cannot take up again: interrupted, resumable. (Bash's
+# default ended the script 143, and a study or a Slurm job read that as a
+# failure.) The traps below take over once the processes run.
+trap 'echo "run_scene: interrupted before the run started; the same command starts or resumes it" >&2; exit 75' TERM INT
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 bin=$build/bin

@@ -178,7 +178,11 @@ rm -f "$tmp/ckdisk/filler"
 finish_run "$out" || true
 check 'complete "$out/run.h5" && same "$out"' "resumed from the cut before the disk filled: run.h5 equals the uninterrupted run's"
 # 7. Recorded across an interruption: one log per segment; replay.sh plays
-# the segments in order and gives the uninterrupted run's results.
+# the segments in order and gives the uninterrupted run's results. On a bus
+# of its own: the log holds whatever its port carries, and a process of an
+# earlier section still talking there (under load one did: 127 messages of
+# another run's key) makes replay.sh refuse the log, as it must.
+export LCM_DEFAULT_URL='udpm://239.255.76.67:7698?ttl=0'
 out=$tmp/recorded
 set -m
 bash "$root/launch_scripts/run_scene.sh" "$tmp/scene.toml" --out "$out" --run-id $run_id --no-build --no-plots \

@@ -118,5 +118,16 @@ check '! grep -q "could not save" "$out/sim_node.log"' \
 check '[[ $taken -ge 10 && $saved_s4 == "$(boundaries "$out/sim_node.log")" && -f "$out/c/cut-$(printf %06d $((taken - 1)))/WHOLE" ]]' \
   "the slow node saved every boundary of the $taken cuts the sim took ($saved_s4), the last cut whole"
 
+# 4. A node signalled before any run info stops at once (nothing to save,
+# and no cut will come); it waited 300 s for a cut, talking on the bus.
+start "$tmp/early.log" "$bin/overlap_node" --run-id 8104 --checkpoint-dir "$tmp/early"
+early_pid=${pids[-1]}
+t0=$(date +%s%N)
+kill -TERM "$early_pid"
+set +e; wait "$early_pid"; rc=$?; set -e
+ms=$(( ($(date +%s%N) - t0) / 1000000 ))
+pids=()
+check '[[ $rc == 2 && $ms -lt 5000 ]]' "a node signalled before any run info exits 2 at once (exit $rc after $ms ms)"
+
 ((fail == 0)) || tail -n 5 "$tmp/slow/"*.log "$tmp/cuts/"*.log
 exit $fail
