@@ -54,3 +54,28 @@ def test_a_panel_with_nothing_a_log_axis_can_show_is_saved_as_such(tmp_path):
         a.set_yscale("log")
     assert A.save(fig, "empty.png") == "figures/empty.png"
     assert (tmp_path / "figures" / "empty.png").stat().st_size > 1000
+
+
+def test_the_cage_relative_and_bond_breaking_fits_are_of_their_own_times(tmp_path):
+    """tau_alpha^CR(phi) and tau_B(phi) are fitted to their own values (the
+    rows once held the standard tau_alpha's fit under their names)."""
+    import math
+
+    from dynhet.analysis.local_measures import local_phi_results
+    A = Analysis.__new__(Analysis)
+    A.dir, A.figdir = str(tmp_path), str(tmp_path / "figures")
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    laws = {"tau": (0.80, 1.5), "tau_cr": (0.83, 2.0), "tau_b": (0.86, 2.5)}  # phi_c, gamma of each
+    for phi in (0.70, 0.72, 0.74, 0.76, 0.78):
+        p = Point(("neighbours", 0.9, phi, 4096))
+        for seed in (1, 2, 3):
+            v = {k: 0.1 * (xc - phi) ** -g * (1 + 0.002 * (seed - 2)) for k, (xc, g) in laws.items()}
+            p.runs.append({"seed": seed, "tau_b": v["tau_b"], "tau_b_err": 0.01 * v["tau_b"],
+                           "cut": {0.6: {"tau_alpha": v["tau"], "tau_alpha_err": 0.01 * v["tau"],
+                                         "tau_cr": v["tau_cr"], "tau_cr_err": 0.01 * v["tau_cr"]}}})
+        A.points[p.pairs, p.eps, p.phi, p.N] = p
+    local_phi_results(A)
+    for tag, key in (("tau_power_eps0.9_cr", "tau_cr"), ("tau_power_eps0.9_B", "tau_b")):
+        f = A.fits[tag]
+        assert f.ok and math.isclose(f.p["xc"], laws[key][0], abs_tol=2e-3), (tag, f.p)
+        assert math.isclose(f.p["g"], laws[key][1], rel_tol=0.02), (tag, f.p)

@@ -36,7 +36,7 @@ def local_phi_results(A):
         ax.errorbar(x, y, e, fmt=m, ms=4, color=col, label=label)
         if len(sel) < 4 or fn is tau:
             continue
-        fp, fv = tau_fits(A, sel, "eps0.9_" + ("cr" if fn is TAU_CR else "B"))
+        fp, fv = tau_fits(A, sel, "eps0.9_" + ("cr" if fn is TAU_CR else "B"), fn)
         xx = np.linspace(x.min(), x.max(), 200)
         if fp.ok:
             ax.plot(xx, fp.p["A"] * (fp.p["xc"] - xx) ** -fp.p["g"], "--", color=col, lw=0.8)

@@ -82,10 +82,11 @@ def overlap_results(A):
           fmt(ft.p["s"], ft.error("s")) + f", χ²/dof {ft.chi2_dof():.2g}", "figure", fi, pts, ft.note)
 
 
-def tau_fits(A, pts, tag):
-    """Power law and VFT for tau_alpha(phi), over every density of the series."""
-    fp = A.fit(f"tau_power_{tag}", fit_series(pts, tau, sf.critical))
-    fv = A.fit(f"tau_vft_{tag}", fit_series(pts, tau, sf.vft))
+def tau_fits(A, pts, tag, fn=tau):
+    """Power law and VFT for a relaxation time against phi (fn: per run
+    (value, error); tau_alpha by default), over every density of the series."""
+    fp = A.fit(f"tau_power_{tag}", fit_series(pts, fn, sf.critical))
+    fv = A.fit(f"tau_vft_{tag}", fit_series(pts, fn, sf.vft))
     return fp, fv
 
 
