@@ -1,8 +1,10 @@
 // FrameNode's side of a checkpoint cut (dynhet/cut.hpp, docs/checkpoints.md):
 // the sim asks for cut c after frame k; the node saves its part once frame k
 // is folded in (or at the first chunk of a later frame, k being lost) and
-// answers on DYNHET_CHECKPOINT_<node>; a request it is already past is
-// answered "failed". A resumed node loads its part after start().
+// answers on DYNHET_CHECKPOINT_<node>. A request for a boundary it saved
+// (the sim repeats requests until the cut is whole) is answered "saved"
+// again; one for a boundary it is past without having saved it, "failed".
+// A resumed node loads its part after start().
 #include <algorithm>
 #include <climits>
 #include <cstdio>

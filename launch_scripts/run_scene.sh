@@ -193,7 +193,10 @@ if [[ $role == all && -z $resume && $no_cuts == 0 ]]; then
   fi
 fi
 pids=() names=() reaped=()
-cleanup() { for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done; }
+cleanup() { # (lcm-logger too: an early exit left it recording)
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  [[ -z ${logger_pid:-} ]] || kill -INT "$logger_pid" 2>/dev/null || true
+}
 trap cleanup EXIT
 if [[ -n $cuts ]]; then
   # SIGTERM/SIGINT: every process takes its part of one more cut and stops;
@@ -260,6 +263,16 @@ fi
 [[ $bus_epoch =~ ^[0-9]+$ ]] || { echo "run_scene: --bus-epoch is a non-negative integer, not $bus_epoch" >&2; exit 2; }
 key=(--key-file "$key_file" --bus-epoch "$bus_epoch")
 
+# A signal while the processes start (the trap above only passes it on to
+# those already running, and a node without run info then exits at once):
+# stop them all and end as interrupted, before the sim starts.
+stop_early() {
+  for p in "${pids[@]}"; do kill -"$stop_signal" "$p" 2>/dev/null || true; done
+  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
+  pids=()
+  echo "run_scene: interrupted (SIG$stop_signal) while the run's processes started; the same command starts or resumes it" >&2
+  exit 75
+}
 start() { # name, then the command; waits for its "ready" line
   # On resume the log goes on: only the lines after this start's own
   # separator count (an earlier attempt's "ready" is not this process's),
@@ -273,9 +286,10 @@ start() { # name, then the command; waits for its "ready" line
   "$@" 2>>"$out/$n.log" &
   pids+=($!) names+=("$n")
   for ((i = 1; i <= limit; ++i)); do
+    [[ -z ${stop_signal:-} ]] || stop_early
     tail -n +"$from" "$out/$n.log" 2>/dev/null | grep -q "ready" && return 0
     kill -0 "${pids[-1]}" 2>/dev/null ||
-      { echo "run_scene: $n died at start:" >&2; tail -n +"$from" "$out/$n.log" >&2; exit 1; }
+      { [[ -z ${stop_signal:-} ]] || stop_early; echo "run_scene: $n died at start:" >&2; tail -n +"$from" "$out/$n.log" >&2; exit 1; }
     ((i % 300)) || echo "run_scene: $n is not ready after $((i / 10)) s (resuming: replaying its part)" >&2
     sleep 0.1
   done
@@ -331,10 +345,16 @@ elif [[ -n $cuts ]]; then
   # the run down at once (killed: the last whole cut is the restart point).
   if ((${#resume_cut[@]})); then echo "---- resumed from cut ${resume_cut[1]}" >>"$out/sim_node.log"; else : >"$out/sim_node.log"; fi
   sim_delay=(); [[ -z $test_sim_delay ]] || sim_delay=(--test-frame-delay "$test_sim_delay")
+  # (tests: DYNHET_TEST_START_PAUSE seconds here, the nodes up and the sim not)
+  [[ -z ${DYNHET_TEST_START_PAUSE:-} ]] || sleep "$DYNHET_TEST_START_PAUSE"
+  [[ -z $stop_signal ]] || stop_early
   "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" "${key[@]}" --pace-nodes --checkpoint "$out/checkpoint.h5" \
     --checkpoint-before-frames "$out/checkpoint_before_frames.h5" "${cut_args[@]}" "${resume_cut[@]}" "${sim_delay[@]}" \
     2> >(trap '' TERM INT; exec tee -a "$out/sim_node.log" >&2) &
   sim_pid=$!
+  # A signal between the check above and this line reached every process
+  # but the sim: pass it on.
+  [[ -z $stop_signal ]] || kill -"$stop_signal" "$sim_pid" 2>/dev/null || true
   died=""
   while kill -0 "$sim_pid" 2>/dev/null; do
     for i in "${!pids[@]}"; do

@@ -97,6 +97,10 @@ void CutCoordinator::on_answer(const lcm::ReceiveBuffer* rb, const std::string& 
 }
 
 bool CutCoordinator::complete(int cut, Pending& p) {
+  // A newer cut is whole already (this one's last answer came late): it
+  // adds nothing, and marking it whole would move the restart point back
+  // and let the pruning below remove it.
+  if (cut <= last_whole_) return true;
   CutInfo c;
   c.cut = cut, c.frame = p.frame, c.sim_time = p.time, c.run_id = run_id_, c.parts = parts_;
   try {
@@ -112,7 +116,10 @@ bool CutCoordinator::complete(int cut, Pending& p) {
         // A part from another build will not do at any cut: stop waiting.
         try {
           const PartHeader h = read_part_header(part_path(dir_, cut, who, p.frame));
-          if (h.build != build_id() && broken_.empty())
+          // (this run's part of this boundary by that process, not a file
+          // left over from another run)
+          if (h.build != build_id() && h.run_id == run_id_ && h.process == who && h.frame == p.frame &&
+              broken_.empty())
             broken_ = who + " writes its parts from another build (" + h.build + "; this sim is " + build_id() +
                       "): start every process of a run from one build";
         } catch (const std::exception&) { // unreadable: another answer may yet bring it
@@ -153,7 +160,11 @@ void CutCoordinator::poll() {
       it = pending_.erase(it);
       continue;
     }
-    if (!broken_.empty()) return; // complete() dropped every open cut
+    if (!broken_.empty()) return; // complete() dropped every open cut (it is invalid)
+    if (it->first < last_whole_) { // passed by a newer whole cut
+      it = pending_.erase(it);
+      continue;
+    }
     if (std::chrono::duration<double>(Clock::now() - p.asked).count() > 1.0) request(it->first, p);
     ++it;
   }

@@ -137,6 +137,25 @@ for round in 1 2; do
 done
 finish_run "$out" || true
 check 'complete "$out/run.h5" && same "$out"' "stopped twice by SIGTERM and resumed: run.h5 equals the uninterrupted run's"
+# 4b. SIGTERM while the processes start (the nodes up, the sim not yet):
+# all stop, exit 75, nothing left running; the same command then runs it.
+out=$tmp/early
+export DYNHET_TEST_START_PAUSE=4
+start_run "$out"
+for _ in $(seq 100); do grep -qs ready "$out/s4_node.log" && break; sleep 0.05; done
+sleep 0.5
+kill -TERM -- -$run_pid 2>/dev/null || true
+s0=$(date +%s%N)
+set +e; wait $run_pid; rc=$?; set -e
+ms=$(( ($(date +%s%N) - s0) / 1000000 ))
+unset DYNHET_TEST_START_PAUSE
+sleep 0.5
+left=$(pgrep -f -- "$out/" | wc -l)
+check '[[ $rc == 75 && $ms -lt 10000 && $left == 0 ]]' \
+  "SIGTERM while the processes start: exit 75 (got $rc) after $ms ms, $left processes left"
+check 'grep -q "interrupted (SIGTERM) while the run.s processes started" "$out.log"' "... and says so"
+finish_run "$out" || true
+check 'complete "$out/run.h5" && same "$out"' "... and the same command then runs it: run.h5 equals the uninterrupted run's"
 
 # 5. The newest whole cut corrupted: the one before is used.
 out=$tmp/corrupt

@@ -116,3 +116,27 @@ TEST(CutCoordinator, APartFromAnotherBuildTurnsCutsOffAtOnce) {
   EXPECT_EQ(cuts.take(5, 2.0, std::vector<uint8_t>(32, 1)), -1);
   EXPECT_FALSE(whole(d.path, 0));
 }
+
+// With repeated requests answered "saved", an older cut's last answer can
+// come after a newer cut is whole. It must not become the restart point
+// (that moved last_whole back, and the pruning then removed its folder).
+TEST(CutCoordinator, AnOlderCutCompletedLateDoesNotMoveTheRestartPointBack) {
+  Dir d;
+  lcm::LCM lcm("memq://");
+  ASSERT_TRUE(lcm.good());
+  CutCoordinator cuts(lcm, Bus::open_bus(), d.path, kRun, kScene, {"sim", "overlap"});
+  const int c5 = cuts.take(5, 1.5, std::vector<uint8_t>(32, 1));
+  const int c6 = cuts.take(6, 2.0, std::vector<uint8_t>(32, 1));
+  write_node_part(d.path, c5, "overlap", 5);
+  write_node_part(d.path, c6, "overlap", 6);
+  answer(lcm, "overlap", c6, 6, "saved"); // cut 5's answer was lost
+  EXPECT_TRUE(cuts.wait_whole(c6, 5.0));
+  EXPECT_EQ(cuts.last_whole(), c6);
+  answer(lcm, "overlap", c5, 5, "saved"); // to the repeated request
+  cuts.poll();
+  cuts.poll();
+  EXPECT_EQ(cuts.last_whole(), c6);
+  EXPECT_FALSE(whole(d.path, c5));
+  EXPECT_TRUE(whole(d.path, c6));
+  EXPECT_EQ(cuts.newest_open(), -1);
+}

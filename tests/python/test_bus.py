@@ -77,3 +77,12 @@ def test_the_log_reader_skips_damage_and_stops_at_a_truncated_event(tmp_path):
     assert [r for *_, r in got] == evs[:2]
     (tmp_path / "empty.lcmlog").write_bytes(b"")
     assert list(lcmlog.events(str(tmp_path / "empty.lcmlog"))) == []
+
+
+def test_the_log_reader_resynchronises_past_a_damaged_length(tmp_path):
+    evs = [event("DYNHET_RUN", b"run", 0), event("DYNHET_FRAME", b"frame one", 1), event("DYNHET_FRAME", b"frame two", 2)]
+    bad = bytearray(evs[1])
+    bad[24:28] = struct.pack(">I", 1 << 30)  # its data length now runs past the end of the log
+    log = tmp_path / "damaged.lcmlog"
+    log.write_bytes(evs[0] + bytes(bad) + evs[2])
+    assert [(c, d) for c, d, _, _ in lcmlog.events(str(log))] == [("DYNHET_RUN", b"run"), ("DYNHET_FRAME", b"frame two")]

@@ -112,3 +112,12 @@ def test_spread_ratio_pools_the_seeds_against_the_quoted_errors():
                {"seed": 2, "cut": {0.6: {"tau_alpha": 2.0, "tau_alpha_err": math.nan}}}]
     r, _, dof, unquoted = spread_ratio([p], tau)
     assert math.isnan(r) and dof == 0 and unquoted == 2
+
+
+def test_a_point_without_a_measured_error_says_so_and_stays_out_of_the_verdict():
+    from dynhet.analysis.finite_size import cell, measured_error
+    one_unquoted = (1930.0, math.nan, math.nan, 1)   # one seed, no quoted error (tau_B)
+    assert math.isnan(measured_error(one_unquoted)) and cell(one_unquoted) == "1930 (no error) ¹"
+    assert "± 12" in cell((1930.0, 12.0, math.nan, 2))
+    text, n0, _, _ = size_verdict([1024, 4096, 16384], [1900.0, 1930.0, 2500.0], [20.0, 20.0, math.nan])
+    assert n0 == 1024 and "N = 4096" in text  # the largest N, without an error, is left out

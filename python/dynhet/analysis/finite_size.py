@@ -12,7 +12,6 @@ import numpy as np
 
 from .config import A_MAIN
 from .plotting import colours
-from .points import point_error
 from .quantities import PER_RUN, XI_MIN, chi0_at_tau, kappa_of, whole_box_s4
 from .size import points_by_phi_n
 from .verdicts import fmt
@@ -163,7 +162,7 @@ def spread_section(multi, multi_cr):
     if not rows:
         return []
     return ["## Error bars against the spread of seeds", "",
-            "Per N, pooled over the densities run there: the standard deviation of the seeds of a point over "
+            "Per N, pooled over the densities run at several N: the standard deviation of the seeds of a point over "
             "the mean error its runs quote (`spread_ratio`, bench/seed_spread.py's ratio), ± its own uncertainty "
             "(ratio / sqrt(2 dof)), degrees of freedom in brackets. About 1 where the quoted errors are honest; "
             "above 1 they are too small. \"No error quoted\": the runs give none (tau_B where its jackknife "
@@ -172,17 +171,30 @@ def spread_section(multi, multi_cr):
             "|---|" + "---|" * len(ns)] + rows + [""]
 
 
+def measured_error(m):
+    """The error of a per-point mean that was measured: the runs' quoted
+    error, else the seeds' standard error; NaN where there is neither (one
+    seed quoting none: tau_B where its blocks cannot span it). Not
+    point_error's 10% stand-in, which the fits use as a weight."""
+    _, e, sem, _ = m
+    return e if np.isfinite(e) and e > 0 else (sem if np.isfinite(sem) and sem > 0 else math.nan)
+
+
 def cell(m):
     v, _, _, n = m
-    return "—" if not np.isfinite(v) else f"{fmt(v, point_error(m))}" + ("" if n > 1 else " ¹")
+    if not np.isfinite(v):
+        return "—"
+    e = measured_error(m)
+    return (fmt(v, e) if np.isfinite(e) else f"{v:.4g} (no error)") + ("" if n > 1 else " ¹")
 
 
 def quantity_rows(d, fn, cr, ns=None):
-    """Per-N means (at the sizes ns, default d's; NaN where d has none) and the verdict."""
+    """Per-N means (at the sizes ns, default d's; NaN where d has none) and
+    the verdict (sizes without a measured error take no part in it)."""
     ns = sorted(d) if ns is None else ns
     nan = (math.nan, math.nan, math.nan, 0)
     ms = [d[n].mean(lambda r: fn(r, cr)) if n in d else nan for n in ns]
-    verdict = size_verdict(ns, [m[0] for m in ms], [point_error(m) if np.isfinite(m[0]) else math.nan for m in ms])
+    verdict = size_verdict(ns, [m[0] for m in ms], [measured_error(m) for m in ms])
     return ns, ms, verdict
 
 
@@ -203,7 +215,7 @@ def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr):
             if not x:
                 continue
             y = [m[0] for m in ms if np.isfinite(m[0])]
-            e = [point_error(m) for m in ms if np.isfinite(m[0])]
+            e = [np.nan_to_num(measured_error(m)) for m in ms if np.isfinite(m[0])]
             ax.errorbar(x, y, e, fmt="s--" if cr else "o-", ms=4, color=col, mfc="none" if cr else col,
                         label=f"φ = {phi:g}" + (" (cage-relative)" if cr else ""))
             drawn = True
@@ -232,7 +244,8 @@ def write_finite_size(A, path, command):
          + ", ".join(f"`{os.path.relpath(s, os.path.dirname(os.path.abspath(path)))}`" for s in [A.dir] + A.also)
          + f". Command: `{command}`", "",
          f"Each cell: the mean over seeds with its error (the runs' own errors, jackknife over origin blocks, "
-         f"combined; the seeds' spread where no run quotes one); ¹ one seed. A verdict is computed from the "
+         f"combined; the seeds' spread where no run quotes one; \"no error\" where one seed quotes none, and such a "
+         f"size takes no part in the verdict); ¹ one seed. A verdict is computed from the "
          f"numbers: **converged** from the smallest N whose value and every larger N's agree with the largest "
          f"N's within {Z_CONVERGED:g} combined errors; otherwise **drifting**, with the change per doubling of N "
          f"between the two largest sizes. χ4^P is the peak of χ4(t) of sub-boxes of about that many particles "
