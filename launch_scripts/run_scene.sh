@@ -154,7 +154,7 @@ cuts="" cut_args=() resume_cut=()
 if [[ $role == all && -z $resume && $no_cuts == 0 ]]; then
   cuts=$out/checkpoints
   if ((fresh)); then
-    rm -rf "$cuts"/cut-* "$cuts"/recorder.journal "$out/run.h5"
+    rm -rf "$cuts"/cut-* "$cuts"/frames "$cuts"/recorder.journal "$out/run.h5"
     # (not the scene to run, when it is DIR's own: the study runner's)
     [[ $(realpath "$scene") == $(realpath -m "$out/scene.toml") ]] || rm -f "$out/scene.toml"
   fi
@@ -188,7 +188,7 @@ if [[ $role == all && -z $resume && $no_cuts == 0 ]]; then
       echo "run_scene: resuming run $run_id from checkpoint cut $cut: frames up to ${BASH_REMATCH[2]} done, t = ${BASH_REMATCH[3]}; what came after it is computed again" >&2
     else
       echo "run_scene: no whole checkpoint cut in $cuts: starting the run from the beginning" >&2
-      rm -rf "$cuts"/cut-* "$cuts"/recorder.journal
+      rm -rf "$cuts"/cut-* "$cuts"/frames "$cuts"/recorder.journal
     fi
   fi
 fi
