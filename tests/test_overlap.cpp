@@ -86,3 +86,28 @@ TEST(Overlap, TauAlphaAndJackknifeOnSyntheticOrigins) {
   EXPECT_GT(r.tau_alpha_err, 0.05);
   EXPECT_LT(r.tau_alpha_err, 0.09);
 }
+
+// tau_alpha's error is quoted only where jackknife blocks spanning the lag
+// beyond the crossing fit four times into the origins; with origins closer
+// than that (tau_alpha^CR of a run whose origins are one standard
+// tau_alpha apart) the capped blocks are correlated and the run quotes none.
+TEST(Overlap, NoTauAlphaErrorWhereTheBlocksCannotSpanIt) {
+  std::vector<double> lags;
+  for (int j = 0; j <= 100; ++j) lags.push_back(0.1 * std::pow(10.0, j / 40.0));
+  const std::vector<double> taus{2.0, 2.2, 1.8, 2.1, 1.9, 2.05, 1.95, 2.15};
+  auto run = [&](double spacing) {
+    OverlapAccumulator acc(8, lags, spacing);
+    for (int k = 0; k < 8; ++k)
+      for (size_t j = 0; j < lags.size(); ++j) {
+        const double v = std::exp(-lags[j] / taus[k]);
+        acc.add(k, static_cast<int>(j), &v, 1);
+      }
+    return acc.result();
+  };
+  const auto near = run(1.1);  // tau_alpha ~ 2 spans 2 spacings: 4 blocks of 2 origins fit
+  const auto close = run(0.5); // 5 spacings: blocks of at most 2 cannot span it
+  EXPECT_NEAR(near.tau_alpha, 2.0, 0.03);
+  EXPECT_TRUE(std::isfinite(near.tau_alpha_err) && near.tau_alpha_err > 0);
+  EXPECT_NEAR(close.tau_alpha, near.tau_alpha, 1e-12);
+  EXPECT_TRUE(std::isnan(close.tau_alpha_err));
+}

@@ -120,6 +120,12 @@ OverlapAccumulator::Result OverlapAccumulator::result() const {
     return std::vector<double>{crossing_time(lag_, q, level)};
   }, origin_block(longest, spacing_, n_origins_));
   r.tau_alpha_err = std::isnan(r.tau_alpha) || e.empty() ? kNaN : e[0];
+  // None where blocks spanning that lag do not fit four times into the
+  // origins (origin_blocks_span): the capped blocks are correlated and the
+  // error too small (tau_alpha^CR of runs whose origins are one standard
+  // tau_alpha apart: a third to a half of the seeds' spread). A study then
+  // takes the spread of its seeds.
+  if (!origin_blocks_span(longest, spacing_, n_origins_)) r.tau_alpha_err = kNaN;
   return r;
 }
 
