@@ -54,6 +54,16 @@ void answer(lcm::LCM& lcm, const std::string& who, int cut, int frame, const std
 
 bool whole(const std::string& dir, int cut) { return std::filesystem::exists(cut_dir(dir, cut) + "/WHOLE"); }
 
+// A cut folder, an in-process bus and the sim's coordinator of the parts.
+struct Cuts {
+  Dir d;
+  lcm::LCM lcm{"memq://"};
+  CutCoordinator cuts;
+  explicit Cuts(std::vector<std::string> parts)
+      : cuts(lcm, Bus::open_bus(), d.path, kRun, kScene, std::move(parts)) {}
+  int take(int frame) { return cuts.take(frame, 0.5 * frame, std::vector<uint8_t>(32, 1)); }
+};
+
 } // namespace
 
 // The sim asks again every second for a cut a slower process has not saved;
@@ -61,42 +71,38 @@ bool whole(const std::string& dir, int cut) { return std::filesystem::exists(cut
 // process that said "saved" has its part on disk: its later "failed" must
 // not end the cut (it did, and most cuts of a study's runs failed).
 TEST(CutCoordinator, AFailedAfterSavedDoesNotEndTheCut) {
-  Dir d;
-  lcm::LCM lcm("memq://");
-  ASSERT_TRUE(lcm.good());
-  CutCoordinator cuts(lcm, Bus::open_bus(), d.path, kRun, kScene, {"sim", "overlap", "s4"});
-  const int c = cuts.take(3, 1.5, std::vector<uint8_t>(32, 1));
+  Cuts f({"sim", "overlap", "s4"});
+  ASSERT_TRUE(f.lcm.good());
+  const int c = f.take(3);
   ASSERT_EQ(c, 0);
-  write_node_part(d.path, c, "overlap", 3);
-  answer(lcm, "overlap", c, 3, "saved");
-  cuts.poll();
-  answer(lcm, "overlap", c, 3, "failed"); // to the repeated request
-  cuts.poll();
-  EXPECT_EQ(cuts.newest_open(), 0) << "the cut is still open, waiting for s4";
-  write_node_part(d.path, c, "s4", 3);
-  answer(lcm, "s4", c, 3, "saved");
-  EXPECT_TRUE(cuts.wait_whole(c, 5.0));
-  EXPECT_EQ(cuts.last_whole(), 0);
-  EXPECT_TRUE(whole(d.path, 0));
+  write_node_part(f.d.path, c, "overlap", 3);
+  answer(f.lcm, "overlap", c, 3, "saved");
+  f.cuts.poll();
+  answer(f.lcm, "overlap", c, 3, "failed"); // to the repeated request
+  f.cuts.poll();
+  EXPECT_EQ(f.cuts.newest_open(), 0) << "the cut is still open, waiting for s4";
+  write_node_part(f.d.path, c, "s4", 3);
+  answer(f.lcm, "s4", c, 3, "saved");
+  EXPECT_TRUE(f.cuts.wait_whole(c, 5.0));
+  EXPECT_EQ(f.cuts.last_whole(), 0);
+  EXPECT_TRUE(whole(f.d.path, 0));
   // A process that never said "saved" still fails the cut.
-  const int c2 = cuts.take(5, 2.0, std::vector<uint8_t>(32, 1));
-  answer(lcm, "s4", c2, 5, "failed");
-  EXPECT_FALSE(cuts.wait_whole(c2, 5.0));
-  EXPECT_EQ(cuts.last_whole(), 0);
+  const int c2 = f.take(5);
+  answer(f.lcm, "s4", c2, 5, "failed");
+  EXPECT_FALSE(f.cuts.wait_whole(c2, 5.0));
+  EXPECT_EQ(f.cuts.last_whole(), 0);
 }
 
 // A part written by another build is never read back, so no cut of the run
 // can be whole: the coordinator says so once, drops the open cuts and takes
 // no more (the sim waited the whole --cut-wait, 300 s, for the last one).
 TEST(CutCoordinator, APartFromAnotherBuildTurnsCutsOffAtOnce) {
-  Dir d;
-  lcm::LCM lcm("memq://");
-  ASSERT_TRUE(lcm.good());
-  CutCoordinator cuts(lcm, Bus::open_bus(), d.path, kRun, kScene, {"sim", "overlap"});
-  const int c = cuts.take(3, 1.5, std::vector<uint8_t>(32, 1));
-  write_node_part(d.path, c, "overlap", 3);
+  Cuts f({"sim", "overlap"});
+  ASSERT_TRUE(f.lcm.good());
+  const int c = f.take(3);
+  write_node_part(f.d.path, c, "overlap", 3);
   // The same part as another build writes it: its build id differs.
-  const std::string path = part_path(d.path, c, "overlap", 3);
+  const std::string path = part_path(f.d.path, c, "overlap", 3);
   std::string bytes;
   {
     std::ifstream in(path, std::ios::binary);
@@ -107,36 +113,34 @@ TEST(CutCoordinator, APartFromAnotherBuildTurnsCutsOffAtOnce) {
   char& last = bytes[at + build_id().size() - 1];
   last = last == 'x' ? 'y' : 'x';
   std::ofstream(path, std::ios::binary) << bytes;
-  answer(lcm, "overlap", c, 3, "saved");
+  answer(f.lcm, "overlap", c, 3, "saved");
   const auto t0 = std::chrono::steady_clock::now();
-  EXPECT_FALSE(cuts.wait_whole(c, 30.0));
+  EXPECT_FALSE(f.cuts.wait_whole(c, 30.0));
   EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 5.0);
-  EXPECT_NE(cuts.broken().find("overlap writes its parts from another build"), std::string::npos) << cuts.broken();
-  EXPECT_EQ(cuts.newest_open(), -1);
-  EXPECT_EQ(cuts.take(5, 2.0, std::vector<uint8_t>(32, 1)), -1);
-  EXPECT_FALSE(whole(d.path, 0));
+  EXPECT_NE(f.cuts.broken().find("overlap writes its parts from another build"), std::string::npos) << f.cuts.broken();
+  EXPECT_EQ(f.cuts.newest_open(), -1);
+  EXPECT_EQ(f.take(5), -1);
+  EXPECT_FALSE(whole(f.d.path, 0));
 }
 
 // With repeated requests answered "saved", an older cut's last answer can
 // come after a newer cut is whole. It must not become the restart point
 // (that moved last_whole back, and the pruning then removed its folder).
 TEST(CutCoordinator, AnOlderCutCompletedLateDoesNotMoveTheRestartPointBack) {
-  Dir d;
-  lcm::LCM lcm("memq://");
-  ASSERT_TRUE(lcm.good());
-  CutCoordinator cuts(lcm, Bus::open_bus(), d.path, kRun, kScene, {"sim", "overlap"});
-  const int c5 = cuts.take(5, 1.5, std::vector<uint8_t>(32, 1));
-  const int c6 = cuts.take(6, 2.0, std::vector<uint8_t>(32, 1));
-  write_node_part(d.path, c5, "overlap", 5);
-  write_node_part(d.path, c6, "overlap", 6);
-  answer(lcm, "overlap", c6, 6, "saved"); // cut 5's answer was lost
-  EXPECT_TRUE(cuts.wait_whole(c6, 5.0));
-  EXPECT_EQ(cuts.last_whole(), c6);
-  answer(lcm, "overlap", c5, 5, "saved"); // to the repeated request
-  cuts.poll();
-  cuts.poll();
-  EXPECT_EQ(cuts.last_whole(), c6);
-  EXPECT_FALSE(whole(d.path, c5));
-  EXPECT_TRUE(whole(d.path, c6));
-  EXPECT_EQ(cuts.newest_open(), -1);
+  Cuts f({"sim", "overlap"});
+  ASSERT_TRUE(f.lcm.good());
+  const int c5 = f.take(5);
+  const int c6 = f.take(6);
+  write_node_part(f.d.path, c5, "overlap", 5);
+  write_node_part(f.d.path, c6, "overlap", 6);
+  answer(f.lcm, "overlap", c6, 6, "saved"); // cut 5's answer was lost
+  EXPECT_TRUE(f.cuts.wait_whole(c6, 5.0));
+  EXPECT_EQ(f.cuts.last_whole(), c6);
+  answer(f.lcm, "overlap", c5, 5, "saved"); // to the repeated request
+  f.cuts.poll();
+  f.cuts.poll();
+  EXPECT_EQ(f.cuts.last_whole(), c6);
+  EXPECT_FALSE(whole(f.d.path, c5));
+  EXPECT_TRUE(whole(f.d.path, c6));
+  EXPECT_EQ(f.cuts.newest_open(), -1);
 }
