@@ -121,3 +121,23 @@ def test_a_point_without_a_measured_error_says_so_and_stays_out_of_the_verdict()
     assert "± 12" in cell((1930.0, 12.0, math.nan, 2))
     text, n0, _, _ = size_verdict([1024, 4096, 16384], [1900.0, 1930.0, 2500.0], [20.0, 20.0, math.nan])
     assert n0 == 1024 and "N = 4096" in text  # the largest N, without an error, is left out
+
+
+def test_errors_are_scaled_to_the_seeds_spread_when_it_is_larger(tmp_path):
+    """Seeds 2 apart around each mean, quoted errors 1: the spread is twice the
+    quoted error (12 dof over 6 points), so the tables' errors are doubled."""
+    A = Analysis.__new__(Analysis)
+    A.dir, A.figdir, A.also = str(tmp_path / "study"), str(tmp_path / "study" / "figures"), []
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    for phi in (0.76, 0.79):
+        for n, t in ((1024, 40.0), (4096, 42.0), (16384, 41.0)):
+            p = Point(("neighbours", 0.9, phi, n))
+            for seed, dv in ((1, -2.0), (2, 0.0), (3, 2.0)):
+                p.runs.append({"seed": seed, "N": n, "cut": {0.6: {"tau_alpha": t + dv, "tau_alpha_err": 1.0}}})
+            A.points[p.pairs, p.eps, p.phi, p.N] = p
+    out = tmp_path / "finite_size.md"
+    write_finite_size(A, str(out), "analyse_study.sh study")
+    text = out.read_text()
+    assert "τ_α × 2.00 (ratio 2.00 ± 0.41, 12 dof)" in text
+    row = next(l for l in text.splitlines() if l.startswith("| τ_α |") and "verdict" not in l and "(" not in l.split("|")[2])
+    assert "42 ± 1.2" in row  # sqrt(3) / 3 quoted, times 2

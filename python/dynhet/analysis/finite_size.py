@@ -21,6 +21,7 @@ from .verdicts import fmt
 SUBBOX_SIZES = (32, 128, 512, 2048, 8192, 32768)
 MIN_SHELLS = 5      # xi needs at least this many q shells below q xi = 1 (issue 27, item 4)
 Z_CONVERGED = 2.0   # values within 2 combined standard errors agree
+MIN_CAL_DOF = 10    # the seeds' spread scales the quoted errors only with this many dof behind it
 
 
 def cutx(r, cr):
@@ -171,6 +172,24 @@ def spread_section(multi, multi_cr):
             "|---|" + "---|" * len(ns)] + rows + [""]
 
 
+def calibration(src, fn, cr=False):
+    """How much larger than quoted a quantity's errors are: the seeds' spread
+    over the quoted errors (spread_ratio) pooled over every point of src
+    ({phi: {N: Point}}). Returns (factor, ratio, uncertainty, dof): the factor
+    is the ratio where it has at least MIN_CAL_DOF dof and lies more than two
+    of its uncertainties above 1, else 1 (quoted errors are never shrunk)."""
+    pts = [p for d in src.values() for p in d.values()]
+    r, u, dof, _ = spread_ratio(pts, fn, cr)
+    k = r if dof >= MIN_CAL_DOF and np.isfinite(r) and r - 2 * u > 1 else 1.0
+    return k, r, u, dof
+
+
+def scaled(m, k):
+    """A per-point mean (Point.mean) with its quoted error times k."""
+    v, e, sem, n = m
+    return v, e * k, sem, n
+
+
 def measured_error(m):
     """The error of a per-point mean that was measured: the runs' quoted
     error, else the seeds' standard error; NaN where there is neither (one
@@ -188,12 +207,13 @@ def cell(m):
     return (fmt(v, e) if np.isfinite(e) else f"{v:.4g} (no error)") + ("" if n > 1 else " ¹")
 
 
-def quantity_rows(d, fn, cr, ns=None):
-    """Per-N means (at the sizes ns, default d's; NaN where d has none) and
-    the verdict (sizes without a measured error take no part in it)."""
+def quantity_rows(d, fn, cr, ns=None, k=1.0):
+    """Per-N means (at the sizes ns, default d's; NaN where d has none), their
+    quoted errors times k (calibration), and the verdict (sizes without a
+    measured error take no part in it)."""
     ns = sorted(d) if ns is None else ns
     nan = (math.nan, math.nan, math.nan, 0)
-    ms = [d[n].mean(lambda r: fn(r, cr)) if n in d else nan for n in ns]
+    ms = [scaled(d[n].mean(lambda r: fn(r, cr)), k) if n in d else nan for n in ns]
     verdict = size_verdict(ns, [m[0] for m in ms], [measured_error(m) for m in ms])
     return ns, ms, verdict
 
@@ -202,7 +222,7 @@ def has_cr(p):
     return any(r.get("cut_cr") and A_MAIN in r["cut_cr"] for r in p.runs)
 
 
-def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr):
+def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr, cal):
     fig, ax = plt.subplots(figsize=(6, 4.3))
     drawn = False
     for (phi, d), col in zip(multi.items(), colours(len(multi))):
@@ -210,7 +230,7 @@ def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr):
             dd = multi_cr.get(phi, {}) if cr else d
             if not dd:
                 continue
-            ns, ms, _ = quantity_rows(dd, fn, cr)
+            ns, ms, _ = quantity_rows(dd, fn, cr, k=cal[slug, cr][0])
             x = [n for n, m in zip(ns, ms) if np.isfinite(m[0])]
             if not x:
                 continue
@@ -254,18 +274,29 @@ def write_finite_size(A, path, command):
          f"neighbour kick pairs. Nothing here is tuned toward the paper's numbers.", ""]
     if not multi:
         L += ["No density was run at more than one N.", ""]
+    cal = {(slug, cr): calibration(multi_cr if cr else multi, fn, cr)
+           for _, slug, fn, has_cr_version, _ in QUANTITIES for cr in ((False, True) if has_cr_version else (False,))}
+    applied = [f"{name}{' — cage-relative' if cr else ''} × {k:.2f} (ratio {r:.2f} ± {u:.2f}, {dof} dof)"
+               for name, slug, _, has_cr_version, _ in QUANTITIES
+               for cr in ((False, True) if has_cr_version else (False,))
+               for k, r, u, dof in [cal[slug, cr]] if k != 1.0]
+    L += ["**Errors scaled to the seeds' spread.** Where the seeds of a point scatter more than their runs' "
+          "quoted errors say, pooled over every point of this report (`calibration`: at least "
+          f"{MIN_CAL_DOF} dof, more than 2 of its uncertainties above 1), the quoted errors of that quantity "
+          "are multiplied by that ratio in the tables, plots and verdicts: "
+          + ("; ".join(applied) if applied else "none needed") + ". Quoted errors are never made smaller.", ""]
     figures = []
     for phi, d in multi.items():
         ns = sorted(d)
         L += [f"## φ = {phi:g}", "",
               "| quantity | " + " | ".join(f"N = {n}" for n in ns) + " | verdict |",
               "|---|" + "---|" * len(ns) + "---|"]
-        for name, _, fn, has_cr_version, _ in QUANTITIES:
+        for name, slug, fn, has_cr_version, _ in QUANTITIES:
             for cr in ((False, True) if has_cr_version else (False,)):
                 dd = multi_cr.get(phi, {}) if cr else d
                 if not dd:
                     continue
-                qn, ms, (text, _, _, _) = quantity_rows(dd, fn, cr, ns)
+                qn, ms, (text, _, _, _) = quantity_rows(dd, fn, cr, ns, cal[slug, cr][0])
                 if not any(np.isfinite(m[0]) for m in ms):
                     continue
                 label = name + (" — cage-relative" if cr else "")
@@ -279,7 +310,7 @@ def write_finite_size(A, path, command):
         L += spread_section(multi, multi_cr)
         L += ["## Plots", ""]
         for name, slug, fn, has_cr_version, log_y in QUANTITIES:
-            f = plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr)
+            f = plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr, cal)
             if f:
                 figures.append(f)
                 L.append(f"- {name}: ![{name}](finite_size/{os.path.basename(f)})")
