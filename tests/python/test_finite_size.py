@@ -141,3 +141,13 @@ def test_errors_are_scaled_to_the_seeds_spread_when_it_is_larger(tmp_path):
     assert "τ_α × 2.00 (ratio 2.00 ± 0.41, 12 dof)" in text
     row = next(l for l in text.splitlines() if l.startswith("| τ_α |") and "verdict" not in l and "(" not in l.split("|")[2])
     assert "42 ± 1.2" in row  # sqrt(3) / 3 quoted, times 2
+
+
+def test_xi_cells_say_how_many_q_shells_their_fits_had():
+    from dynhet.analysis.finite_size import shells_note
+    p = Point(("neighbours", 0.9, 0.79, 4096))
+    p.runs = [{"seed": 1, "cut": {0.6: s4_cut(2.0, 100.0)}}, {"seed": 2, "cut": {0.6: s4_cut(4.0, 100.0)}}]
+    assert shells_note(p, False) == " [3-7 q]"  # xi = 2: 7 shells below q xi = 1; xi = 4: 3
+    p.runs = p.runs[:1]
+    assert shells_note(p, False) == " [7 q]"
+    assert shells_note(None, False) == ""

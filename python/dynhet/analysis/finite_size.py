@@ -63,6 +63,25 @@ def xi_shells(r, cr=False):
     return xi, abs(xi) * rel, shells
 
 
+def shells_note(p, cr):
+    """The q shells below q xi = 1 of a point's runs, as a cell's suffix:
+    " [7 q]" (the fewest over its seeds, " [5-7 q]" where they differ); ""
+    without runs or where no run has xi."""
+    if p is None:
+        return ""
+    ks = []
+    for r in p.runs:
+        try:
+            _, _, k = xi_shells(r, cr)
+        except (KeyError, TypeError, IndexError, ValueError):
+            continue
+        if k:
+            ks.append(k)
+    if not ks:
+        return ""
+    return f" [{min(ks)} q]" if min(ks) == max(ks) else f" [{min(ks)}-{max(ks)} q]"
+
+
 def with_cr(fn):
     """A per-run function of the standard results made to take cr=True."""
     def f(r, cr=False):
@@ -270,7 +289,8 @@ def write_finite_size(A, path, command):
          f"N's within {Z_CONVERGED:g} combined errors; otherwise **drifting**, with the change per doubling of N "
          f"between the two largest sizes. χ4^P is the peak of χ4(t) of sub-boxes of about that many particles "
          f"(interior peaks only); ξ is the whole box's Ornstein-Zernike ξ at τ_α, taken only where at least "
-         f"{MIN_SHELLS} q shells lie below q ξ = 1 (else \"—\": not resolved at this N). a = {A_MAIN}, ε = 0.9, "
+         f"{MIN_SHELLS} q shells lie below q ξ = 1 (else \"—\": not resolved at this N); [k q]: the shells below "
+         f"q ξ = 1 of its runs. a = {A_MAIN}, ε = 0.9, "
          f"neighbour kick pairs. Nothing here is tuned toward the paper's numbers.", ""]
     if not multi:
         L += ["No density was run at more than one N.", ""]
@@ -300,7 +320,10 @@ def write_finite_size(A, path, command):
                 if not any(np.isfinite(m[0]) for m in ms):
                     continue
                 label = name + (" — cage-relative" if cr else "")
-                L.append(f"| {label} | " + " | ".join(cell(m) for m in ms) + f" | {text} |")
+                cells = [cell(m) for m in ms]
+                if slug == "xi":  # how many q shells its fits had below q xi = 1 (issue 27, item 4)
+                    cells = [c + shells_note(dd.get(n), cr) for c, n in zip(cells, qn)]
+                L.append(f"| {label} | " + " | ".join(cells) + f" | {text} |")
         seeds = ", ".join(f"N {n}: {len(d[n].runs)}" for n in ns)
         crs = multi_cr.get(phi, {})
         if crs and any(crs.get(n) is not d.get(n) for n in crs):
