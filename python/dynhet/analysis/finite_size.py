@@ -339,6 +339,7 @@ def write_finite_size(A, path, command):
                 L.append(f"- {name}: ![{name}](finite_size/{os.path.basename(f)})")
         L.append("")
     out_dir = os.path.dirname(os.path.abspath(path))
+    os.makedirs(out_dir, exist_ok=True)
     fig_dir = os.path.join(out_dir, "finite_size")
     if figures:
         os.makedirs(fig_dir, exist_ok=True)

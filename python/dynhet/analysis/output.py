@@ -99,6 +99,7 @@ def write_table(A, path, command, discussion=None, restate_from=None):
     if restate_from:
         L += restate(restate_from, A.rows)
     L.append("")
+    os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path + ".tmp", "w") as fh:
         fh.write("\n".join(L))
         if discussion:
