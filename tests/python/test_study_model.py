@@ -82,3 +82,11 @@ def test_run_lengths_in_the_cage_relative_tau_alpha(tmp_path):
     with pytest.raises(StudyError) as e:
         study(tmp_path, GOOD.replace('tau_alpha = "pilot"', 'tau_alpha = "pilot"\nunit = "tau_cr"'))
     assert "run_length.unit: value 'tau_cr' is not allowed" in str(e.value)
+
+
+def test_the_dry_run_scales_its_estimate_by_what_complete_runs_cost():
+    from dynhet.study.index import measured_ratio
+    ratios, overall = measured_ratio([(1024, 10.0, 15.0), (1024, 30.0, 45.0), (4096, 100.0, 110.0)])
+    assert ratios == {1024: 1.5, 4096: 1.1}
+    assert abs(overall - 170.0 / 140.0) < 1e-12
+    assert measured_ratio([]) == ({}, None)

@@ -48,23 +48,54 @@ def nodes_of(sc):
     return len({("overlap" if c in ("chi4", "msd", "displacement") else c) for c in comp})
 
 
+def measured_ratio(done):
+    """[(N, estimated CPU s, measured CPU s)] of complete runs -> {N: measured
+    / estimated} per N, and the ratio over all of them (None without data).
+    The engine's estimate leaves out the nodes, the recorder and the start of
+    every process, which weigh most at small N."""
+    per = {}
+    for n, est, got in done:
+        a = per.setdefault(n, [0.0, 0.0])
+        a[0] += est
+        a[1] += got
+    ratios = {n: g / e for n, (e, g) in per.items() if e > 0}
+    e_all, g_all = sum(e for e, _ in per.values()), sum(g for _, g in per.values())
+    return ratios, (g_all / e_all if e_all > 0 else None)
+
+
 def dry_run(sd):
     rows = plan(sd)
+    costs = [(p, sc, tau, src, state, *estimate(sc, nodes_of(sc)), read_status(sd.run_dir(p)).get("cpu_s"))
+             for p, sc, tau, src, state in rows]
+    done = [(sc["system"]["n_particles"], cpu, float(got)) for _, sc, _, _, state, cpu, _, got in costs
+            if state == "complete" and got]
+    ratios, overall = measured_ratio(done)
     print(f"# study {sd.study.name}: {len(rows)} runs; times from the tau_alpha estimates known now; "
-          "CPU time from the engine's measured speed (docs/engine.md)")
+          "CPU time from the engine's measured speed (docs/engine.md)"
+          + (", times the measured CPU over that estimate of the complete runs (per N where some of that N "
+             "are complete, else over all); complete runs at their measured CPU" if overall else ""))
     print(f"{'run':44s} {'state':9s} {'N':>8s} {'tau_est':>9s} {'t_equil':>9s} {'t_prod':>9s} "
           f"{'cpu':>9s} {'memory':>8s}  tau from")
-    tot_cpu = left_cpu = 0.0
+    tot_cpu = left_cpu = engine_cpu = 0.0
     peak = 0.0
-    for p, sc, tau, src, state in rows:
-        cpu, mem = estimate(sc, nodes_of(sc))
+    for p, sc, tau, src, state, cpu, mem, got in costs:
+        n = sc["system"]["n_particles"]
+        engine_cpu += cpu
+        if state == "complete" and got:
+            cpu = float(got)
+        else:
+            cpu *= ratios.get(n, overall or 1.0)
         sch = sc.get("schedule", {})
         prod = (int(sch.get("origins", 10)) - 1) * float(sch.get("origin_spacing", 10)) + float(sch.get("lag_max", 100))
         tot_cpu += cpu
         left_cpu += 0 if state == "complete" else cpu
         peak = max(peak, mem)
-        print(f"{sd.study.run_name(p):44s} {state:9s} {sc['system']['n_particles']:8d} "
+        print(f"{sd.study.run_name(p):44s} {state:9s} {n:8d} "
               f"{(f'{tau:.4g}' if tau else '-'):>9s} {sc.get('run', {}).get('equilibration_time', 100):9.4g} "
               f"{prod:9.4g} {fmt_time(cpu):>9s} {mem / 2**20:7.0f}M  {src}")
+    if overall:
+        print("# measured CPU over the engine's estimate, complete runs: "
+              + ", ".join(f"N {n}: {r:.2f}" for n, r in sorted(ratios.items())) + f"; all: {overall:.2f}")
     print(f"# total CPU {fmt_time(tot_cpu)} ({tot_cpu / 3600:.2f} CPU-hours), left {fmt_time(left_cpu)}; "
-          f"largest run {peak / 2**20:.0f} MiB (pilots not counted)")
+          + (f"the engine's estimate alone {engine_cpu / 3600:.2f} CPU-hours; " if overall else "")
+          + f"largest run {peak / 2**20:.0f} MiB (pilots not counted)")
