@@ -113,6 +113,15 @@ bool CutCoordinator::complete(int cut, Pending& p) {
         p.saved.erase(who);
         if (p.said.insert(who).second)
           std::fprintf(stderr, "\nsim_node: checkpoint cut %d: no usable part of %s\n", cut, b.c_str());
+        // Its own answers keep coming ("saved" to every repeated request):
+        // a part that stays unusable fails the cut instead of holding it
+        // open to the end of the run.
+        if (++p.unusable[who] >= kUnusableAnswers && !p.failed) {
+          p.failed = true;
+          std::fprintf(stderr, "\nsim_node: checkpoint cut %d fails: the part of %s is still unusable after %d of "
+                       "its answers; the restart point stays cut %d\n", cut, who.c_str(), kUnusableAnswers,
+                       last_whole_);
+        }
         // A part from another build will not do at any cut: stop waiting.
         try {
           const PartHeader h = read_part_header(part_path(dir_, cut, who, p.frame));
@@ -161,7 +170,7 @@ void CutCoordinator::poll() {
       continue;
     }
     if (!broken_.empty()) return; // complete() dropped every open cut (it is invalid)
-    if (it->first < last_whole_) { // passed by a newer whole cut
+    if (p.failed || it->first < last_whole_) { // given up, or passed by a newer whole cut
       it = pending_.erase(it);
       continue;
     }

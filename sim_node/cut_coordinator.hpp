@@ -59,6 +59,9 @@ public:
   long unauthenticated() const { return unauthenticated_; } // answers dropped by the bus
   int newest_open() const; // -1: none
   static constexpr size_t kMaxOpen = 60; // the nodes keep 64
+  // A process whose part of a cut is read back unusable after this many of
+  // its "saved" answers (a forged one may come first) fails the cut.
+  static constexpr int kUnusableAnswers = 3;
   // Wall-clock seconds since the last cut was taken (or since the start).
   double seconds_since_take() const;
 
@@ -69,8 +72,11 @@ private:
     double time;
     bool stop = false;
     std::set<std::string> saved, said; // answered "saved"; named as missing a part
+    std::map<std::string, int> unusable; // how often a process's answered part was read back unusable
+    bool failed = false;                 // given up (a part that stays unusable)
     Clock::time_point asked;
   };
+
   void on_answer(const lcm::ReceiveBuffer* rb, const std::string& channel);
   void request(int cut, const Pending& p);
   bool complete(int cut, Pending& p); // false: not whole (yet)

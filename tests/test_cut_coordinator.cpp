@@ -144,3 +144,31 @@ TEST(CutCoordinator, AnOlderCutCompletedLateDoesNotMoveTheRestartPointBack) {
   EXPECT_TRUE(whole(f.d.path, c6));
   EXPECT_EQ(f.cuts.newest_open(), -1);
 }
+
+// A part that is read back unusable (here: a byte of its state changed, so
+// its CRC fails) while its process keeps answering "saved" fails the cut
+// after kUnusableAnswers answers, instead of holding it open to the end.
+TEST(CutCoordinator, APartThatStaysUnusableFailsTheCut) {
+  Cuts f({"sim", "overlap"});
+  ASSERT_TRUE(f.lcm.good());
+  const int c = f.take(3);
+  write_node_part(f.d.path, c, "overlap", 3);
+  const std::string path = part_path(f.d.path, c, "overlap", 3);
+  {
+    std::fstream io(path, std::ios::in | std::ios::out | std::ios::binary);
+    io.seekp(-5, std::ios::end);
+    io.put('\x55');
+  }
+  for (int k = 0; k < CutCoordinator::kUnusableAnswers - 1; ++k) {
+    answer(f.lcm, "overlap", c, 3, "saved");
+    f.cuts.poll();
+    EXPECT_EQ(f.cuts.newest_open(), c) << "answer " << k + 1 << ": still open";
+  }
+  answer(f.lcm, "overlap", c, 3, "saved");
+  f.cuts.poll();
+  f.cuts.poll();
+  EXPECT_EQ(f.cuts.newest_open(), -1);
+  EXPECT_EQ(f.cuts.last_whole(), -1);
+  EXPECT_FALSE(whole(f.d.path, c));
+  EXPECT_TRUE(f.cuts.broken().empty()) << "one bad part fails its cut, not every cut";
+}
