@@ -62,6 +62,11 @@ struct Cuts {
   explicit Cuts(std::vector<std::string> parts)
       : cuts(lcm, Bus::open_bus(), d.path, kRun, kScene, std::move(parts)) {}
   int take(int frame) { return cuts.take(frame, 0.5 * frame, std::vector<uint8_t>(32, 1)); }
+  // Writes a node's part as the node does; returns its path.
+  std::string node_part(int cut, const std::string& who, int frame) {
+    write_node_part(d.path, cut, who, frame);
+    return part_path(d.path, cut, who, frame);
+  }
 };
 
 } // namespace
@@ -100,9 +105,8 @@ TEST(CutCoordinator, APartFromAnotherBuildTurnsCutsOffAtOnce) {
   Cuts f({"sim", "overlap"});
   ASSERT_TRUE(f.lcm.good());
   const int c = f.take(3);
-  write_node_part(f.d.path, c, "overlap", 3);
+  const std::string path = f.node_part(c, "overlap", 3);
   // The same part as another build writes it: its build id differs.
-  const std::string path = part_path(f.d.path, c, "overlap", 3);
   std::string bytes;
   {
     std::ifstream in(path, std::ios::binary);
@@ -152,8 +156,7 @@ TEST(CutCoordinator, APartThatStaysUnusableFailsTheCut) {
   Cuts f({"sim", "overlap"});
   ASSERT_TRUE(f.lcm.good());
   const int c = f.take(3);
-  write_node_part(f.d.path, c, "overlap", 3);
-  const std::string path = part_path(f.d.path, c, "overlap", 3);
+  const std::string path = f.node_part(c, "overlap", 3);
   {
     std::fstream io(path, std::ios::in | std::ios::out | std::ios::binary);
     io.seekp(-5, std::ios::end);
