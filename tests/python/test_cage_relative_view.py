@@ -79,3 +79,17 @@ def test_the_cage_relative_and_bond_breaking_fits_are_of_their_own_times(tmp_pat
         f = A.fits[tag]
         assert f.ok and math.isclose(f.p["xc"], laws[key][0], abs_tol=2e-3), (tag, f.p)
         assert math.isclose(f.p["g"], laws[key][1], rel_tol=0.02), (tag, f.p)
+
+
+def test_values_without_any_error_are_still_drawn(tmp_path):
+    """A series whose points have no error at all (single seeds quoting none:
+    tau_alpha where the origins cannot span it) is drawn without bars;
+    matplotlib's own errorbar raises StopIteration on all-NaN errors, which
+    failed whole sections of a study's analysis."""
+    import math
+
+    from dynhet.analysis.plotting import errorbar
+    fig, ax = plt.subplots()
+    lines = errorbar(ax, [1.0, 2.0], [3.0, 4.0], [math.nan, math.nan], fmt="o")
+    assert list(lines[0].get_ydata()) == [3.0, 4.0]
+    plt.close(fig)

@@ -6,6 +6,7 @@ import numpy as np
 
 from .config import A_MAIN
 from .quantities import chi4_at_tau, cut, oz_fit, s4_at_tau, whole_box_s4
+from .plotting import errorbar
 
 
 def appendix_results(A):
@@ -43,7 +44,7 @@ def appendix_results(A):
                         (oz, "^", "χ0, fit 2 (OZ), whole box"),
                         (a2, "o", "χ0, fit 3 (with A²), whole box")):
         arr = np.array([v[:2] for v in arr])
-        ax[0].errorbar(x, arr[:, 0], arr[:, 1], fmt=m, label=lab, mfc="none")
+        errorbar(ax[0], x, arr[:, 0], arr[:, 1], fmt=m, label=lab, mfc="none")
     ax[0].set_yscale("log")
     ax[0].set_xlabel("φ")
     ax[0].set_ylabel("χ at the s4 node's t_s4 (= its τ_α)")

@@ -9,7 +9,7 @@ from .config import XI_MIN_DF
 from .points import fit_series, seeds_of, series_arrays
 from .quantities import chi0_at_tau, chi4_at_tau, cut, interior_note, proper_subbox, s4_at_tau, tau, tau4_of, xi_at_tau
 from .verdicts import fit_verdict, fixed_xc_row, fmt, range_scan
-from .plotting import colours
+from .plotting import colours, errorbar
 
 
 def chi4_results(A, phi_c_tau, joint=None):
@@ -35,7 +35,7 @@ def chi4_results(A, phi_c_tau, joint=None):
         m = p.mean(t4)
         y.append(m[0])
         e.append(m[1])
-    ax[1].errorbar(x, y, e, fmt="o", ms=4)
+    errorbar(ax[1], x, y, e, fmt="o", ms=4)
     if f4.ok:
         xx = np.geomspace(*f4.x_range, 20)
         ax[1].plot(xx, f4.p["A"] * xx ** f4.p["s"], "k--", label=f"τ4 ∝ τ_α^{f4.p['s']:.3g}")
@@ -47,7 +47,7 @@ def chi4_results(A, phi_c_tau, joint=None):
     ax[1].set_title("inset of fig. chi4")
     fc = A.fit("chi4_tau_phi", fit_series(pts, chi4_at_tau, sf.critical))
     x, y, e = series_arrays(pts, chi4_at_tau)
-    ax[2].errorbar(x, y, e, fmt="o", ms=4)
+    errorbar(ax[2], x, y, e, fmt="o", ms=4)
     if fc.ok:
         xx = np.linspace(x.min(), x.max(), 100)
         ax[2].plot(xx, fc.p["A"] * (fc.p["xc"] - xx) ** -fc.p["g"], "--", label=f"φc = {fc.p['xc']:.4f}, γχ = {fc.p['g']:.3g}")
@@ -109,7 +109,7 @@ def s4_results(A, joint):
     fd_note, _ = range_scan(fd_scan, "s", "ξ_min")
     fig, ax = plt.subplots(1, 3, figsize=(16, 4.5))
     x, y, e = series_arrays(pts, xi_at_tau)
-    ax[0].errorbar(x, y, e, fmt="o")
+    errorbar(ax[0], x, y, e, fmt="o")
     if fx.ok:
         xx = np.linspace(x.min(), x.max(), 100)
         ax[0].plot(xx, fx.p["A"] * (fx.p["xc"] - xx) ** -fx.p["g"], "--", label=f"φc = {fx.p['xc']:.4f}, γξ = {fx.p['g']:.3g}")
@@ -124,7 +124,7 @@ def s4_results(A, joint):
             m = p.mean(fn)
             ys.append(m[0])
             es.append(m[1])
-        ax[k + 1].errorbar(xs, ys, es, fmt="o")
+        errorbar(ax[k + 1], xs, ys, es, fmt="o")
         if f_.ok:
             xx = np.geomspace(*f_.x_range, 20)
             ax[k + 1].plot(xx, f_.p["A"] * xx ** f_.p["s"], "k--", label=f"∝ ξ^{f_.p['s']:.3g}")

@@ -10,7 +10,7 @@ from .runs import snapshot
 from .points import fit_series, point_error, series_arrays
 from .quantities import KAPPA_LO, cut, kappa_of, n_star
 from .verdicts import fmt, verdict
-from .plotting import colours
+from .plotting import colours, errorbar
 
 
 def cluster_results(A, phi_c, phi_c_why=None, joint=None):
@@ -32,9 +32,9 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
         ax[0].legend(fontsize=8)
         ax[0].set_title("Fig. clusters-VF805: R_g(N_c)")
     x, y, e = series_arrays(pts, dfs)
-    ax[1].errorbar(x, y, e, fmt="o", color="C3", label="slow")
+    errorbar(ax[1], x, y, e, fmt="o", color="C3", label="slow")
     x2, y2, e2 = series_arrays(pts, dff)
-    ax[1].errorbar(x2, y2, e2, fmt="s", color="C7", label="fast")
+    errorbar(ax[1], x2, y2, e2, fmt="s", color="C7", label="fast")
     ax[1].set_xlabel("φ")
     ax[1].set_ylabel("d_f")
     ax[1].legend(fontsize=8)

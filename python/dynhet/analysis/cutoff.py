@@ -7,7 +7,7 @@ from .config import A_THREE, EPS_MAIN
 from .points import fit_series, series_arrays
 from .quantities import XI_MIN, chi4_at_tau, cut, proper_subbox, xi_at_tau
 from .verdicts import fit_verdict, fmt
-from .plotting import colours
+from .plotting import colours, errorbar
 
 
 def cutoff_results(A):
@@ -63,7 +63,7 @@ def cutoff_results(A):
         xfn = lambda r, a=a: xi_at_tau(r, a, own=True)
         cfn = lambda r, a=a: chi4_at_tau(r, a, own=True)
         x, y, e = series_arrays(pts, xfn)
-        ax[2].errorbar(x, y, e, fmt=m + "-", ms=4, label=f"a = {a:g}")
+        errorbar(ax[2], x, y, e, fmt=m + "-", ms=4, label=f"a = {a:g}")
         fd = A.fit(f"chi4_xi_a{a:g}", fit_series(pts, cfn, sf.power, xrun=xfn))
         xs, ys = [p.mean(xfn)[0] for p in pts], [p.mean(cfn)[0] for p in pts]
         ax[3].loglog(xs, ys, m, label=f"a = {a:g}: d_f' = {fd.p['s']:.3g}")

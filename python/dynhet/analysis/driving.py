@@ -6,6 +6,7 @@ from .points import fit_series, series_arrays
 from .quantities import chi4_at_tau, cut, tau, xi_at_tau
 from .verdicts import fmt
 from .overlap import better, tau_fits
+from .plotting import errorbar
 
 
 def driving_results(A):
@@ -17,7 +18,7 @@ def driving_results(A):
         pts = A.series(pairs=rule)
         fp, fv = tau_fits(A, pts, f"{rule}")
         x, y, e = series_arrays(pts, tau)
-        ax.errorbar(x, y, e, fmt="o", color=col, label=f"pairs = {rule}")
+        errorbar(ax, x, y, e, fmt="o", color=col, label=f"pairs = {rule}")
         res = {"fp": fp, "fv": fv, "pts": pts}
         if all("s4_N" in cut(r) for p in pts for r in p.runs):
             res["fc"] = A.fit(f"chi4_phi_{rule}", fit_series(pts, chi4_at_tau, sf.critical))

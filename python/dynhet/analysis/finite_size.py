@@ -11,7 +11,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .config import A_MAIN
-from .plotting import colours
+from .plotting import colours, errorbar
 from .quantities import PER_RUN, XI_MIN, chi0_at_tau, kappa_of, whole_box_s4
 from .size import points_by_phi_n
 from .verdicts import fmt
@@ -255,7 +255,7 @@ def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr, cal
                 continue
             y = [m[0] for m in ms if np.isfinite(m[0])]
             e = [np.nan_to_num(measured_error(m)) for m in ms if np.isfinite(m[0])]
-            ax.errorbar(x, y, e, fmt="s--" if cr else "o-", ms=4, color=col, mfc="none" if cr else col,
+            errorbar(ax, x, y, e, fmt="s--" if cr else "o-", ms=4, color=col, mfc="none" if cr else col,
                         label=f"φ = {phi:g}" + (" (cage-relative)" if cr else ""))
             drawn = True
     if not drawn:

@@ -9,7 +9,7 @@ import numpy as np
 
 from .config import say
 from .overlap import tau_fits
-from .plotting import colours
+from .plotting import colours, errorbar
 from .points import point_error, series_arrays
 from .quantities import PER_RUN, tau
 from .size import points_by_phi_n
@@ -33,7 +33,7 @@ def local_phi_results(A):
     for label, fn, col, m in MEASURES:
         sel = [p for p in pts if measured(p, fn)]
         x, y, e = series_arrays(sel, fn)
-        ax.errorbar(x, y, e, fmt=m, ms=4, color=col, label=label)
+        errorbar(ax, x, y, e, fmt=m, ms=4, color=col, label=label)
         if len(sel) < 4 or fn is tau:
             continue
         fp, fv = tau_fits(A, sel, "eps0.9_" + ("cr" if fn is TAU_CR else "B"), fn)
@@ -71,7 +71,7 @@ def local_n_results(A):
         for label, fn, col, m in MEASURES:
             ms = [d[n].mean(fn) for n in ns]
             ok = [i for i, v in enumerate(ms) if v[3]]
-            ax.errorbar([ns[i] for i in ok], [ms[i][0] for i in ok], [point_error(ms[i]) for i in ok], fmt=m + "-",
+            errorbar(ax, [ns[i] for i in ok], [ms[i][0] for i in ok], [point_error(ms[i]) for i in ok], fmt=m + "-",
                         color=col, label=label)
             if len(ok) < 2:
                 continue

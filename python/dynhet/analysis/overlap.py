@@ -9,7 +9,7 @@ from .config import PHI_AGE
 from .points import fit_series, series_arrays
 from .quantities import cut, tau
 from .verdicts import fit_verdict, fixed_xc_row, fmt, verdict
-from .plotting import colours
+from .plotting import colours, errorbar
 
 
 def overlap_results(A):
@@ -61,7 +61,7 @@ def overlap_results(A):
             mm = p.mean(fn)
             y.append(mm[0])
             e.append(mm[1])
-        ax.errorbar(x, y, e, fmt=m, ms=4, label=lab)
+        errorbar(ax, x, y, e, fmt=m, ms=4, label=lab)
     for f, lab in ((fb, "β"), (ft, "τ_α")):
         if f.ok:
             xx = np.geomspace(*f.x_range, 50)
@@ -103,7 +103,7 @@ def tau_results(A, joint=None):
     fp, fv = tau_fits(A, pts, "eps0.9")
     fig, ax = plt.subplots(figsize=(6, 4.5))
     x, y, e = series_arrays(pts, tau)
-    ax.errorbar(x, y, e, fmt="o", ms=4, color="k", label="ε = 0.9, neighbour pairs")
+    errorbar(ax, x, y, e, fmt="o", ms=4, color="k", label="ε = 0.9, neighbour pairs")
     xx = np.linspace(x.min() if len(x) else 0.6, x.max() if len(x) else 0.8, 200)
     if fp.ok:
         ax.plot(xx, fp.p["A"] * (fp.p["xc"] - xx) ** -fp.p["g"], "--", label=f"(φc-φ)^-γ: φc = {fp.p['xc']:.4f}, γ = {fp.p['g']:.3g}")

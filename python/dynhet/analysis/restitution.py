@@ -9,6 +9,7 @@ from .config import XI_MIN_DF
 from .points import fit_series, series_arrays
 from .quantities import chi4_at_tau, cut, tau, xi_at_tau
 from .verdicts import fmt
+from .plotting import errorbar
 
 
 def restitution_results(A):
@@ -23,7 +24,7 @@ def restitution_results(A):
         fp = A.fit(f"tau_power_eps{eps:g}_common", fit_series(pts, tau, sf.critical, x_range=common))
         fv = A.fit(f"tau_vft_eps{eps:g}_common", fit_series(pts, tau, sf.vft, x_range=common))
         x, y, e = series_arrays(pts, tau)
-        ax[0].errorbar(x, y, e, fmt="o", ms=4, color=col, label=f"ε = {eps:g}")
+        errorbar(ax[0], x, y, e, fmt="o", ms=4, color=col, label=f"ε = {eps:g}")
         if fv.ok:
             xx = np.linspace(*fv.x_range, 50)
             ax[0].plot(xx, fv.p["A"] * np.exp(fv.p["B"] / (fv.p["x0"] - xx)), "-", color=col, lw=0.7)
@@ -32,7 +33,7 @@ def restitution_results(A):
         if p78 is not None and abs(p78.phi - 0.78) < 1e-9:
             c = cut(p78.runs[0])
             pk = np.array([p78.mean(lambda r, g=g: (cut(r)["chi4_peak"][g], cut(r)["chi4_peak_err"][g])) for g in range(len(c["chi4_N"]))])
-            ax[2].errorbar(c["chi4_N"], pk[:, 0], pk[:, 1], fmt="o-", color=col, label=f"ε = {eps:g}")
+            errorbar(ax[2], c["chi4_N"], pk[:, 0], pk[:, 1], fmt="o-", color=col, label=f"ε = {eps:g}")
     ax[0].set_yscale("log")
     ax[0].set_xlabel("φ")
     ax[0].set_ylabel("τ_α")
@@ -43,7 +44,7 @@ def restitution_results(A):
         f_ = [fp if nm == "xc" else fv for _, fp, fv, _ in pc]
         if not any(f.ok for f in f_):
             continue
-        ax[1].errorbar(xs, [f.p[nm] for f in f_], [f.error(nm) for f in f_], fmt=m, label="φ_c (power law)" if nm == "xc" else "φ_0 (VFT)")
+        errorbar(ax[1], xs, [f.p[nm] for f in f_], [f.error(nm) for f in f_], fmt=m, label="φ_c (power law)" if nm == "xc" else "φ_0 (VFT)")
     ax[1].set_xlabel("ε")
     ax[1].set_ylabel("φ_c, φ_0")
     ax[1].legend()

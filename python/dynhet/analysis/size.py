@@ -9,7 +9,7 @@ from .config import EPS_MAIN
 from .points import fit_series, point_error
 from .quantities import tau
 from .verdicts import fmt
-from .plotting import colours, log_axes
+from .plotting import colours, errorbar, log_axes
 
 
 def points_by_phi_n(A, has=lambda p: True):
@@ -43,7 +43,7 @@ def d_n_results(A):
     for (phi, d), col in zip(multi.items(), colours(len(multi))):
         ns = sorted(d)
         vals = [d[n].mean(dD) for n in ns]
-        ax[0].errorbar(ns, [v[0] for v in vals], [point_error(v) for v in vals], fmt="o-", color=col, label=f"φ = {phi:g}")
+        errorbar(ax[0], ns, [v[0] for v in vals], [point_error(v) for v in vals], fmt="o-", color=col, label=f"φ = {phi:g}")
         cells.append(f"φ {phi:g}: " + ", ".join(f"{fmt(v[0], point_error(v))} (N {n})" for n, v in zip(ns, vals)))
         used += list(d.values())
     log_axes(ax[0], "N", "D", "D against the number of particles")
@@ -65,7 +65,7 @@ def d_n_results(A):
                     th[n] = (-f.p["s"], f.error("s"), len(common))
     if th:
         ns = sorted(th)
-        ax[1].errorbar(ns, [th[n][0] for n in ns], [th[n][1] for n in ns], fmt="o-", color="k")
+        errorbar(ax[1], ns, [th[n][0] for n in ns], [th[n][1] for n in ns], fmt="o-", color="k")
     ax[1].set_xscale("log")
     ax[1].set_xlabel("N")
     ax[1].set_ylabel("θ (D ∝ τ_α^-θ, φ = " + ", ".join(f"{x:g}" for x in common) + ")")
@@ -96,7 +96,7 @@ def tau_n_results(A):
     for (phi, d), col in zip(multi.items(), colours(len(multi))):
         ns = sorted(d)
         vals = [d[n].mean(tau) for n in ns]
-        ax.errorbar(ns, [v[0] for v in vals], [v[1] for v in vals], fmt="o-", color=col, label=f"φ = {phi:g}")
+        errorbar(ax, ns, [v[0] for v in vals], [v[1] for v in vals], fmt="o-", color=col, label=f"φ = {phi:g}")
         cells.append(f"φ {phi:g}: " + ", ".join(f"{fmt(v[0], v[1])} (N {n}, {d[n].mean(tau)[3]} seed{'s' if d[n].mean(tau)[3] > 1 else ''})"
                                                  for n, v in zip(ns, vals)))
         used += list(d.values())

@@ -7,6 +7,7 @@ from .config import A_MAIN, PHI_HIGH, PHI_INTERMEDIATE, PHI_PDX
 from .points import fit_series
 from .quantities import tau
 from .verdicts import fit_verdict, fmt
+from .plotting import errorbar
 
 
 def d_results(A):
@@ -21,7 +22,7 @@ def d_results(A):
         m = p.mean(dfn)
         ys.append(m[0])
         es.append(m[1])
-    ax.errorbar(xs, ys, es, fmt="o", ms=4, color="k")
+    errorbar(ax, xs, ys, es, fmt="o", ms=4, color="k")
     for f, ls, lab in ((fi, "-", "θ"), (fh, "--", "θ'")):
         if f.ok:
             xx = np.geomspace(*f.x_range, 20)
