@@ -111,12 +111,12 @@ bool CutCoordinator::complete(int cut, Pending& p) {
       for (const std::string& b : bad) {
         const std::string who = b.substr(0, b.find(':'));
         p.saved.erase(who);
-        if (p.said.insert(who).second)
-          std::fprintf(stderr, "\nsim_node: checkpoint cut %d: no usable part of %s\n", cut, b.c_str());
+        const int times = ++p.unusable[who];
+        if (times == 1) std::fprintf(stderr, "\nsim_node: checkpoint cut %d: no usable part of %s\n", cut, b.c_str());
         // Its own answers keep coming ("saved" to every repeated request):
         // a part that stays unusable fails the cut instead of holding it
         // open to the end of the run.
-        if (++p.unusable[who] >= kUnusableAnswers && !p.failed) {
+        if (times >= kUnusableAnswers && !p.failed) {
           p.failed = true;
           std::fprintf(stderr, "\nsim_node: checkpoint cut %d fails: the part of %s is still unusable after %d of "
                        "its answers; the restart point stays cut %d\n", cut, who.c_str(), kUnusableAnswers,

@@ -71,8 +71,8 @@ private:
     int frame;
     double time;
     bool stop = false;
-    std::set<std::string> saved, said; // answered "saved"; named as missing a part
-    std::map<std::string, int> unusable; // how often a process's answered part was read back unusable
+    std::set<std::string> saved;         // answered "saved"
+    std::map<std::string, int> unusable; // how often a process's answered part was read back unusable (named the first time)
     bool failed = false;                 // given up (a part that stays unusable)
     Clock::time_point asked;
   };
