@@ -25,6 +25,9 @@ from scipy import odr
 from scipy.optimize import least_squares
 
 
+MIN_JK_SEEDS = 3   # below this a jackknife over seeds is not taken alone (Fit.error)
+
+
 class Fit:
     def __init__(self, form, names, x_range=(math.nan, math.nan), note=""):
         self.form = form
@@ -32,6 +35,7 @@ class Fit:
         self.p = {n: math.nan for n in names}
         self.err = {n: math.nan for n in names}     # from the covariance of the fit
         self.jk = {n: math.nan for n in names}      # jackknife over seeds (set by jackknife_over_seeds)
+        self.jk_seeds = 0                           # the seeds behind jk
         self.chi2 = math.nan
         self.dof = 0
         self.n = 0
@@ -47,9 +51,14 @@ class Fit:
         """The quoted error: the jackknife over seeds where it exists, else the
         fit's own; where the form misses the points (chi2/dof > 1) at least
         the fit's own error times sqrt(chi2/dof) (the Birge ratio), since
-        seeds that all share the misfit agree with each other."""
+        seeds that all share the misfit agree with each other. A jackknife
+        over fewer than MIN_JK_SEEDS seeds (one dof: its size is itself
+        uncertain by a factor of several) is not taken alone: the larger of it
+        and the fit's own error."""
         e = self.jk.get(name, math.nan)
         e = e if np.isfinite(e) else self.err[name]
+        if self.jk_seeds < MIN_JK_SEEDS and np.isfinite(self.err[name]):
+            e = max(e, self.err[name])
         r = self.chi2_dof()
         if np.isfinite(r) and r > 1 and np.isfinite(self.err[name]):
             e = max(e, self.err[name] * math.sqrt(r)) if np.isfinite(e) else self.err[name] * math.sqrt(r)
@@ -326,6 +335,7 @@ def jackknife_over_seeds(fit_fn, seeds, fit=None):
         return fit
     reps = [fit_fn(s) for s in seeds]
     n = len(reps)
+    fit.jk_seeds = n
     for name in fit.names:
         th = np.array([r.p.get(name, math.nan) for r in reps], float)
         if np.all(np.isfinite(th)):

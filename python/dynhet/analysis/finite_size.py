@@ -13,6 +13,7 @@ import numpy as np
 from .config import A_MAIN
 from .plotting import colours, errorbar
 from .quantities import PER_RUN, XI_MIN, chi0_at_tau, kappa_of, whole_box_s4
+from .points import MIN_CAL_DOF, ensure_calibrated, spread_ratio as pooled_spread
 from .size import points_by_phi_n
 from .verdicts import fmt
 
@@ -21,7 +22,6 @@ from .verdicts import fmt
 SUBBOX_SIZES = (32, 128, 512, 2048, 8192, 32768)
 MIN_SHELLS = 5      # xi needs at least this many q shells below q xi = 1 (issue 27, item 4)
 Z_CONVERGED = 2.0   # values within 2 combined standard errors agree
-MIN_CAL_DOF = 10    # the seeds' spread scales the quoted errors only with this many dof behind it
 
 
 def cutx(r, cr):
@@ -137,27 +137,10 @@ def size_verdict(ns, vals, errs):
 
 
 def spread_ratio(points, fn, cr=False):
-    """Are the quoted errors honest at this N? The seeds' spread against the
-    errors the runs quote, pooled over points as bench/seed_spread.py pools it:
-    ratio^2 = sum_p sum_s (x_s - mean_p)^2 / e_p^2 / sum_p (K_p - 1), e_p the
-    mean quoted error of point p's K_p seeds (runs without a finite error left
-    out). About 1 for honest errors; its own uncertainty ratio / sqrt(2 dof).
-    Returns (ratio, uncertainty, dof, runs without a quoted error)."""
-    num, dof, unquoted = 0.0, 0, 0
-    for p in points:
-        vals = p.values(lambda r: fn(r, cr))
-        unquoted += sum(1 for _, v, e in vals if np.isfinite(v) and not (np.isfinite(e) and e > 0))
-        ok = [(v, e) for _, v, e in vals if np.isfinite(v) and np.isfinite(e) and e > 0]
-        if len(ok) < 2:
-            continue
-        x = np.array([v for v, _ in ok])
-        e = float(np.mean([e for _, e in ok]))
-        num += float(((x - x.mean()) ** 2).sum()) / e ** 2
-        dof += len(ok) - 1
-    if dof == 0:
-        return math.nan, math.nan, 0, unquoted
-    r = math.sqrt(num / dof)
-    return r, r / math.sqrt(2 * dof), dof, unquoted
+    """points.spread_ratio of fn(run, cr): the seeds' spread against the quoted
+    errors, pooled over points. Returns (ratio, uncertainty, dof, runs without a
+    quoted error)."""
+    return pooled_spread(points, lambda r: fn(r, cr))
 
 
 def spread_section(multi, multi_cr):
@@ -191,24 +174,6 @@ def spread_section(multi, multi_cr):
             "|---|" + "---|" * len(ns)] + rows + [""]
 
 
-def calibration(src, fn, cr=False):
-    """How much larger than quoted a quantity's errors are: the seeds' spread
-    over the quoted errors (spread_ratio) pooled over every point of src
-    ({phi: {N: Point}}). Returns (factor, ratio, uncertainty, dof): the factor
-    is the ratio where it has at least MIN_CAL_DOF dof and lies more than two
-    of its uncertainties above 1, else 1 (quoted errors are never shrunk)."""
-    pts = [p for d in src.values() for p in d.values()]
-    r, u, dof, _ = spread_ratio(pts, fn, cr)
-    k = r if dof >= MIN_CAL_DOF and np.isfinite(r) and r - 2 * u > 1 else 1.0
-    return k, r, u, dof
-
-
-def scaled(m, k):
-    """A per-point mean (Point.mean) with its quoted error times k."""
-    v, e, sem, n = m
-    return v, e * k, sem, n
-
-
 def measured_error(m):
     """The error of a per-point mean that was measured: the runs' quoted
     error, else the seeds' standard error; NaN where there is neither (one
@@ -226,13 +191,13 @@ def cell(m):
     return (fmt(v, e) if np.isfinite(e) else f"{v:.4g} (no error)") + ("" if n > 1 else " ¹")
 
 
-def quantity_rows(d, fn, cr, ns=None, k=1.0):
-    """Per-N means (at the sizes ns, default d's; NaN where d has none), their
-    quoted errors times k (calibration), and the verdict (sizes without a
-    measured error take no part in it)."""
+def quantity_rows(d, fn, cr, ns=None):
+    """Per-N means (at the sizes ns, default d's; NaN where d has none; their
+    errors scaled by their study's calibration, Point.mean) and the verdict
+    (sizes without a measured error take no part in it)."""
     ns = sorted(d) if ns is None else ns
     nan = (math.nan, math.nan, math.nan, 0)
-    ms = [scaled(d[n].mean(lambda r: fn(r, cr)), k) if n in d else nan for n in ns]
+    ms = [d[n].mean(lambda r: fn(r, cr)) if n in d else nan for n in ns]
     verdict = size_verdict(ns, [m[0] for m in ms], [measured_error(m) for m in ms])
     return ns, ms, verdict
 
@@ -241,7 +206,7 @@ def has_cr(p):
     return any(r.get("cut_cr") and A_MAIN in r["cut_cr"] for r in p.runs)
 
 
-def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr, cal):
+def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr):
     fig, ax = plt.subplots(figsize=(6, 4.3))
     drawn = False
     for (phi, d), col in zip(multi.items(), colours(len(multi))):
@@ -249,7 +214,7 @@ def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr, cal
             dd = multi_cr.get(phi, {}) if cr else d
             if not dd:
                 continue
-            ns, ms, _ = quantity_rows(dd, fn, cr, k=cal[slug, cr][0])
+            ns, ms, _ = quantity_rows(dd, fn, cr)
             x = [n for n, m in zip(ns, ms) if np.isfinite(m[0])]
             if not x:
                 continue
@@ -269,6 +234,36 @@ def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr, cal
     ax.set_title(f"{name} against N")
     ax.legend(fontsize=7)
     return A.save(fig, f"fs_{slug}.png")
+
+
+def calibration_note(A, multi, multi_cr):
+    """The factors by which each quantity's quoted errors are scaled
+    (points.calibration, pooled over each study's points)."""
+    ensure_calibrated(list(A.points.values()) + list(A.extra.values()))
+    pops = {id(p.population): p.population for src in (multi, multi_cr) for d in src.values() for p in d.values()}
+    applied = []
+    for name, slug, fn, has_cr_version, _ in QUANTITIES:
+        for cr in ((False, True) if has_cr_version else (False,)):
+            f = lambda run: fn(run, cr)  # noqa: E731
+            groups = {}   # (factor, ratio, uncertainty, dof, borrowed) -> the studies
+            for pop in pops.values():
+                k, r, u, dof = pop.calibration(f)
+                borrowed = pop.parent is not None and pop.own(f)[3] < MIN_CAL_DOF
+                if k != 1.0:
+                    groups.setdefault((k, r, u, dof, borrowed), []).append(pop.name or os.path.basename(A.dir))
+            for (k, r, u, dof, borrowed), names in groups.items():
+                where = ""
+                if len(pops) > 1:
+                    where = f", {'studies' if len(names) > 1 else 'study'} {', '.join(sorted(names))}"
+                    where += " (too few seeds of their own: pooled over all studies)" if borrowed else ""
+                applied.append(f"{name}{' — cage-relative' if cr else ''} × {k:.2f} (ratio {r:.2f} ± {u:.2f}, "
+                               f"{dof} dof{where})")
+    return ["**Errors scaled to the seeds' spread.** Where the seeds of a study scatter more than their runs' "
+            "quoted errors say, pooled over every point of that study (`points.calibration`: at least "
+            f"{MIN_CAL_DOF} dof, more than 2 of its uncertainties above 1), the quoted errors of that quantity "
+            "are multiplied by that ratio in the tables, plots and verdicts (and in every other report of the "
+            "study analysis): " + ("; ".join(applied) if applied else "none needed") +
+            ". Quoted errors are never made smaller.", ""]
 
 
 def write_finite_size(A, path, command):
@@ -294,17 +289,7 @@ def write_finite_size(A, path, command):
          f"neighbour kick pairs. Nothing here is tuned toward the paper's numbers.", ""]
     if not multi:
         L += ["No density was run at more than one N.", ""]
-    cal = {(slug, cr): calibration(multi_cr if cr else multi, fn, cr)
-           for _, slug, fn, has_cr_version, _ in QUANTITIES for cr in ((False, True) if has_cr_version else (False,))}
-    applied = [f"{name}{' — cage-relative' if cr else ''} × {k:.2f} (ratio {r:.2f} ± {u:.2f}, {dof} dof)"
-               for name, slug, _, has_cr_version, _ in QUANTITIES
-               for cr in ((False, True) if has_cr_version else (False,))
-               for k, r, u, dof in [cal[slug, cr]] if k != 1.0]
-    L += ["**Errors scaled to the seeds' spread.** Where the seeds of a point scatter more than their runs' "
-          "quoted errors say, pooled over every point of this report (`calibration`: at least "
-          f"{MIN_CAL_DOF} dof, more than 2 of its uncertainties above 1), the quoted errors of that quantity "
-          "are multiplied by that ratio in the tables, plots and verdicts: "
-          + ("; ".join(applied) if applied else "none needed") + ". Quoted errors are never made smaller.", ""]
+    L += calibration_note(A, multi, multi_cr)
     figures = []
     for phi, d in multi.items():
         ns = sorted(d)
@@ -316,7 +301,7 @@ def write_finite_size(A, path, command):
                 dd = multi_cr.get(phi, {}) if cr else d
                 if not dd:
                     continue
-                qn, ms, (text, _, _, _) = quantity_rows(dd, fn, cr, ns, cal[slug, cr][0])
+                qn, ms, (text, _, _, _) = quantity_rows(dd, fn, cr, ns)
                 if not any(np.isfinite(m[0]) for m in ms):
                     continue
                 label = name + (" — cage-relative" if cr else "")
@@ -333,7 +318,7 @@ def write_finite_size(A, path, command):
         L += spread_section(multi, multi_cr)
         L += ["## Plots", ""]
         for name, slug, fn, has_cr_version, log_y in QUANTITIES:
-            f = plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr, cal)
+            f = plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr)
             if f:
                 figures.append(f)
                 L.append(f"- {name}: ![{name}](finite_size/{os.path.basename(f)})")

@@ -5,6 +5,7 @@ import time
 import h5py
 import numpy as np
 
+from .points import MIN_CAL_DOF
 from .quantities import PER_RUN, chi4_at_tau, cut, tau, xi_at_tau
 from .verdicts import fmt
 from .config import CONVENTIONS
@@ -55,6 +56,26 @@ def write_h5(A, path):
     os.replace(tmp, path)
 
 
+def calibration_lines(A):
+    """The study's quoted errors against its seeds' spread, per quantity
+    (points.calibration over its own points): the factor its per-point errors
+    take."""
+    pop = next((p.population for p in A.points.values() if p.population is not None), None)
+    if pop is None:
+        return []
+    cells = []
+    for name, fn in PER_RUN.items():
+        k, r, u, dof = pop.calibration(fn)
+        if dof:
+            cells.append(f"{name} {r:.2f} ± {u:.2f} ({dof} dof)" + (f" → × {k:.2f}" if k != 1.0 else ""))
+    if not cells:
+        return []
+    return ["The seeds' spread over the errors the runs quote, pooled over this study's points (`points.calibration`; "
+            "about 1 where the quoted errors are honest), and the factor (→) by which a quantity's quoted errors are "
+            f"scaled where that ratio has at least {MIN_CAL_DOF} dof and lies more than 2 of its uncertainties "
+            "above 1: " + "; ".join(cells) + ".", ""]
+
+
 def hms(s):
     s = int(round(s))
     return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
@@ -69,9 +90,12 @@ def write_table(A, path, command, discussion=None, restate_from=None):
          f"{n_runs} complete runs, {hms(total)} of CPU in the runs and {hms(A.pilot_cpu)} in the pilots.",
          "", f"Command: `{command}`", "",
          "The paper: Avila, Castillo, Vollmayr-Lee, Zippelius, *Dynamical heterogeneities in a driven granular "
-         "fluid* (`../shared/paper/`), section 3. Errors: jackknife over seeds for every cross-run fit, the standard "
-         "error of the seed mean for per-point values. \"agrees\" means within 2 of our standard errors; a row "
+         "fluid* (`../shared/paper/`), section 3. Errors: jackknife over seeds for every cross-run fit; for "
+         "per-point values the runs' own errors combined (jackknife over origin blocks), scaled to the seeds' "
+         "spread where the study's seeds scatter more than those errors say (below), or the standard error of "
+         "the seed mean where no run quotes one. \"agrees\" means within 2 of our standard errors; a row "
          "marked \"differs\" is discussed below the table. CPU is that of the runs behind the row.", ""]
+    L += calibration_lines(A)
     if A.skipped:
         L += [f"Left out: {len(A.skipped)} runs not complete ({', '.join(sorted({s for _, s in A.skipped}))}).", ""]
     L += ["| result | paper (section, figure) | paper | ours | verdict | figure | CPU |", "|---|---|---|---|---|---|---|"]

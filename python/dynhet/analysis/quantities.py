@@ -54,7 +54,7 @@ def chi4_at_tau(r, a=A_MAIN, g=None, own=False):
     if g is None:
         g = proper_subbox(c, r["N"])
     v, ie = sf.interp_ln_t(c["chi4_lag"], c["chi4"][g], t)
-    _, e = sf.interp_ln_t(c["chi4_lag"], c["chi4_err"][g], t)
+    e, _ = sf.interp_ln_t(c["chi4_lag"], c["chi4_err"][g], t)  # the error at t (not the error curve's own interpolation error)
     return v, math.hypot(e, ie if np.isfinite(ie) else 0.0)
 
 

@@ -7,7 +7,7 @@ import numpy as np
 
 from .config import A_MAIN, EPS_MAIN
 from .runs import read_run
-from .points import Point, point_error
+from .points import Point, ensure_calibrated, point_error
 from .quantities import PER_RUN
 
 
@@ -43,6 +43,7 @@ class Analysis:
         self.also = [os.path.abspath(x) for x in also]
         for k, sd in enumerate([d] + list(also)):
             self.read_study(sd, primary=(k == 0))
+        ensure_calibrated(list(self.points.values()) + list(self.extra.values()))
         self.fits = {}
         self.rows = []
         self.figdir = os.path.join(self.dir, "figures")  # made by the first figure saved
@@ -170,6 +171,7 @@ class CageRelativeView(Analysis):
                     out[k] = q
             return out
         self.points, self.extra = swapped(base.points), swapped(base.extra)
+        ensure_calibrated(list(self.points.values()) + list(self.extra.values()))
 
     def save(self, fig, name):
         return self.base.save(fig, "cr_" + name)

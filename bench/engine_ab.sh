@@ -1,0 +1,63 @@
+#!/usr/bin/env bash
+# Issue 28's goal rows, the engine of one build against another's,
+# interleaved (one run of each per round, ROUNDS rounds), then the median
+# of each row: elastic at N = 10^4 (200 collisions per particle), 10^5 (20)
+# and 10^6 (5), phi 0.78 and 0.805; driven (eps 0.9) at 10^5 (20) and 10^6
+# (5), phi 0.78 and 0.80, with neighbour kick pairs and with pairs from the
+# whole system ("any"). Rates are per CPU second of the benchmark's thread:
+# collisions per second (elastic), collisions plus kicks per second
+# (driven). Each build keeps its compressed states in its own cache
+# (CACHE/old, CACHE/new); the first round prepares them. Prints one line
+# per run, then the table of medians with the ratios new / old and, for the
+# driven rows of the new build, neighbours / any.
+# Usage: bench/engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS=5] [CACHE=/tmp/dynhet-ab]
+set -euo pipefail
+old=${1:?usage: engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS] [CACHE]} new=${2:?usage: engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS] [CACHE]}
+rounds=${3:-5} cache=${4:-/tmp/dynhet-ab}
+for b in "$old" "$new"; do
+  [[ -x $b/bin/bench_engine ]] || { echo "engine_ab: no $b/bin/bench_engine (build first)" >&2; exit 2; }
+done
+[[ $rounds =~ ^[1-9][0-9]*$ ]] || { echo "engine_ab: ROUNDS must be a positive integer, not '$rounds'" >&2; exit 2; }
+mkdir -p "$cache/old" "$cache/new"
+out=$(mktemp)
+trap 'rm -f "$out"' EXIT
+# row: label N phi coll mode (elastic | neighbours | any)
+rows=("elastic 10000 0.78 200" "elastic 10000 0.805 200" "elastic 100000 0.78 20" "elastic 100000 0.805 20"
+      "elastic 1000000 0.78 5" "elastic 1000000 0.805 5"
+      "neighbours 100000 0.78 20" "neighbours 100000 0.80 20" "any 100000 0.78 20" "any 100000 0.80 20"
+      "neighbours 1000000 0.78 5" "neighbours 1000000 0.80 5" "any 1000000 0.78 5" "any 1000000 0.80 5")
+run() { # which build mode N phi coll
+  local a=(--n "$4" --phi "$5" --coll "$6" --sync 10 --tile-from 10000 --cache "$cache/$1")
+  case $3 in
+  elastic) ;;
+  neighbours) a+=(--eps 0.9 --driven --pairs neighbours) ;;
+  any) a+=(--eps 0.9 --driven --pairs any) ;;
+  esac
+  # columns: N phi prep_s coll/s kicks/s c+k/s ...
+  "$2/bin/bench_engine" "${a[@]}" 2>&1 | tail -1 | awk -v w="$1" -v m="$3" '{print w, m, $1, $2, ($5 == 0 ? $4 : $6)}'
+}
+for ((r = 1; r <= rounds; ++r)); do
+  for row in "${rows[@]}"; do
+    read -r mode n phi coll <<<"$row"
+    for w in old new; do
+      b=$old; [[ $w == new ]] && b=$new
+      line=$(run "$w" "$b" "$mode" "$n" "$phi" "$coll")
+      echo "round $r: $line"
+      echo "$line" >>"$out"
+    done
+  done
+done
+echo
+echo "| model | N | phi | old (median) | new (median) | new / old | runs each |"
+echo "|---|---|---|---|---|---|---|"
+awk '{ k = $2 " " $3 " " $4; v[k, $1, ++n[k, $1]] = $5; keys[k] = 1 }
+  function median(k, w,   m, i, j, t, a) {
+    m = n[k, w]; for (i = 1; i <= m; ++i) a[i] = v[k, w, i]
+    for (i = 1; i <= m; ++i) for (j = i + 1; j <= m; ++j) if (a[j] < a[i]) { t = a[i]; a[i] = a[j]; a[j] = t }
+    return m % 2 ? a[(m + 1) / 2] : 0.5 * (a[m / 2] + a[m / 2 + 1])
+  }
+  END { for (k in keys) { split(k, f, " "); o = median(k, "old"); w = median(k, "new")
+          printf "| %s | %d | %s | %.3g | %.3g | %.2f | %d |\n", f[1], f[2], f[3], o, w, w / o, n[k, "new"]
+          med[f[1], f[2], f[3]] = w }
+        for (k in keys) { split(k, f, " "); if (f[1] == "neighbours" && (("any", f[2], f[3]) in med))
+          printf "neighbours / any, new build, N = %d, phi = %s: %.2f\n", f[2], f[3], med[k] / med["any", f[2], f[3]] } }' "$out" | sort -t'|' -k2,2 -k3,3n
