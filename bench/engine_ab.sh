@@ -6,19 +6,20 @@
 # (5), phi 0.78 and 0.80, with neighbour kick pairs and with pairs from the
 # whole system ("any"). Rates are per CPU second of the benchmark's thread:
 # collisions per second (elastic), collisions plus kicks per second
-# (driven). Each build keeps its compressed states in its own cache
-# (CACHE/old, CACHE/new); the first round prepares them. Prints one line
+# (driven). Both builds start from the same compressed (and, driven,
+# relaxed) states, kept in CACHE by whichever runs first (the first round
+# prepares them, untimed). Prints one line
 # per run, then the table of medians with the ratios new / old and, for the
 # driven rows of the new build, neighbours / any.
-# Usage: bench/engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS=5] [CACHE=/tmp/dynhet-ab]
+# Usage: bench/engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS=5] [CACHE=/tmp/dynhet-bench]
 set -euo pipefail
 old=${1:?usage: engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS] [CACHE]} new=${2:?usage: engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS] [CACHE]}
-rounds=${3:-5} cache=${4:-/tmp/dynhet-ab}
+rounds=${3:-5} cache=${4:-/tmp/dynhet-bench}
 for b in "$old" "$new"; do
   [[ -x $b/bin/bench_engine ]] || { echo "engine_ab: no $b/bin/bench_engine (build first)" >&2; exit 2; }
 done
 [[ $rounds =~ ^[1-9][0-9]*$ ]] || { echo "engine_ab: ROUNDS must be a positive integer, not '$rounds'" >&2; exit 2; }
-mkdir -p "$cache/old" "$cache/new"
+mkdir -p "$cache"
 out=$(mktemp)
 trap 'rm -f "$out"' EXIT
 # row: label N phi coll mode (elastic | neighbours | any)
@@ -27,7 +28,7 @@ rows=("elastic 10000 0.78 200" "elastic 10000 0.805 200" "elastic 100000 0.78 20
       "neighbours 100000 0.78 20" "neighbours 100000 0.80 20" "any 100000 0.78 20" "any 100000 0.80 20"
       "neighbours 1000000 0.78 5" "neighbours 1000000 0.80 5" "any 1000000 0.78 5" "any 1000000 0.80 5")
 run() { # which build mode N phi coll
-  local a=(--n "$4" --phi "$5" --coll "$6" --sync 10 --tile-from 10000 --cache "$cache/$1")
+  local a=(--n "$4" --phi "$5" --coll "$6" --sync 10 --tile-from 10000 --cache "$cache")
   case $3 in
   elastic) ;;
   neighbours) a+=(--eps 0.9 --driven --pairs neighbours) ;;

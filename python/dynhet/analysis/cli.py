@@ -57,6 +57,9 @@ def main(argv=None):
     ap.add_argument("--also", action="append", default=[], metavar="STUDY_DIR",
                     help="another study whose runs add points: tau_alpha against N where it ran other N, and the "
                          "cutoff figure from whichever study's lags reach furthest")
+    ap.add_argument("--largest-n", action="store_true",
+                    help="at each density of the study, take the point of the largest N over it and the --also "
+                         "studies for every row and fit (the table says which N each density has)")
     ap.add_argument("--restate", metavar="OLD_TABLE",
                     help="an earlier reproduction.md: append, for each row it judged \"differs\", the verdict now")
     a = ap.parse_args(argv)
@@ -64,6 +67,12 @@ def main(argv=None):
         raise SystemExit(f"analyse_study: --restate {a.restate}: no such file")
     t0 = time.time()
     A = Analysis(a.study_dir, a.also)
+    if a.largest_n:
+        if not a.also:
+            raise SystemExit("analyse_study: --largest-n takes the largest N over the --also studies: give at least one")
+        say("analyse_study: largest N: " + (", ".join(f"φ {p.phi:g} ({p.pairs}, ε {p.eps:g}): N = {p.N} from "
+                                                       f"{p.study} ({len(p.runs)} seed{'s' if len(p.runs) > 1 else ''})"
+                                                       for p in A.promote_largest_n()) or "no --also study has a larger N"))
     if not A.points:
         raise SystemExit(f"analyse_study: no complete run with a = {A_MAIN} in {a.study_dir}"
                          + (f" ({len(A.skipped)} left out: {A.skipped[0][0]}: {A.skipped[0][1]}, ...)" if A.skipped else ""))

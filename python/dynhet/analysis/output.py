@@ -23,7 +23,7 @@ def write_h5(A, path):
             g = pg.create_group(f"{p.pairs}_eps{p.eps:g}_phi{p.phi:g}_n{p.N}")
             g.attrs.update(pairs=p.pairs, restitution=p.eps, packing_fraction=p.phi, n_particles=p.N,
                            seeds=np.array([r["seed"] for r in p.runs]), runs=",".join(r["name"] for r in p.runs),
-                           cpu_s=A.cpu.get(key, 0.0))
+                           cpu_s=A.cpu_of([p]))
             for name, fn in PER_RUN.items():
                 vals = p.values(fn)
                 m, e, sem, n = p.mean(fn)
@@ -96,6 +96,12 @@ def write_table(A, path, command, discussion=None, restate_from=None):
          "the seed mean where no run quotes one. \"agrees\" means within 2 of our standard errors; a row "
          "marked \"differs\" is discussed below the table. CPU is that of the runs behind the row.", ""]
     L += calibration_lines(A)
+    if getattr(A, "promoted", None):
+        L += ["**At the largest N** (`--largest-n`): at these densities every row and fit takes the point of the "
+              "largest N over the studies, not this study's own: "
+              + "; ".join(f"φ = {p.phi:g} ({p.pairs}, ε = {p.eps:g}): N = {p.N}, study {p.study}, "
+                          f"{len(p.runs)} seed{'s' if len(p.runs) > 1 else ''}" for p in A.promoted)
+              + ". The other densities are this study's.", ""]
     if A.skipped:
         L += [f"Left out: {len(A.skipped)} runs not complete ({', '.join(sorted({s for _, s in A.skipped}))}).", ""]
     L += ["| result | paper (section, figure) | paper | ours | verdict | figure | CPU |", "|---|---|---|---|---|---|---|"]

@@ -86,6 +86,33 @@ class Analysis:
                         self.pilot_cpu += float(tomllib.load(fh).get("cpu_s", 0.0))
         self.study_name = getattr(self, "study_name", study)
 
+    def promote_largest_n(self):
+        """Issue 27, item 3: at each (pairs, eps, phi) of this study, the point
+        of the largest N over this study and the --also studies whose runs
+        measured everything this study's point measured joins this study's
+        points, so that every series (and so every row and fit) takes it in
+        place of this study's own; other studies' densities are not added.
+        Returns the promoted points (also in self.promoted)."""
+        def measured(p):
+            return set.intersection(*[set(r["cut"].get(A_MAIN, {})) | set(r) for r in p.runs]) if p.runs else set()
+        best = {}
+        for k, p in self.extra.items():
+            key = k[1:4]
+            own = [q for pk, q in self.points.items() if pk[:3] == key]
+            if not own:
+                continue
+            top = max(own, key=lambda q: q.N)
+            if p.N <= top.N or not measured(top) <= measured(p):
+                continue
+            q = best.get(key)
+            if q is None or p.N > q.N or (p.N == q.N and len(p.runs) > len(q.runs)):
+                best[key] = p
+        self.promoted = []
+        for key, p in sorted(best.items()):
+            self.points[key + (p.N,)] = p
+            self.promoted.append(p)
+        return self.promoted
+
     # -- selections
     def series(self, pairs="neighbours", eps=EPS_MAIN, N=None):
         """The points of one (pairs, eps) series, one per density: at a density

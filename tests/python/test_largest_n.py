@@ -1,0 +1,54 @@
+"""Analysis.promote_largest_n (analyse_study --largest-n, issue 27 item 3):
+at each density of the study the point of the largest N over the --also
+studies takes the place of the study's own in every series; densities the
+study does not have are not added."""
+from dynhet.analysis.points import Point
+from dynhet.analysis.study import Analysis
+
+
+def point(phi, n, seeds, study=None):
+    p = Point(("neighbours", 0.9, phi, n))
+    if study:
+        p.study = study
+    p.runs = [{"seed": s, "cut": {0.6: {"tau_alpha": 10.0 * phi + n / 1e5}}} for s in seeds]
+    return p
+
+
+def analysis():
+    A = Analysis.__new__(Analysis)
+    A.points, A.extra, A.cpu = {}, {}, {}
+    for phi in (0.70, 0.78):
+        p = point(phi, 4096, (1, 2, 3))
+        A.points[p.pairs, p.eps, p.phi, p.N] = p
+    for phi, n, seeds, study in ((0.78, 16384, (1, 2), "fs"), (0.78, 65536, (1,), "scale"),
+                                 (0.78, 65536, (1, 2), "scale2"), (0.80, 65536, (1, 2), "scale")):
+        p = point(phi, n, seeds, study)
+        A.extra[(study,) + (p.pairs, p.eps, p.phi, p.N)] = p
+    return A
+
+
+def test_the_largest_n_at_each_of_the_studys_densities():
+    A = analysis()
+    promoted = A.promote_largest_n()
+    assert [(p.phi, p.N, p.study) for p in promoted] == [(0.78, 65536, "scale2")]  # the most seeds of the largest N
+    s = A.series()
+    assert [(p.phi, p.N) for p in s] == [(0.70, 4096), (0.78, 65536)]             # no 0.80: not this study's
+    assert A.cpu_of(s) == 0.0
+
+
+def test_nothing_larger_nothing_promoted():
+    A = analysis()
+    A.extra = {k: v for k, v in A.extra.items() if v.N <= 4096}
+    assert A.promote_largest_n() == [] and [p.N for p in A.series()] == [4096, 4096]
+
+
+def test_a_larger_n_that_did_not_measure_everything_is_not_taken():
+    A = analysis()
+    for p in A.points.values():
+        for r in p.runs:
+            r["cut"][0.6]["chi4"] = [1.0]               # this study measured chi4 ...
+    for k, p in A.extra.items():
+        if p.N == 16384:
+            for r in p.runs:
+                r["cut"][0.6]["chi4"] = [1.0]           # ... and so did the N = 16384 runs, not the N = 65536 ones
+    assert [(p.phi, p.N, p.study) for p in A.promote_largest_n()] == [(0.78, 16384, "fs")]
