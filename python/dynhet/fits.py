@@ -25,7 +25,7 @@ from scipy import odr
 from scipy.optimize import least_squares
 
 
-MIN_JK_SEEDS = 3   # below this a jackknife over seeds is not taken alone (Fit.error)
+MIN_JK_SEEDS = 4   # below this a jackknife over seeds is not taken alone (Fit.error)
 
 
 class Fit:
@@ -52,9 +52,9 @@ class Fit:
         fit's own; where the form misses the points (chi2/dof > 1) at least
         the fit's own error times sqrt(chi2/dof) (the Birge ratio), since
         seeds that all share the misfit agree with each other. A jackknife
-        over fewer than MIN_JK_SEEDS seeds (one dof: its size is itself
-        uncertain by a factor of several) is not taken alone: the larger of it
-        and the fit's own error."""
+        over fewer than MIN_JK_SEEDS seeds (one or two dof: its size is itself
+        uncertain by a factor of two or more) is not taken alone: the larger of
+        it and the fit's own error."""
         e = self.jk.get(name, math.nan)
         e = e if np.isfinite(e) else self.err[name]
         if self.jk_seeds < MIN_JK_SEEDS and np.isfinite(self.err[name]):

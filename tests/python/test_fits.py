@@ -57,7 +57,8 @@ def test_jackknife_over_identical_seeds_has_no_spread():
 
 def test_a_jackknife_over_two_seeds_is_not_taken_alone():
     # Two seeds whose fits agree by chance: one dof says nothing about the
-    # error, so the fit's own error stands; with three seeds the jackknife does.
+    # error, so the fit's own error stands (three seeds too: two dof); with
+    # four the jackknife does.
     x = np.geomspace(1, 50, 8)
     rng = np.random.default_rng(7)
     y = 2 * x * np.exp(rng.normal(0, 0.1, len(x)))
@@ -65,8 +66,10 @@ def test_a_jackknife_over_two_seeds_is_not_taken_alone():
     assert two.jk["s"] < 1e-12 and two.jk_seeds == 2
     assert two.error("s") >= two.err["s"] > 0.01
     three = sf.jackknife_over_seeds(lambda drop: sf.power(x, y, 0.1 * y), [1, 2, 3])
-    assert three.jk_seeds == 3 and three.error("s") < 1e-12  # chi2/dof below 1 here: no Birge inflation
-    assert three.chi2_dof() < 1
+    assert three.jk_seeds == 3 and three.error("s") >= three.err["s"]
+    four = sf.jackknife_over_seeds(lambda drop: sf.power(x, y, 0.1 * y), [1, 2, 3, 4])
+    assert four.jk_seeds == 4 and four.error("s") < 1e-12  # chi2/dof below 1 here: no Birge inflation
+    assert four.chi2_dof() < 1
 
 
 def test_no_verdict_from_a_fit_whose_error_exceeds_its_value():

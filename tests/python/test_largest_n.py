@@ -33,7 +33,8 @@ def test_the_largest_n_at_each_of_the_studys_densities():
     assert [(p.phi, p.N, p.study) for p in promoted] == [(0.78, 65536, "scale2")]  # the most seeds of the largest N
     s = A.series()
     assert [(p.phi, p.N) for p in s] == [(0.70, 4096), (0.78, 65536)]             # no 0.80: not this study's
-    assert A.cpu_of(s) == 0.0
+    A.cpu = {("scale2", "neighbours", 0.9, 0.78, 65536): 7.0, ("neighbours", 0.9, 0.78, 4096): 100.0}
+    assert A.cpu_of(s) == 7.0  # the promoted point's own CPU, not the study's point's it replaced
 
 
 def test_nothing_larger_nothing_promoted():
@@ -52,3 +53,23 @@ def test_a_larger_n_that_did_not_measure_everything_is_not_taken():
             for r in p.runs:
                 r["cut"][0.6]["chi4"] = [1.0]           # ... and so did the N = 16384 runs, not the N = 65536 ones
     assert [(p.phi, p.N, p.study) for p in A.promote_largest_n()] == [(0.78, 16384, "fs")]
+
+
+def test_a_promoted_point_is_one_point_in_the_cutoff_candidates_and_the_cage_relative_view():
+    from dynhet.analysis.points import ensure_calibrated
+    A = analysis()
+    A.study_name, A.rows, A.fits = "quick", [], {}
+    for p in list(A.points.values()) + list(A.extra.values()):
+        for r in p.runs:
+            r["cut_cr"] = {0.6: {"tau_alpha": 3 * r["cut"][0.6]["tau_alpha"], "tau_alpha_err": 0.1}}
+            r["cut"][0.6]["tau_alpha_err"] = 0.1
+    ensure_calibrated(list(A.points.values()) + list(A.extra.values()))
+    big = A.promote_largest_n()[0]
+    C = A.cage_relative_view()
+    copies = [p for p in list(C.points.values()) + list(C.extra.values()) if p.N == big.N and p.phi == big.phi
+              and getattr(p, "study", None) == big.study]
+    assert len({id(p) for p in copies}) == 1 and C.promoted == [copies[0]]
+    pop = copies[0].population
+    assert sum(1 for p in pop.points if p is copies[0]) == 1
+    assert sum(len(p.runs) for p in pop.parent.points) == sum(
+        len(p.runs) for p in {id(p): p for p in list(A.points.values()) + list(A.extra.values())}.values())

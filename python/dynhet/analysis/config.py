@@ -3,11 +3,17 @@
 CONVENTIONS = """(docs/analysis.md, "Study analysis"):
 - A point is (driving.pairs, restitution, packing fraction, N); its value is
   the mean over seeds, its error the standard error of that mean from the
-  runs' own quoted errors (checked against the spread of seeds in
-  bench/seed_spread.py); the seeds' own spread is recorded beside it.
+  runs' own quoted errors, times the study's factor for that quantity
+  (points.calibration: the seeds' spread over the quoted errors pooled over
+  the study's points, where that ratio has at least 10 dof and lies more
+  than 2 sigma above 1; a study with fewer dof takes the ratio pooled over
+  every study analysed with it); where no run quotes an error, the seeds'
+  standard error. The seeds' own spread is recorded beside it.
 - Cross-run fits are weighted by those errors and quoted with the
   jackknife error over seeds (each seed left out of every point in turn);
-  their chi2/dof and range are recorded.
+  with fewer than 4 seeds at least the fit's own error, and where
+  chi2/dof > 1 at least the fit's own error times sqrt(chi2/dof); their
+  chi2/dof and range are recorded.
 - "At tau_alpha" means at the run's own tau_alpha (a = 0.6, the overlap
   node's): chi4, S4, xi and chi0 are interpolated linearly in ln t between
   the two computed lags around it; the interpolation error (against a

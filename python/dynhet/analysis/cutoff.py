@@ -17,6 +17,7 @@ def cutoff_results(A):
     # the study (this one or an --also one) whose lags reach furthest in tau_alpha(0.6), all its densities
     cands = [p for p in A.series() + [q for q in A.extra.values() if q.pairs == "neighbours" and abs(q.eps - EPS_MAIN) < 1e-9]
              if len(p.runs[0]["cut"]) > 1]
+    cands = list({id(p): p for p in cands}.values())  # a point promoted by --largest-n is in both
     reach = lambda p: cut(p.runs[0])["lag"][-1] / max(cut(p.runs[0])["tau_alpha"], 1e-300)
     by_study = {}
     for p in cands:

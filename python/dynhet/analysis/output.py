@@ -41,7 +41,8 @@ def write_h5(A, path):
             h = fg.create_group(name)
             h.attrs.update(form=fit.form, chi2=fit.chi2, dof=fit.dof, n_points=fit.n, x_min=fit.x_range[0],
                            x_max=fit.x_range[1], note=fit.note or "",
-                           error_from="jackknife over seeds (err_fit: the fit's own covariance)")
+                           error_from="jackknife over seeds; with fewer than 4 seeds at least err_fit, and where "
+                                      "chi2/dof > 1 at least err_fit * sqrt(chi2/dof) (err_fit: the fit's own covariance)")
             for n_ in fit.names:
                 h.attrs[n_] = fit.p[n_]
                 h.attrs[n_ + "_err"] = fit.error(n_)
@@ -57,23 +58,31 @@ def write_h5(A, path):
 
 
 def calibration_lines(A):
-    """The study's quoted errors against its seeds' spread, per quantity
-    (points.calibration over its own points): the factor its per-point errors
-    take."""
-    pop = next((p.population for p in A.points.values() if p.population is not None), None)
-    if pop is None:
+    """Each study's quoted errors against its seeds' spread, per quantity
+    (points.calibration): the factor its per-point errors take. The study's
+    own points first, then those --largest-n took from other studies."""
+    pops = []
+    for p in list(A.points.values()):
+        if p.population is not None and all(p.population is not q for q in pops):
+            pops.append(p.population)
+    out = []
+    for pop in pops:
+        cells = []
+        for name, fn in PER_RUN.items():
+            k, r, u, dof = pop.calibration(fn)
+            borrowed = pop.parent is not None and pop.own(fn)[3] < MIN_CAL_DOF
+            if dof:
+                cells.append(f"{name} {r:.2f} ± {u:.2f} ({dof} dof{', all studies' if borrowed else ''})"
+                             + (f" → × {k:.2f}" if k != 1.0 else ""))
+        if cells:
+            out.append(f"study {pop.name or A.study_name}: " + "; ".join(cells))
+    if not out:
         return []
-    cells = []
-    for name, fn in PER_RUN.items():
-        k, r, u, dof = pop.calibration(fn)
-        if dof:
-            cells.append(f"{name} {r:.2f} ± {u:.2f} ({dof} dof)" + (f" → × {k:.2f}" if k != 1.0 else ""))
-    if not cells:
-        return []
-    return ["The seeds' spread over the errors the runs quote, pooled over this study's points (`points.calibration`; "
-            "about 1 where the quoted errors are honest), and the factor (→) by which a quantity's quoted errors are "
-            f"scaled where that ratio has at least {MIN_CAL_DOF} dof and lies more than 2 of its uncertainties "
-            "above 1: " + "; ".join(cells) + ".", ""]
+    return ["The seeds' spread over the errors the runs quote, pooled over each study's points (`points.calibration`; "
+            "about 1 where the quoted errors are honest; \"all studies\": the study has fewer than "
+            f"{MIN_CAL_DOF} dof of its own and takes the ratio pooled over every study analysed with it), and the "
+            "factor (→) by which a quantity's quoted errors are scaled where that ratio has at least "
+            f"{MIN_CAL_DOF} dof and lies more than 2 of its uncertainties above 1. " + ". ".join(out) + ".", ""]
 
 
 def hms(s):
@@ -90,7 +99,8 @@ def write_table(A, path, command, discussion=None, restate_from=None):
          f"{n_runs} complete runs, {hms(total)} of CPU in the runs and {hms(A.pilot_cpu)} in the pilots.",
          "", f"Command: `{command}`", "",
          "The paper: Avila, Castillo, Vollmayr-Lee, Zippelius, *Dynamical heterogeneities in a driven granular "
-         "fluid* (`../shared/paper/`), section 3. Errors: jackknife over seeds for every cross-run fit; for "
+         "fluid* (`../shared/paper/`), section 3. Errors: jackknife over seeds for every cross-run fit (with fewer than "
+         "4 seeds, or where χ²/dof > 1, at least the fit's own error, the latter times sqrt(χ²/dof)); for "
          "per-point values the runs' own errors combined (jackknife over origin blocks), scaled to the seeds' "
          "spread where the study's seeds scatter more than those errors say (below), or the standard error of "
          "the seed mean where no run quotes one. \"agrees\" means within 2 of our standard errors; a row "

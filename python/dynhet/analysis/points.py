@@ -50,10 +50,12 @@ def calibration(points, fn):
 
 def fn_key(fn):
     """A per-run function's identity for the calibration cache: its code, its
-    defaults and what its closure holds (None where those are not hashable:
-    then the factor is computed at every call)."""
+    defaults (keyword-only too), what its closure holds and, for a bound
+    method, its object (None where those are not hashable: then the factor
+    is computed at every call)."""
     try:
-        key = (fn.__code__, fn.__defaults__, tuple(c.cell_contents for c in (fn.__closure__ or ())))
+        key = (fn.__code__, fn.__defaults__, tuple(sorted((fn.__kwdefaults__ or {}).items())),
+               tuple(c.cell_contents for c in (fn.__closure__ or ())), getattr(fn, "__self__", None))
         hash(key)
         return key
     except (AttributeError, TypeError, ValueError):
@@ -89,7 +91,7 @@ def ensure_calibrated(points):
     """Give every point without a population the one of its study (points
     grouped by their .study, the primary study's having none), with all of
     them together as the parent. Returns the populations made."""
-    points = [p for p in points if p.population is None]
+    points = list({id(p): p for p in points if p.population is None}.values())
     if not points:
         return []
     parent = Population(points, "all studies")

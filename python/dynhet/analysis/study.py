@@ -44,6 +44,7 @@ class Analysis:
         for k, sd in enumerate([d] + list(also)):
             self.read_study(sd, primary=(k == 0))
         ensure_calibrated(list(self.points.values()) + list(self.extra.values()))
+        self.promoted = []
         self.fits = {}
         self.rows = []
         self.figdir = os.path.join(self.dir, "figures")  # made by the first figure saved
@@ -186,19 +187,26 @@ class CageRelativeView(Analysis):
         self.__dict__.update(base.__dict__)
         self.base = base
 
+        copies = {}  # one copy per point (a point promoted by --largest-n is in both dicts)
+
         def swapped(points):
             out = {}
             for k, p in points.items():
-                runs = [dict(r, cut=r["cut_cr"]) for r in p.runs if A_MAIN in r.get("cut_cr", {})]
-                if runs:
-                    q = Point((p.pairs, p.eps, p.phi, p.N))
-                    q.runs = runs
-                    if hasattr(p, "study"):
-                        q.study = p.study
-                    out[k] = q
+                if id(p) not in copies:
+                    runs = [dict(r, cut=r["cut_cr"]) for r in p.runs if A_MAIN in r.get("cut_cr", {})]
+                    q = None
+                    if runs:
+                        q = Point((p.pairs, p.eps, p.phi, p.N))
+                        q.runs = runs
+                        if hasattr(p, "study"):
+                            q.study = p.study
+                    copies[id(p)] = q
+                if copies[id(p)] is not None:
+                    out[k] = copies[id(p)]
             return out
         self.points, self.extra = swapped(base.points), swapped(base.extra)
-        ensure_calibrated(list(self.points.values()) + list(self.extra.values()))
+        self.promoted = [copies[id(p)] for p in getattr(base, "promoted", []) if copies.get(id(p)) is not None]
+        ensure_calibrated(list({id(p): p for p in list(self.points.values()) + list(self.extra.values())}.values()))
 
     def save(self, fig, name):
         return self.base.save(fig, "cr_" + name)
