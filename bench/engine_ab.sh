@@ -12,7 +12,27 @@
 # per run, then the table of medians with the ratios new / old and, for the
 # driven rows of the new build, neighbours / any.
 # Usage: bench/engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS=5] [CACHE=/tmp/dynhet-bench]
+#        bench/engine_ab.sh --table RUNS_FILE   (the table again from a run's file of runs)
 set -euo pipefail
+table() { # the medians of a file of runs "build mode N phi rate"
+  echo
+  echo "| model | N | phi | old (median) | new (median) | new / old | runs each |"
+  echo "|---|---|---|---|---|---|---|"
+  awk '{ k = $2 " " $3 " " $4; v[k, $1, ++n[k, $1]] = $5; keys[k] = 1 }
+    function median(k, w,   m, i, j, t, a) {
+      m = n[k, w]; for (i = 1; i <= m; ++i) a[i] = v[k, w, i]
+      for (i = 1; i <= m; ++i) for (j = i + 1; j <= m; ++j) if (a[j] < a[i]) { t = a[i]; a[i] = a[j]; a[j] = t }
+      return m % 2 ? a[(m + 1) / 2] : 0.5 * (a[m / 2] + a[m / 2 + 1])
+    }
+    END { for (k in keys) { split(k, f, " "); o = median(k, "old"); w = median(k, "new")
+            printf "| %s | %d | %s | %.3g | %.3g | %.2f | %d |\n", f[1], f[2], f[3], o, w, w / o, n[k, "new"]
+            med[f[1] " " f[2] " " f[3]] = w }
+          for (k in keys) { split(k, f, " "); a = "any " f[2] " " f[3]
+            if (f[1] == "neighbours" && (a in med))
+              printf "~neighbours / any, new build, N = %d, phi = %s: %.2f\n", f[2], f[3], med[k] / med[a] } }' "$1" |
+    LC_ALL=C sort | sed "s/^~//"
+}
+if [[ ${1:-} == --table ]]; then table "${2:?usage: engine_ab.sh --table RUNS_FILE}"; exit 0; fi
 old=${1:?usage: engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS] [CACHE]} new=${2:?usage: engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS] [CACHE]}
 rounds=${3:-5} cache=${4:-/tmp/dynhet-bench}
 for b in "$old" "$new"; do
@@ -20,8 +40,8 @@ for b in "$old" "$new"; do
 done
 [[ $rounds =~ ^[1-9][0-9]*$ ]] || { echo "engine_ab: ROUNDS must be a positive integer, not '$rounds'" >&2; exit 2; }
 mkdir -p "$cache"
-out=$(mktemp)
-trap 'rm -f "$out"' EXIT
+out=$cache/engine_ab.$$.txt  # the runs, kept: bench/engine_ab.sh --table FILE prints the table again
+: >"$out"
 # row: label N phi coll mode (elastic | neighbours | any)
 rows=("elastic 10000 0.78 200" "elastic 10000 0.805 200" "elastic 100000 0.78 20" "elastic 100000 0.805 20"
       "elastic 1000000 0.78 5" "elastic 1000000 0.805 5"
@@ -48,17 +68,5 @@ for ((r = 1; r <= rounds; ++r)); do
     done
   done
 done
-echo
-echo "| model | N | phi | old (median) | new (median) | new / old | runs each |"
-echo "|---|---|---|---|---|---|---|"
-awk '{ k = $2 " " $3 " " $4; v[k, $1, ++n[k, $1]] = $5; keys[k] = 1 }
-  function median(k, w,   m, i, j, t, a) {
-    m = n[k, w]; for (i = 1; i <= m; ++i) a[i] = v[k, w, i]
-    for (i = 1; i <= m; ++i) for (j = i + 1; j <= m; ++j) if (a[j] < a[i]) { t = a[i]; a[i] = a[j]; a[j] = t }
-    return m % 2 ? a[(m + 1) / 2] : 0.5 * (a[m / 2] + a[m / 2 + 1])
-  }
-  END { for (k in keys) { split(k, f, " "); o = median(k, "old"); w = median(k, "new")
-          printf "| %s | %d | %s | %.3g | %.3g | %.2f | %d |\n", f[1], f[2], f[3], o, w, w / o, n[k, "new"]
-          med[f[1], f[2], f[3]] = w }
-        for (k in keys) { split(k, f, " "); if (f[1] == "neighbours" && (("any", f[2], f[3]) in med))
-          printf "neighbours / any, new build, N = %d, phi = %s: %.2f\n", f[2], f[3], med[k] / med["any", f[2], f[3]] } }' "$out" | sort -t'|' -k2,2 -k3,3n
+table "$out"
+echo "(runs in $out)"

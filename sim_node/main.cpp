@@ -18,10 +18,11 @@
 #include <thread>
 #include <unistd.h>
 
-#include <CLI/CLI.hpp>
 #include <lcm/lcm-cpp.hpp>
 
 #include "checkpoint.hpp"
+#include "options.hpp"
+#include "frames.hpp"
 #include "pacer.hpp"
 #include "reporter.hpp"
 #include "cut_coordinator.hpp"
@@ -61,89 +62,19 @@ double seconds_since(Clock::time_point t0) {
 }
 
 
-dynhet::run_info_t make_run_info(const dynhet::Scene& sc, const dynhet::engine::Engine& e,
-                                 const dynhet::FrameSchedule& s, int64_t run_id) {
-  dynhet::run_info_t m{};
-  m.run_id = run_id;
-  m.n_particles = static_cast<int32_t>(e.size());
-  m.box_length = e.box_length();
-  m.packing_fraction = sc.packing_fraction;
-  m.restitution = sc.restitution;
-  for (int k = 0; k < 2; ++k) m.radius[k] = e.radius(k), m.mass[k] = e.mass(k);
-  m.n_small = static_cast<int32_t>(dynhet::small_count(e.size()));
-  m.frame_time = s.frame_time;
-  m.n_frames = static_cast<int32_t>(m.frame_time.size());
-  m.origin_frame = s.origin_frame;
-  m.n_origins = static_cast<int32_t>(m.origin_frame.size());
-  m.lag_time = s.lag_time;
-  m.n_lags = static_cast<int32_t>(m.lag_time.size());
-  m.pair_frame = s.pair_frame;
-  m.n_pairs = static_cast<int32_t>(m.pair_frame.size());
-  m.cutoff_a = sc.cutoff_a;
-  m.n_cutoffs = static_cast<int32_t>(m.cutoff_a.size());
-  m.observables = sc.computed_observables();
-  m.n_observables = static_cast<int32_t>(m.observables.size());
-  m.overlap_subbox_particles = sc.overlap_subbox_particles;
-  m.chi4_subbox_particles = sc.chi4_subbox_particles;
-  m.n_chi4_sizes = static_cast<int32_t>(m.chi4_subbox_particles.size());
-  m.keep_frames = sc.keep_frames;
-  m.chunk_particles = sc.chunk_particles;
-  m.scene_toml = sc.text;
-  return m;
-}
-
 } // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"dynhet sim_node: event-driven MD of a driven granular fluid, frames over LCM"};
-  std::string scene_path, url;
-  int64_t run_id = 0;
-  std::string checkpoint_path, resume_path, before_frames_path;
-  app.add_option("scene", scene_path, "scene file (TOML)");
-  app.add_option("--checkpoint", checkpoint_path, "write checkpoints (HDF5) to this file");
-  app.add_option("--resume", resume_path, "continue the run saved in this checkpoint");
-  app.add_option("--checkpoint-before-frames", before_frames_path,
-                 "also keep the last checkpoint taken before the first frame in this file (with --checkpoint): a "
-                 "run interrupted in production restarts from it with every frame still to come, so fresh "
-                 "analysis nodes see them all");
-  std::string prepare_path;
-  app.add_option("--prepare-only", prepare_path,
-                 "compress the scene's system, draw its velocities, write this prepared state (HDF5) and exit: "
-                 "runs of any restitution or driving that start from it (system.initial_state) equal the runs "
-                 "that compress themselves, bit for bit");
-  bool equilibrate = false;
-  app.add_flag("--equilibrate", equilibrate,
-               "with --prepare-only: also run the scene's dynamics to the last checkpoint slot within "
-               "run.equilibration_time (from the scene's initial_state if it has one) and write that state: "
-               "runs of the same dynamics from it equal the runs that equilibrate themselves, bit for bit");
-  app.add_option("--lcm-url", url, "LCM URL (default $LCM_DEFAULT_URL or " + std::string(dynhet::kDefaultLcmUrl) + ")");
-  app.add_option("--run-id", run_id, "run id (default: random)");
-  dynhet::BusOptions bus_options;
-  dynhet::add_bus_options(app, bus_options);
-  bool pace = false;
-  app.add_flag("--pace-nodes", pace,
-               "flow control: hold each frame until the scene's nodes, and the recorder when the scene keeps the "
-               "frames (their status on DYNHET_NODE_STATUS_<node>), have caught up to within a socket "
-               "buffer's worth of frames (run_scene.sh sets it)");
-  bool check = false;
-  app.add_flag("--check", check, "validate the scene, print what it needs (nodes, frames) and exit");
-  std::string cut_root;
-  int resume_cut = -1;
-  bool find_cut = false;
-  double cut_wait = 300, test_frame_delay = 0;
-  app.add_option("--test-frame-delay", test_frame_delay,
-                 "tests only: sleep this many seconds before each frame, a stand-in for a slow engine (large N)");
-  app.add_option("--checkpoint-dir", cut_root,
-                 "take checkpoint cuts of the whole pipeline in this folder (docs/checkpoints.md): at every "
-                 "run.checkpoint_interval (or run.checkpoint_wall_interval), and on SIGTERM/SIGINT before exiting");
-  app.add_option("--resume-cut", resume_cut, "resume the run from this whole cut of --checkpoint-dir (the scene's)");
-  app.add_flag("--find-cut", find_cut,
-               "print the newest whole cut of --checkpoint-dir that every part of reads back for this scene "
-               "(\"cut N frame K time T run_id R\"), each cut refused and why on stderr, and exit (1: none)");
-  app.add_option("--cut-wait", cut_wait,
-                 "on SIGTERM/SIGINT, wait at most this many seconds for every process to save its part of the last cut")
-      ->capture_default_str();
-  CLI11_PARSE(app, argc, argv);
+  dynhet::SimOptions o;
+  if (const int rc = dynhet::parse_sim_options(argc, argv, o); rc >= 0) return rc;
+  std::string &scene_path = o.scene_path, &url = o.url, &checkpoint_path = o.checkpoint_path,
+              &resume_path = o.resume_path, &before_frames_path = o.before_frames_path,
+              &prepare_path = o.prepare_path, &cut_root = o.cut_root;
+  int64_t& run_id = o.run_id;
+  const bool equilibrate = o.equilibrate, pace = o.pace, check = o.check, find_cut = o.find_cut;
+  const int resume_cut = o.resume_cut;
+  const double cut_wait = o.cut_wait, test_frame_delay = o.test_frame_delay;
+  const dynhet::BusOptions& bus_options = o.bus;
 
   if (scene_path.empty() == resume_path.empty()) {
     std::fprintf(stderr, "sim_node: give either a scene file or --resume CHECKPOINT\n");
@@ -275,7 +206,7 @@ int main(int argc, char** argv) {
     // run from the start and watch the sim's status instead of waiting blind.
     const dynhet::FrameSchedule sched = dynhet::make_schedule(scene.schedule, scene.equilibration_time);
     const double t_end = scene.equilibration_time + scene.production_time;
-    dynhet::run_info_t info = make_run_info(scene, eng, sched, run_id);
+    dynhet::run_info_t info = dynhet::make_run_info(scene, eng, sched, run_id);
     auto last_info = Clock::now();
     auto publish_info = [&] {
       info.utime = utime_now();
@@ -492,27 +423,7 @@ int main(int argc, char** argv) {
         throw std::runtime_error("overlap " + std::to_string(ov) + " of a contact distance at t=" +
                                  std::to_string(eng.time()));
 #endif
-      chunk.utime = utime_now();
-      chunk.frame_index = f;
-      chunk.time = sched.frame_time[f];
-      for (size_t c = 0; c < ranges.size(); ++c) {
-        chunk.chunk_index = static_cast<int32_t>(c);
-        chunk.first_particle = ranges[c].first;
-        chunk.count = ranges[c].count;
-        chunk.n_values = 2 * ranges[c].count;
-        chunk.position.assign(xy.begin() + 2 * ranges[c].first,
-                              xy.begin() + 2 * (ranges[c].first + ranges[c].count));
-        bus.publish(lcm, dynhet::kChanFrame, chunk);
-        // Pace multi-chunk frames so receivers' socket buffers keep up:
-        // 300 us after a chunk of up to 8192 particles (an unpaced
-        // lcm-logger keeps up with small chunks at that pace: at 5 us per
-        // 128-particle chunk it lost 4 of 56 frames), and in proportion
-        // beyond, about 440 MB/s (300 us per chunk whatever its size let 1
-        // MB chunks go out at 3 GB/s, and a receiver on a busy core lost
-        // datagrams at N = 10^6).
-        if (ranges.size() > 1)
-          std::this_thread::sleep_for(std::chrono::microseconds(300 * std::max(1, ranges[c].count / 8192)));
-      }
+      dynhet::publish_frame(lcm, bus, chunk, ranges, f, sched.frame_time[f], xy);
       publish_seconds += seconds_since(t_publish);
       bytes_published += 16.0 * static_cast<double>(eng.size());
       rep.msg().frames_published = next_frame = f + 1;
