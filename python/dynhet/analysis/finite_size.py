@@ -278,7 +278,8 @@ def write_finite_size(A, path, command):
          + ", ".join(f"`{os.path.relpath(s, os.path.dirname(os.path.abspath(path)))}`" for s in [A.dir] + A.also)
          + f". Command: `{command}`", "",
          f"Each cell: the mean over seeds with its error (the runs' own errors, jackknife over origin blocks, "
-         f"combined; the seeds' spread where no run quotes one; \"no error\" where one seed quotes none, and such a "
+         f"combined, times the study's factor below where its seeds scatter more; the seeds' spread where no run "
+         f"quotes one; \"no error\" where one seed quotes none, and such a "
          f"size takes no part in the verdict); ¹ one seed. A verdict is computed from the "
          f"numbers: **converged** from the smallest N whose value and every larger N's agree with the largest "
          f"N's within {Z_CONVERGED:g} combined errors; otherwise **drifting**, with the change per doubling of N "
