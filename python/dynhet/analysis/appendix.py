@@ -9,6 +9,13 @@ from .quantities import chi4_at_tau, cut, oz_fit, s4_at_tau, whole_box_s4
 from .plotting import errorbar
 
 
+def whole_box(r, key):
+    """(value, error) of a per-grid S4 result `key` for the run's whole box."""
+    c = cut(r)
+    g = whole_box_s4(c)
+    return c[key][g], c[key + "_err"][g]
+
+
 def appendix_results(A):
     """chi0 of the whole box's S4 fits (fit 2: OZ, fit 3: with A^2; the finest
     q) against chi4 of the same whole box (N var(Q) over origins, the s4
@@ -26,10 +33,12 @@ def appendix_results(A):
         c = cut(p.runs[0])
         gw = whole_box_s4(c)
         x.append(p.phi)
-        c4.append(p.mean(lambda r: (cut(r)["s4_chi4"][gw], cut(r)["s4_chi4_err"][gw])))
+        # each run's own whole box (the factor of points.calibration pools
+        # these functions over a study whose points may have other grids)
+        c4.append(p.mean(lambda r: whole_box(r, "s4_chi4")))
         c4s.append(p.mean(lambda r: chi4_at_tau(r)))
-        oz.append(p.mean(lambda r: (cut(r)["s4_oz_chi0"][gw], cut(r)["s4_oz_chi0_err"][gw])))
-        a2.append(p.mean(lambda r: (cut(r)["s4_a2_chi0"][gw], cut(r)["s4_a2_chi0_err"][gw])))
+        oz.append(p.mean(lambda r: whole_box(r, "s4_oz_chi0")))
+        a2.append(p.mean(lambda r: whole_box(r, "s4_a2_chi0")))
         row = []
         per_run = [(s4_at_tau(r, A_MAIN, gw), cut(r)["s4_chi4"][gw]) for r in p.runs]  # once, for every q_m
         for qm in qms:
