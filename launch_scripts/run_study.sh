@@ -15,8 +15,9 @@
 #   --dry-run          print every run with its times, estimated CPU time and
 #                      memory, and the totals; start nothing
 #   --no-build         skip setup.sh (packages and build)
-# The study directory holds study.toml (a copy; a changed study file is
-# refused), runs/<run>/{scene.toml,status.toml,run.h5,logs}, pilots/ and
+# The study directory holds study.toml (a copy; a study file that now says
+# something else is refused, one whose comments or spacing changed is
+# not), runs/<run>/{scene.toml,status.toml,run.h5,logs}, pilots/ and
 # index.toml, which the analysis reads.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)

@@ -90,3 +90,14 @@ def test_the_dry_run_scales_its_estimate_by_what_complete_runs_cost():
     assert ratios == {1024: 1.5, 4096: 1.1}
     assert abs(overall - 170.0 / 140.0) < 1e-12
     assert measured_ratio([]) == ({}, None)
+
+
+def test_a_study_dir_takes_the_same_study_with_other_comments_and_refuses_another(tmp_path):
+    from dynhet.study.rundir import StudyDir
+    out = tmp_path / "out"
+    StudyDir(study(tmp_path, GOOD), str(out)).claim()
+    # comments and spacing are not the study: the same directory resumes it
+    StudyDir(study(tmp_path, "# a note on the cost\n" + GOOD.replace("seed = [1, 2]", "seed = [1,  2]  # two")),
+             str(out)).claim()
+    with pytest.raises(StudyError, match="differs from the study"):
+        StudyDir(study(tmp_path, GOOD.replace("seed = [1, 2]", "seed = [1, 2, 3]")), str(out)).claim()

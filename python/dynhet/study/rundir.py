@@ -40,6 +40,17 @@ def run_h5_result(path, cutoff, group="overlap"):
     return int(c), float(t)
 
 
+def same_toml(a, b):
+    """Whether two TOML texts (bytes) say the same: equal, or equal once
+    parsed (comments, spacing and order of keys are not the study)."""
+    if a == b:
+        return True
+    try:
+        return tomllib.loads(a.decode()) == tomllib.loads(b.decode())
+    except (UnicodeDecodeError, tomllib.TOMLDecodeError):
+        return False
+
+
 class StudyDir:
     def __init__(self, study, out):
         self.study = study
@@ -54,7 +65,7 @@ class StudyDir:
         base_path = os.path.join(self.dir, "base_scene.toml")
         base_text = toml_dump(self.study.base, "# the study's base scene, as read when the study started")
         if os.path.exists(copy_path):
-            if open(copy_path, "rb").read() != self.study.text:
+            if not same_toml(open(copy_path, "rb").read(), self.study.text):
                 raise StudyError(f"{self.study.path} differs from the study that {self.dir} holds "
                                  f"({copy_path}): a changed study is never mixed into old runs; "
                                  "give another --out, or restore the study file")
