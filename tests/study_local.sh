@@ -79,7 +79,12 @@ kill -TERM "$runner"
 wait "$runner" && rc=0 || rc=$?
 check '[[ $rc == 130 ]]' "stopped study exits 130 (got $rc)"
 check 'grep -qs "state = \"interrupted\"" "$tmp"/b/runs/*/status.toml' "the stopped run is marked interrupted"
+stopped=$(grep -ls "state = \"interrupted\"" "$tmp"/b/runs/*/status.toml | head -1)
+cpu_before=$(sed -n 's/^cpu_s = //p' "$stopped")
 "${study[@]}" "$root/studies/tiny.toml" --out "$tmp/b" --jobs 2 >"$tmp/b2.out" 2>&1 || { cat "$tmp/b2.out"; exit 1; }
+cpu_after=$(sed -n 's/^cpu_s = //p' "$stopped") cpu_attempt=$(sed -n 's/^cpu_s_attempt = //p' "$stopped")
+check 'awk -v b="$cpu_before" -v a="$cpu_after" -v t="$cpu_attempt" "BEGIN { exit !(b > 0 && t > 0 && (a - b - t) ^ 2 < 1e-12) }"' \
+  "the resumed run's CPU is its two attempts' ($cpu_before + $cpu_attempt = $cpu_after s)"
 check 'grep -qE "was interrupted; resuming (mid-production from checkpoint cut [0-9]+|from .*checkpoint_before_frames.h5)" "$tmp/b2.out"' \
   "run again: the interrupted run resumes from its last checkpoint cut (or, before any, from its state before the frames)"
 check 'grep -q "4 of 4 runs complete, 0 failed" "$tmp/b2.out"' "run again: 4 of 4 complete"

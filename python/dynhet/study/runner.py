@@ -81,6 +81,9 @@ def do_run(sd, p, log=print):
         status["requeues"] = int(os.environ["SLURM_RESTART_COUNT"])
     scene_path = os.path.join(d, "scene.toml")
     cut0 = newest_whole_cut(d)
+    # A resumed run's CPU includes its earlier attempts' (what the result
+    # cost: the study's CPU figures and --dry-run's measured scale use it).
+    carried = float(old.get("cpu_s", 0.0)) if resume is not None else 0.0
     # A run that failed (or was too short) starts over: resuming it from its
     # last cut would repeat what failed (a recorder part that lost frames
     # can never make the run complete).
@@ -106,8 +109,8 @@ def do_run(sd, p, log=print):
     if rc == RESUMABLE and not STOPPING.is_set() and newest_whole_cut(d) == cut0:
         rc = 1  # no progress: a failure, not an interruption
     complete, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc), st.tau_group()) if rc == 0 else (0, float("nan"))
-    status.update({"exit": rc, "wall_s": wall, "cpu_s": cpu, "finished": time.strftime("%Y-%m-%dT%H:%M:%S"),
-                   "tau_alpha": tau})
+    status.update({"exit": rc, "wall_s": wall, "cpu_s": carried + cpu, "cpu_s_attempt": cpu,
+                   "finished": time.strftime("%Y-%m-%dT%H:%M:%S"), "tau_alpha": tau})
     status.pop("pid", None)
     # A run that finished before the stop reached it is complete: a signal
     # late in a Slurm task's time must not cost the run its result.
