@@ -1,7 +1,7 @@
 // The driving's kicks (engine.hpp, class Engine): which pair a kick takes
 // (neighbour pairs from the kick lists, or the 3 x 3-cell search they
 // replaced; pairs from the whole system) and the kick itself. The kick
-// lists are kept with the neighbour lists, in engine.cpp.
+// lists are kept with the neighbour lists, in lists.cpp.
 #include "dynhet/engine/engine.hpp"
 
 #include <cmath>
