@@ -248,7 +248,7 @@ def calibration_note(A, multi, multi_cr):
             groups = {}   # (factor, ratio, uncertainty, dof, borrowed) -> the studies
             for pop in pops.values():
                 k, r, u, dof = pop.calibration(f)
-                borrowed = pop.parent is not None and pop.own(f)[3] < MIN_CAL_DOF
+                borrowed = pop.borrows(f)
                 if k != 1.0:
                     groups.setdefault((k, r, u, dof, borrowed), []).append(pop.name or os.path.basename(A.dir))
             for (k, r, u, dof, borrowed), names in groups.items():

@@ -70,7 +70,7 @@ def calibration_lines(A):
         cells = []
         for name, fn in PER_RUN.items():
             k, r, u, dof = pop.calibration(fn)
-            borrowed = pop.parent is not None and pop.own(fn)[3] < MIN_CAL_DOF
+            borrowed = pop.borrows(fn)
             if dof:
                 cells.append(f"{name} {r:.2f} ± {u:.2f} ({dof} dof{', all studies' if borrowed else ''})"
                              + (f" → × {k:.2f}" if k != 1.0 else ""))

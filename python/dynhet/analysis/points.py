@@ -79,12 +79,13 @@ class Population:
             self._cache[key] = calibration(self.points, fn)
         return self._cache[key]
 
+    def borrows(self, fn):
+        """Whether fn's calibration is the parent's (too few dof of its own)."""
+        return self.parent is not None and self.own(fn)[3] < MIN_CAL_DOF
+
     def calibration(self, fn):
         """(factor, ratio, uncertainty, dof): the study's own, else the parent's."""
-        c = self.own(fn)
-        if c[3] < MIN_CAL_DOF and self.parent is not None:
-            return self.parent.own(fn)
-        return c
+        return self.parent.own(fn) if self.borrows(fn) else self.own(fn)
 
 
 def ensure_calibrated(points):

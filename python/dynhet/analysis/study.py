@@ -206,7 +206,7 @@ class CageRelativeView(Analysis):
             return out
         self.points, self.extra = swapped(base.points), swapped(base.extra)
         self.promoted = [copies[id(p)] for p in getattr(base, "promoted", []) if copies.get(id(p)) is not None]
-        ensure_calibrated(list({id(p): p for p in list(self.points.values()) + list(self.extra.values())}.values()))
+        ensure_calibrated(list(self.points.values()) + list(self.extra.values()))  # it takes each point once
 
     def save(self, fig, name):
         return self.base.save(fig, "cr_" + name)
