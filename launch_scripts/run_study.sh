@@ -5,7 +5,9 @@
 #
 # Usage: launch_scripts/run_study.sh STUDY.toml [options]
 #   --executor local   (default) up to --jobs runs at once on this machine,
-#                      each on its own private network namespace
+#                      each on its own private network namespace, the
+#                      longest estimated run first (low phi first when run
+#                      lengths are interpolated)
 #   --executor slurm   one sbatch job array (a task per run) and a dependent
 #                      job that writes the index; --partition, --time, --mem
 #                      and --sbatch=FLAG (repeatable) pass through

@@ -101,3 +101,29 @@ def test_a_study_dir_takes_the_same_study_with_other_comments_and_refuses_anothe
              str(out)).claim()
     with pytest.raises(StudyError, match="differs from the study"):
         StudyDir(study(tmp_path, GOOD.replace("seed = [1, 2]", "seed = [1, 2, 3]")), str(out)).claim()
+
+
+def test_the_executors_take_the_longest_run_first(tmp_path):
+    # Longest-processing-time first: on a few cores the study's wall time is
+    # set by its longest run, which must not start last behind short ones.
+    # The estimates are the dry run's, from each run's own scene.
+    from dynhet.study.index import run_estimates, run_order
+    from dynhet.study.rundir import StudyDir
+    text = GOOD.replace("lag_max_tau = 30.0", "lag_max_tau = 30.0\ntau_guess = [[0.6, 1.0], [0.7, 5.0]]")
+    sd = StudyDir(study(tmp_path, text), str(tmp_path / "out"))
+    sd.claim()
+    pts = sd.study.points()
+    est = run_estimates(sd)
+    order = run_order(sd, pts, est)
+    costs = [est[sd.study.run_name(p)] for p in order]
+    assert costs == sorted(costs, reverse=True) and costs[0] > costs[-1]
+    assert order[0]["n_particles"] == 1024                # the big, slow run starts first
+    assert [p["packing_fraction"] for p in order[-2:]] == [0.6, 0.6]
+    same = [p for p in order if p["packing_fraction"] == 0.6]
+    assert [p["seed"] for p in same] == [1, 2]            # equal estimates keep the study's order
+    # interpolated run lengths need the low densities first, whatever they cost
+    sd = StudyDir(study(tmp_path, text.replace('tau_alpha = "pilot"', 'tau_alpha = "interpolate"')),
+                  str(tmp_path / "out2"))
+    sd.claim()
+    order = run_order(sd, sd.study.points(), est)
+    assert [p["packing_fraction"] for p in order[:2]] == [0.6, 0.6]

@@ -43,6 +43,24 @@ def plan(sd):
     return out
 
 
+def run_estimates(sd):
+    """{run name: estimated CPU seconds} from the estimates known now."""
+    return {sd.study.run_name(p): estimate(sc, nodes_of(sc))[0] for p, sc, *_ in plan(sd)}
+
+
+def run_order(sd, todo, est):
+    """The order the executors take runs in (the local pool, and the Slurm
+    array's task indices, which a throttled array starts in order). With
+    interpolated run lengths the low densities first (the rest interpolate
+    from them); otherwise the longest estimated run first, so that the
+    longest run, which sets the study's wall time on a few cores, does not
+    start last behind the short ones (longest-processing-time first; equal
+    estimates keep the study's order)."""
+    if sd.study.run_length["tau_alpha"] == "interpolate":
+        return sorted(todo, key=lambda p: p["packing_fraction"])
+    return sorted(todo, key=lambda p: -est.get(sd.study.run_name(p), 0.0))
+
+
 def nodes_of(sc):
     comp = sc.get("observables", {}).get("compute", ["overlap"])
     return len({("overlap" if c in ("chi4", "msd", "displacement") else c) for c in comp})

@@ -7,11 +7,11 @@ import time
 
 from .paths import ROOT
 from .model import AXES, StudyError, StudyInterrupted
-from .estimates import estimate, fmt_time
+from .estimates import fmt_time
 from .rundir import read_status, write_status
 from .children import STOPPING, stop_children
 from .runner import do_run
-from .index import nodes_of, plan, write_index
+from .index import run_estimates, run_order, write_index
 
 
 def run_local(sd, jobs):
@@ -20,9 +20,8 @@ def run_local(sd, jobs):
     done0 = len(points) - len(todo)
     if done0:
         print(f"study {sd.study.name}: {done0} of {len(points)} runs complete already (skipped)", flush=True)
-    if sd.study.run_length["tau_alpha"] == "interpolate":  # low phi first: the rest interpolate from them
-        todo.sort(key=lambda p: p["packing_fraction"])
-    est = {sd.study.run_name(p): estimate(sc, nodes_of(sc))[0] for p, sc, *_ in plan(sd)}
+    est = run_estimates(sd)
+    todo = run_order(sd, todo, est)
     lock = threading.Lock()
     state = {"done": done0, "failed": 0, "running": 0, "left": len(todo), "cpu_done": 0.0, "est_done": 0.0}
     queue = list(todo)
