@@ -151,3 +151,37 @@ def test_xi_cells_say_how_many_q_shells_their_fits_had():
     p.runs = p.runs[:1]
     assert shells_note(p, False) == " [7 q]"
     assert shells_note(None, False) == ""
+
+
+def test_tau_b_beyond_the_lags_is_a_bound_and_c_b_is_compared_at_a_common_time(tmp_path):
+    """C_B(t) = exp(-t / 100) in every run; one seed at N = 4096 stops at
+    t = 60, before C_B reaches 1/e. Its point gives no mean tau_B (the other
+    seed alone would say 100) but the bound > (100 + 60) / 2 = 80, and C_B
+    is compared across N at t = 60, the longest lag every run reached."""
+    A = Analysis.__new__(Analysis)
+    A.dir, A.figdir, A.also = str(tmp_path / "study"), str(tmp_path / "study" / "figures"), []
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    for n in (1024, 4096):
+        p = Point(("neighbours", 0.9, 0.79, n))
+        for seed in (1, 2):
+            t_max = 60.0 if (n, seed) == (4096, 1) else 1000.0
+            lag = np.geomspace(1.0, t_max, 40)
+            p.runs.append({"seed": seed, "N": n, "packing_fraction": 0.79,
+                           "cut": {0.6: {"tau_alpha": 10.0 + seed, "tau_alpha_err": 1.0}},
+                           "c_b_lag": lag, "c_b": np.exp(-lag / 100.0), "c_b_err": np.full(40, 0.01),
+                           "tau_b": 100.0 if t_max > 100 else math.nan, "tau_b_err": 2.0})
+        A.points[p.pairs, p.eps, p.phi, p.N] = p
+    out = tmp_path / "finite_size.md"
+    write_finite_size(A, str(out), "analyse_study.sh study")
+    text = out.read_text()
+    row = next(l for l in text.splitlines() if l.startswith("| τ_B (bond breaking) |") and "verdict" not in l
+               and "seeds: C_B" in l)
+    cells = [c.strip() for c in row.split("|")[2:-1]]
+    assert cells[0].startswith("100 ± ")                     # both seeds reached it
+    assert cells[1] == "> 80 (1 of 2 seeds: C_B > 1/e at the last lag)"
+    assert cells[2] == "one N only"                          # the bound takes no part in the verdict
+    row = next(l for l in text.splitlines() if l.startswith("| C_B at t = 60 (bond breaking) |"))
+    v = math.exp(-0.6)
+    for c in row.split("|")[2:4]:
+        assert abs(float(c.split("±")[0]) - v) < 2e-3     # interpolated in ln t between lags
+    assert "converged from N = 1024" in row

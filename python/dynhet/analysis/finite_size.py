@@ -16,6 +16,7 @@ from .quantities import PER_RUN, XI_MIN, chi0_at_tau, kappa_of, whole_box_s4
 from .points import MIN_CAL_DOF, ensure_calibrated, spread_ratio as pooled_spread
 from .size import points_by_phi_n
 from .verdicts import fmt
+from ..fits import interp_ln_t
 
 # chi4^P (the peak of chi4(t)) per sub-box size: a run's grid counts for a
 # size when its <N_r> is within a factor 1.6 of it and is not the whole box.
@@ -97,16 +98,89 @@ def tau_of(r, cr=False):
     return c["tau_alpha"], c["tau_alpha_err"]
 
 
+def tau_b_of(r, cr=False):
+    return PER_RUN["tau_b"](r)
+
+
+def c_b_at(times):
+    """C_B(t), the fraction of bonds intact (bond breaking), at a fixed time
+    per density, interpolated in ln t, with the run's quoted error (jackknife
+    over origin blocks) and the interpolation's in quadrature. `times` is
+    ((phi, t), ...); NaN beyond a run's lags."""
+    at = dict(times)
+
+    def fn(r, cr=False):
+        t = at.get(round(float(r["packing_fraction"]), 6), math.nan)
+        v, ie = interp_ln_t(r["c_b_lag"], r["c_b"], t)
+        e, _ = interp_ln_t(r["c_b_lag"], r["c_b_err"], t)
+        return v, math.hypot(e, ie if np.isfinite(ie) else 0.0)
+    return fn
+
+
+def c_b_times(multi):
+    """Per density, the longest lag that every run of it (at every N) reached:
+    where C_B is compared across N."""
+    out = []
+    for phi, d in multi.items():
+        last = [float(r["c_b_lag"][-1]) for p in d.values() for r in p.runs if len(r.get("c_b_lag", ()))]
+        if last:
+            out.append((round(float(phi), 6), min(last)))
+    return tuple(out)
+
+
 # (name, file name, per-run function (r, cr) -> (value, error), has a
-# cage-relative version, log axis)
-QUANTITIES = [("τ_α", "tau_alpha", tau_of, True, True),
-              ("τ_B (bond breaking)", "tau_b", lambda r, cr=False: PER_RUN["tau_b"](r), False, True)] + \
-    [(f"χ4^P, sub-boxes of {n}", f"chi4p_{n}", chi4p_of(n), True, True) for n in SUBBOX_SIZES] + \
-    [("χ0 of S4 (whole box, at τ_α)", "chi0", with_cr(chi0_at_tau), True, True),
-     ("ξ of S4 (whole box, at τ_α)", "xi", lambda r, cr=False: xi_shells(r, cr)[:2], True, True),
-     ("κ (slow clusters)", "kappa", with_cr(kappa_of), True, False),
-     ("d_f (slow clusters)", "d_f", lambda r, cr=False: (cutx(r, cr)["cl_slow_d_f"], cutx(r, cr)["cl_slow_d_f_err"]),
-      True, False)]
+# cage-relative version, log axis). C_B's time depends on the runs: quantities().
+TAU_ROWS = [("τ_α", "tau_alpha", tau_of, True, True),
+            ("τ_B (bond breaking)", "tau_b", tau_b_of, False, True)]
+CHI4P_ROWS = [(f"χ4^P, sub-boxes of {n}", f"chi4p_{n}", chi4p_of(n), True, True) for n in SUBBOX_SIZES]
+REST_ROWS = [("χ0 of S4 (whole box, at τ_α)", "chi0", with_cr(chi0_at_tau), True, True),
+             ("ξ of S4 (whole box, at τ_α)", "xi", lambda r, cr=False: xi_shells(r, cr)[:2], True, True),
+             ("κ (slow clusters)", "kappa", with_cr(kappa_of), True, False),
+             ("d_f (slow clusters)", "d_f", lambda r, cr=False: (cutx(r, cr)["cl_slow_d_f"], cutx(r, cr)["cl_slow_d_f_err"]),
+              True, False)]
+QUANTITIES = TAU_ROWS + CHI4P_ROWS + REST_ROWS
+
+
+def quantities(multi):
+    """Every row of the report: QUANTITIES and C_B at each density's common
+    last lag (bond breaking measured where tau_B lies beyond the lags)."""
+    cb = [("C_B at the longest common lag (bond breaking)", "c_b", c_b_at(c_b_times(multi)), False, False)]
+    return TAU_ROWS + cb + CHI4P_ROWS + REST_ROWS
+
+
+def tau_b_bound(p):
+    """Where some run of the point never saw C_B fall to 1/e: the mean over
+    its seeds of tau_B or, where not reached, the last lag, a lower bound on
+    the point's tau_B; None where every run reached it (or none measured
+    C_B)."""
+    vals, short = [], False
+    for r in p.runs:
+        lag = r.get("c_b_lag")
+        if lag is None or not len(lag):
+            continue
+        tb = r.get("tau_b", math.nan)
+        if np.isfinite(tb):
+            vals.append(tb)
+        else:
+            vals.append(float(lag[-1]))
+            short = True
+    return float(np.mean(vals)) if short else None
+
+
+def missing_cell(slug, p, cr):
+    """The text of a cell with no value that says why: tau_B beyond the lags
+    (with a lower bound), xi not resolved; None for a plain "—"."""
+    if p is None:
+        return None
+    if slug == "tau_b":
+        b = tau_b_bound(p)
+        if b is not None:
+            n = sum(1 for r in p.runs if not np.isfinite(r.get("tau_b", math.nan)) and len(r.get("c_b_lag", ())))
+            return f"> {b:.3g} ({n} of {len(p.runs)} seeds: C_B > 1/e at the last lag)"
+    if slug in ("xi", "chi0") and any(len(cutx(r, cr).get("xi_t", ())) for r in p.runs if A_MAIN in r.get(
+            "cut_cr" if cr else "cut", {})):
+        return "not resolved"
+    return None
 
 
 def size_verdict(ns, vals, errs):
@@ -148,7 +222,7 @@ def spread_section(multi, multi_cr):
     tau_alpha^CR, tau_B and chi4^P over the densities run there."""
     ns = sorted({n for d in multi.values() for n in d})
     rows = []
-    for name, _, fn, has_cr_version, _ in QUANTITIES[:2 + len(SUBBOX_SIZES)]:
+    for name, _, fn, has_cr_version, _ in TAU_ROWS + CHI4P_ROWS:
         for cr in ((False, True) if has_cr_version else (False,)):
             src = multi_cr if cr else multi
             cells, any_data = [], False
@@ -191,13 +265,16 @@ def cell(m):
     return (fmt(v, e) if np.isfinite(e) else f"{v:.4g} (no error)") + ("" if n > 1 else " ¹")
 
 
-def quantity_rows(d, fn, cr, ns=None):
+def quantity_rows(d, fn, cr, ns=None, slug=None):
     """Per-N means (at the sizes ns, default d's; NaN where d has none; their
     errors scaled by their study's calibration, Point.mean) and the verdict
-    (sizes without a measured error take no part in it)."""
+    (sizes without a measured error take no part in it). A tau_B of which
+    some seed was not reached is no mean (the rest would bias it low): NaN,
+    and its cell gives the bound (missing_cell)."""
     ns = sorted(d) if ns is None else ns
     nan = (math.nan, math.nan, math.nan, 0)
-    ms = [d[n].mean(lambda r: fn(r, cr)) if n in d else nan for n in ns]
+    ms = [d[n].mean(lambda r: fn(r, cr)) if n in d and not (slug == "tau_b" and tau_b_bound(d[n]) is not None)
+          else nan for n in ns]
     verdict = size_verdict(ns, [m[0] for m in ms], [measured_error(m) for m in ms])
     return ns, ms, verdict
 
@@ -214,7 +291,7 @@ def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr):
             dd = multi_cr.get(phi, {}) if cr else d
             if not dd:
                 continue
-            ns, ms, _ = quantity_rows(dd, fn, cr)
+            ns, ms, _ = quantity_rows(dd, fn, cr, slug=slug)
             x = [n for n, m in zip(ns, ms) if np.isfinite(m[0])]
             if not x:
                 continue
@@ -242,7 +319,7 @@ def calibration_note(A, multi, multi_cr):
     ensure_calibrated(list(A.points.values()) + list(A.extra.values()))
     pops = {id(p.population): p.population for src in (multi, multi_cr) for d in src.values() for p in d.values()}
     applied = []
-    for name, slug, fn, has_cr_version, _ in QUANTITIES:
+    for name, slug, fn, has_cr_version, _ in quantities(multi):
         for cr in ((False, True) if has_cr_version else (False,)):
             f = lambda run: fn(run, cr)  # noqa: E731
             groups = {}   # (factor, ratio, uncertainty, dof, borrowed) -> the studies
@@ -291,22 +368,29 @@ def write_finite_size(A, path, command):
     if not multi:
         L += ["No density was run at more than one N.", ""]
     L += calibration_note(A, multi, multi_cr)
+    rows, cb_at = quantities(multi), c_b_times(multi)
     figures = []
     for phi, d in multi.items():
         ns = sorted(d)
         L += [f"## φ = {phi:g}", "",
               "| quantity | " + " | ".join(f"N = {n}" for n in ns) + " | verdict |",
               "|---|" + "---|" * len(ns) + "---|"]
-        for name, slug, fn, has_cr_version, _ in QUANTITIES:
+        for name, slug, fn, has_cr_version, _ in rows:
             for cr in ((False, True) if has_cr_version else (False,)):
                 dd = multi_cr.get(phi, {}) if cr else d
                 if not dd:
                     continue
-                qn, ms, (text, _, _, _) = quantity_rows(dd, fn, cr, ns)
-                if not any(np.isfinite(m[0]) for m in ms):
+                qn, ms, (text, _, _, _) = quantity_rows(dd, fn, cr, ns, slug)
+                why = [missing_cell(slug, dd.get(n), cr) if not np.isfinite(m[0]) else None for n, m in zip(qn, ms)]
+                if not any(np.isfinite(m[0]) for m in ms) and not any(why):
                     continue
+                if not any(np.isfinite(m[0]) for m in ms):
+                    text = ("not reached at any N: C_B stays above 1/e over the runs' lags" if slug == "tau_b"
+                            else "not resolved at any N")
                 label = name + (" — cage-relative" if cr else "")
-                cells = [cell(m) for m in ms]
+                if slug == "c_b":
+                    label = f"C_B at t = {dict(cb_at).get(round(float(phi), 6), math.nan):.4g} (bond breaking)"
+                cells = [w or cell(m) for m, w in zip(ms, why)]
                 if slug == "xi":  # how many q shells its fits had below q xi = 1 (issue 27, item 4)
                     cells = [c + shells_note(dd.get(n), cr) for c, n in zip(cells, qn)]
                 L.append(f"| {label} | " + " | ".join(cells) + f" | {text} |")
@@ -318,7 +402,7 @@ def write_finite_size(A, path, command):
     if multi:
         L += spread_section(multi, multi_cr)
         L += ["## Plots", ""]
-        for name, slug, fn, has_cr_version, log_y in QUANTITIES:
+        for name, slug, fn, has_cr_version, log_y in rows:
             f = plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr)
             if f:
                 figures.append(f)

@@ -108,6 +108,7 @@ def read_run(path, meta):
             b = run.observable("bond_breaking")
             r["tau_b"], r["tau_b_err"] = fnum(last(b, "tau_b")), fnum(last(b, "tau_b_err"))
             r["c_b_lag"], r["c_b"] = b["lag_time"][:], last(b, "c_b")
+            r["c_b_err"] = last(b, "c_b_err") if "c_b_err" in b else np.full(len(r["c_b"]), np.nan)
         if "sim" in obs:
             s = run.observable("sim")
             r["Z"], r["Z_err"] = fnum(last(s, "reduced_pressure")), fnum(last(s, "reduced_pressure_err"))
