@@ -167,7 +167,8 @@ def test_tau_b_beyond_the_lags_is_a_bound_and_c_b_is_compared_at_a_common_time(t
             t_max = 60.0 if (n, seed) == (4096, 1) else 1000.0
             lag = np.geomspace(1.0, t_max, 40)
             p.runs.append({"seed": seed, "N": n, "packing_fraction": 0.79,
-                           "cut": {0.6: {"tau_alpha": 10.0 + seed, "tau_alpha_err": 1.0}},
+                           "cut": {0.6: {"tau_alpha": 10.0 + seed, "tau_alpha_err": 1.0,
+                                         "lag": np.array([1.0, 50.0 * seed]), "tau_cr": 10.0}},
                            "c_b_lag": lag, "c_b": np.exp(-lag / 100.0), "c_b_err": np.full(40, 0.01),
                            "tau_b": 100.0 if t_max > 100 else math.nan, "tau_b_err": 2.0})
         A.points[p.pairs, p.eps, p.phi, p.N] = p
@@ -185,3 +186,5 @@ def test_tau_b_beyond_the_lags_is_a_bound_and_c_b_is_compared_at_a_common_time(t
     for c in row.split("|")[2:4]:
         assert abs(float(c.split("±")[0]) - v) < 2e-3     # interpolated in ln t between lags
     assert "converged from N = 1024" in row
+    # the run lengths in units of each run's own tau_alpha^CR, per N (seed range)
+    assert "own measured τ_α^CR (the same at every N where the protocol is): N 1024: 5-10, N 4096: 5-10." in text
