@@ -188,3 +188,21 @@ def test_tau_b_beyond_the_lags_is_a_bound_and_c_b_is_compared_at_a_common_time(t
     assert "converged from N = 1024" in row
     # the run lengths in units of each run's own tau_alpha^CR, per N (seed range)
     assert "own measured τ_α^CR (the same at every N where the protocol is): N 1024: 5-10, N 4096: 5-10." in text
+
+
+def test_a_tau_b_error_whose_blocks_cannot_span_it_is_dropped_on_reading(tmp_path):
+    """The nodes' rule (origin_blocks_span), applied to runs recorded before
+    the node did: 8 origins 263.7 apart allow blocks of 2 origins, which span
+    a lag of up to 2 spacings; tau_B = 1950 spans 8."""
+    import h5py
+    from dynhet.analysis.runs import blocks_span, run_schedule
+    path = tmp_path / "run.h5"
+    with h5py.File(path, "w") as f:
+        g = f.create_group("parameters/schedule")
+        g.attrs["origins"], g.attrs["origin_spacing"] = 8, 263.72614
+    sch = run_schedule(str(path))
+    assert sch == (8, 263.72614)
+    assert not blocks_span(1950.0, sch)
+    assert blocks_span(2 * 263.72614, sch) and not blocks_span(2.01 * 263.72614, sch)
+    assert blocks_span(1950.0, (32, 263.72614))           # 8 blocks of 8 origins span it
+    assert blocks_span(1950.0, None) and blocks_span(math.nan, sch)   # cannot be told: kept

@@ -10,7 +10,7 @@ import shutil
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .config import A_MAIN
+from .config import A_MAIN, EPS_MAIN
 from .plotting import colours, errorbar
 from .quantities import PER_RUN, XI_MIN, chi0_at_tau, kappa_of, whole_box_s4
 from .points import MIN_CAL_DOF, ensure_calibrated, spread_ratio as pooled_spread
@@ -279,6 +279,29 @@ def quantity_rows(d, fn, cr, ns=None, slug=None):
     return ns, ms, verdict
 
 
+def reached_tau_b(p):
+    return bool(p.runs) and all(np.isfinite(r.get("tau_b", math.nan)) for r in p.runs)
+
+
+def tau_b_points(A, multi):
+    """{phi: {N: Point}} for the tau_B rows: at each density and N the point
+    (of this study or an --also study) every run of which saw C_B fall to
+    1/e, most runs first; else the report's own point (whose cell then gives
+    the bound). Studies with longer lags (studies/cage_bonds.toml) thus give
+    tau_B where the main runs stop short of it."""
+    out = {}
+    for phi, d in multi.items():
+        dd = dict(d)
+        for p in list(A.points.values()) + list(A.extra.values()):
+            if p.phi != phi or p.pairs != "neighbours" or abs(p.eps - EPS_MAIN) > 1e-9 or not reached_tau_b(p):
+                continue
+            q = dd.get(p.N)
+            if q is None or not reached_tau_b(q) or len(p.runs) > len(q.runs):
+                dd[p.N] = p
+        out[phi] = dd
+    return out
+
+
 def lags_in_tau_cr(d, ns):
     """Per N, the longest lag of the overlap over the run's own measured
     tau_alpha^CR (the range over seeds): whether every N ran as long in
@@ -386,6 +409,7 @@ def write_finite_size(A, path, command):
         L += ["No density was run at more than one N.", ""]
     L += calibration_note(A, multi, multi_cr)
     rows, cb_at = quantities(multi), c_b_times(multi)
+    multi_tb = tau_b_points(A, multi)
     figures = []
     for phi, d in multi.items():
         ns = sorted(d)
@@ -394,7 +418,7 @@ def write_finite_size(A, path, command):
               "|---|" + "---|" * len(ns) + "---|"]
         for name, slug, fn, has_cr_version, _ in rows:
             for cr in ((False, True) if has_cr_version else (False,)):
-                dd = multi_cr.get(phi, {}) if cr else d
+                dd = multi_cr.get(phi, {}) if cr else (multi_tb[phi] if slug == "tau_b" else d)
                 if not dd:
                     continue
                 qn, ms, (text, _, _, _) = quantity_rows(dd, fn, cr, ns, slug)
@@ -416,6 +440,10 @@ def write_finite_size(A, path, command):
         crs = multi_cr.get(phi, {})
         if crs and any(crs.get(n) is not d.get(n) for n in crs):
             seeds += "; cage-relative rows: " + ", ".join(f"N {n}: {len(p.runs)}" for n, p in sorted(crs.items()))
+        tbs = [(n, p) for n, p in sorted(multi_tb.get(phi, {}).items()) if p is not d.get(n)]
+        if tbs:
+            seeds += "; τ_B row: " + ", ".join(f"N {n}: {len(p.runs)} of study {getattr(p, 'study', '?')}"
+                                               for n, p in tbs)
         L += ["", f"Runs (seeds) per N: {seeds}." + (f" Longest lag in units of each run's own measured "
                                                       f"τ_α^CR (the same at every N where the protocol is): {spans}."
                                                       if spans else ""), ""]
@@ -423,7 +451,8 @@ def write_finite_size(A, path, command):
         L += spread_section(multi, multi_cr)
         L += ["## Plots", ""]
         for name, slug, fn, has_cr_version, log_y in rows:
-            f = plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr)
+            f = plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi_tb if slug == "tau_b" else multi,
+                              multi_cr)
             if f:
                 figures.append(f)
                 L.append(f"- {name}: ![{name}](finite_size/{os.path.basename(f)})")

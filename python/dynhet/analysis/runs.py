@@ -17,6 +17,31 @@ def fnum(v):
     return float(v) if v is not None else math.nan
 
 
+MIN_JACKKNIFE_BLOCKS = 4   # kMinJackknifeBlocks of analysis_nodes/kernels/fits.hpp
+
+
+def run_schedule(path):
+    """(origins, origin spacing) of a run (parameters/schedule of run.h5);
+    None where it is not recorded."""
+    with h5py.File(path, "r") as f:
+        g = f.get("parameters/schedule")
+        if g is None or "origins" not in g.attrs or "origin_spacing" not in g.attrs:
+            return None
+        return int(g.attrs["origins"]), float(g.attrs["origin_spacing"])
+
+
+def blocks_span(longest_lag, schedule):
+    """The nodes' origin_blocks_span: whether jackknife blocks of origins that
+    span `longest_lag` fit at least MIN_JACKKNIFE_BLOCKS times into the
+    origins; where they do not, the blocks are correlated and a quoted error
+    is too small (docs/analysis.md, "a run quotes no tau_B error it cannot
+    back"). True where it cannot be told."""
+    if schedule is None or not np.isfinite(longest_lag) or longest_lag <= 0 or schedule[1] <= 0:
+        return True
+    n, spacing = schedule
+    return math.ceil(longest_lag / spacing - 1e-9) <= max(1, n // MIN_JACKKNIFE_BLOCKS)
+
+
 def cutoff_groups(run, kind):
     """{a: Observable} of an observable family (empty where the run lacks it)."""
     return {a: run.observable(kind, a) for a in run.cutoffs(kind)}
@@ -107,6 +132,8 @@ def read_run(path, meta):
         if "bond_breaking" in obs:
             b = run.observable("bond_breaking")
             r["tau_b"], r["tau_b_err"] = fnum(last(b, "tau_b")), fnum(last(b, "tau_b_err"))
+            if not blocks_span(r["tau_b"], run_schedule(path)):
+                r["tau_b_err"] = math.nan  # a run recorded before the node applied the same rule
             r["c_b_lag"], r["c_b"] = b["lag_time"][:], last(b, "c_b")
             r["c_b_err"] = last(b, "c_b_err") if "c_b_err" in b else np.full(len(r["c_b"]), np.nan)
         if "sim" in obs:
