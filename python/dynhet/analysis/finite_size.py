@@ -402,8 +402,9 @@ def write_finite_size(A, path, command):
          f"N's within {Z_CONVERGED:g} combined errors; otherwise **drifting**, with the change per doubling of N "
          f"between the two largest sizes. χ4^P is the peak of χ4(t) of sub-boxes of about that many particles "
          f"(interior peaks only); ξ is the whole box's Ornstein-Zernike ξ at τ_α, taken only where at least "
-         f"{MIN_SHELLS} q shells lie below q ξ = 1 (else \"—\": not resolved at this N); [k q]: the shells below "
-         f"q ξ = 1 of its runs. a = {A_MAIN}, ε = 0.9, "
+         f"{MIN_SHELLS} q shells lie below q ξ = 1 (else \"not resolved\" at this N); [k q]: the shells below "
+         f"q ξ = 1 of its runs (the range over seeds), which are the q points its OZ fit ran over (the S4 node "
+         f"fits over q ξ ≤ 1, and over the 3 smallest q where fewer lie there). a = {A_MAIN}, ε = 0.9, "
          f"neighbour kick pairs. Nothing here is tuned toward the paper's numbers.", ""]
     if not multi:
         L += ["No density was run at more than one N.", ""]
