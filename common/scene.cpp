@@ -1,122 +1,23 @@
+// Scene files: the schema of every table and key, each key checked alone as
+// it is read (scene_check.cpp), then the checks between keys
+// (scene_relations.cpp); every problem is named before one error is thrown.
 #include "dynhet/scene.hpp"
 
-#include <charconv>
-#include "dynhet/subbox.hpp"
-
 #include <algorithm>
-#include <cmath>
 #include <fstream>
-#include <functional>
-#include <map>
-#include <iomanip>
 #include <limits>
+#include <map>
 #include <sstream>
 
 #include <toml++/toml.h>
 
 #include "dynhet/lcm_url.hpp" // cutoff_label
 #include "dynhet/model.hpp"
+#include "dynhet/subbox.hpp"
+#include "scene_check.hpp"
 
 namespace dynhet {
-namespace {
-
-const char* type_name(const toml::node& n) {
-  switch (n.type()) {
-  case toml::node_type::string: return "a string";
-  case toml::node_type::integer: return "an integer";
-  case toml::node_type::floating_point: return "a float";
-  case toml::node_type::boolean: return "a boolean";
-  case toml::node_type::array: return "an array";
-  case toml::node_type::table: return "a table";
-  default: return "a date/time";
-  }
-}
-
-// A number as the shortest text that reads back as the same double (0.9,
-// 1.0000000000000002, 1e+300): what the file says, never rounded away.
-std::string num(double v) {
-  char buf[64];
-  const auto r = std::to_chars(buf, buf + sizeof buf, v);
-  return std::string(buf, r.ptr);
-}
-
-std::string show(const toml::node& n) {
-  std::ostringstream s;
-  if (n.is_table()) return "{...}";
-  if (auto d = n.value_exact<double>()) return num(*d);
-  n.visit([&](auto&& v) { s << v; });
-  return s.str();
-}
-
-// Collects every problem of a scene, then throws them together.
-class Checker {
-public:
-  explicit Checker(std::string origin) : origin_(std::move(origin)) {}
-
-  void fail(const std::string& key, const std::string& what) {
-    errors_.push_back(origin_ + ": " + key + ": " + what);
-  }
-  void bad_value(const std::string& key, const toml::node& n, const std::string& allowed) {
-    fail(key, "value " + show(n) + " is not allowed; " + allowed);
-  }
-  void bad_type(const std::string& key, const toml::node& n, const std::string& expected) {
-    fail(key, "value " + show(n) + " is " + type_name(n) + ", expected " + expected);
-  }
-  bool ok() const { return errors_.empty(); }
-  void throw_if_failed() const {
-    if (errors_.empty()) return;
-    std::string msg = "invalid scene (" + std::to_string(errors_.size()) + " problem" +
-                      (errors_.size() > 1 ? "s" : "") + "):";
-    for (const auto& e : errors_) msg += "\n  " + e;
-    throw SceneError(msg);
-  }
-
-  bool get_int(const std::string& key, const toml::node& n, int64_t& out) {
-    if (auto v = n.value_exact<int64_t>()) { out = *v; return true; }
-    bad_type(key, n, "an integer");
-    return false;
-  }
-  bool get_double(const std::string& key, const toml::node& n, double& out) {
-    if (n.is_integer()) {
-      // An integer beyond 2^53 has no exact double: refused, not rounded.
-      const int64_t i = *n.value_exact<int64_t>();
-      if (i > (int64_t{1} << 53) || i < -(int64_t{1} << 53)) {
-        bad_value(key, n, "an integer beyond 2^53 is not exactly a number here; write it as a float (1e18)");
-        return false;
-      }
-      out = static_cast<double>(i);
-      return true;
-    }
-    if (n.is_floating_point()) {
-      out = *n.value_exact<double>();
-      if (std::isfinite(out)) return true;
-      bad_value(key, n, "it must be a finite number");
-      return false;
-    }
-    bad_type(key, n, "a number");
-    return false;
-  }
-  bool get_bool(const std::string& key, const toml::node& n, bool& out) {
-    if (auto v = n.value_exact<bool>()) { out = *v; return true; }
-    bad_type(key, n, "a boolean (true or false)");
-    return false;
-  }
-
-private:
-  std::string origin_;
-  std::vector<std::string> errors_;
-};
-
-using Handler = std::function<void(const std::string& key, const toml::node&)>;
-using Table = std::map<std::string, Handler>;
-
-std::string known_keys(const Table& t) {
-  std::string s;
-  for (const auto& [k, h] : t) s += (s.empty() ? "" : ", ") + k;
-  return s;
-}
-
-} // namespace
+using namespace scene_detail;
 
 const std::vector<std::string>& known_observables() {
   static const std::vector<std::string> v{"overlap", "chi4", "msd", "displacement", "clusters", "s4", "bond_breaking"};
@@ -179,52 +80,9 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
   }
 
   Checker c(origin);
-  // A positive number (time or length) under `key`.
-  auto positive = [&](double& out) {
-    return [&c, &out](const std::string& key, const toml::node& n) {
-      double v;
-      if (!c.get_double(key, n, v)) return;
-      if (v <= 0) return c.bad_value(key, n, "it must be > 0");
-      out = v;
-    };
-  };
-  auto non_negative = [&](double& out) {
-    return [&c, &out](const std::string& key, const toml::node& n) {
-      double v;
-      if (!c.get_double(key, n, v)) return;
-      if (v < 0) return c.bad_value(key, n, "it must be >= 0");
-      out = v;
-    };
-  };
-  auto int_in = [&](auto& out, int64_t lo, int64_t hi) {
-    return [&c, &out, lo, hi](const std::string& key, const toml::node& n) {
-      int64_t v;
-      if (!c.get_int(key, n, v)) return;
-      if (v < lo || v > hi)
-        return c.bad_value(key, n,
-                           "allowed: " + std::to_string(lo) + " <= value <= " + std::to_string(hi));
-      out = static_cast<std::remove_reference_t<decltype(out)>>(v);
-    };
-  };
-  // A number, or a string naming the default recipe (stored as -1).
-  auto number_or = [&](double& out, const std::string& word) {
-    return [&c, &out, word](const std::string& key, const toml::node& n) {
-      if (n.is_string()) {
-        if (*n.value<std::string>() != word)
-          return c.bad_value(key, n, "allowed: \"" + word + "\" or a number > 0");
-        out = -1.0;
-        return;
-      }
-      double v;
-      if (!c.get_double(key, n, v)) return;
-      if (v <= 0) return c.bad_value(key, n, "allowed: \"" + word + "\" or a number > 0");
-      out = v;
-    };
-  };
-
   std::map<std::string, Table> schema;
   schema["system"] = {
-      {"n_particles", int_in(s.n_particles, 2, std::numeric_limits<int32_t>::max())},
+      {"n_particles", int_in(c, s.n_particles, 2, std::numeric_limits<int32_t>::max())},
       {"packing_fraction",
        [&](const std::string& key, const toml::node& n) {
          double v;
@@ -247,7 +105,7 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
          if (!(v >= 1 && v <= 10)) return c.bad_value(key, n, "allowed: 1 <= r2/r1 <= 10");
          s.radius_ratio = v;
        }},
-      {"tc_time", non_negative(s.tc_time)},
+      {"tc_time", non_negative(c, s.tc_time)},
       {"initial_state",
        [&](const std::string& key, const toml::node& n) {
          const auto v = n.value_exact<std::string>();
@@ -265,7 +123,7 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
   };
   schema["driving"] = {
       {"enabled", [&](const std::string& key, const toml::node& n) { c.get_bool(key, n, s.driving); }},
-      {"kick_rate", number_or(s.kick_rate, "enskog")},
+      {"kick_rate", number_or(c, s.kick_rate, "enskog")},
       {"contact_value",
        [&](const std::string& key, const toml::node& n) {
          if (n.is_string()) {
@@ -276,7 +134,7 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
            s.contact_value = -1.0;
            return;
          }
-         number_or(s.contact_value, "mixture")(key, n);
+         number_or(c, s.contact_value, "mixture")(key, n);
        }},
       {"pairs",
        [&](const std::string& key, const toml::node& n) {
@@ -295,17 +153,17 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
        }},
   };
   schema["run"] = {
-      {"equilibration_time", non_negative(s.equilibration_time)},
-      {"production_time", positive(s.production_time)},
-      {"checkpoint_interval", positive(s.checkpoint_interval)},
-      {"checkpoint_wall_interval", non_negative(s.checkpoint_wall_interval)},
+      {"equilibration_time", non_negative(c, s.equilibration_time)},
+      {"production_time", positive(c, s.production_time)},
+      {"checkpoint_interval", positive(c, s.checkpoint_interval)},
+      {"checkpoint_wall_interval", non_negative(c, s.checkpoint_wall_interval)},
   };
   schema["schedule"] = {
-      {"origins", int_in(s.schedule.origins, 1, 1000000)},
-      {"origin_spacing", positive(s.schedule.origin_spacing)},
-      {"lag_min", positive(s.schedule.lag_min)},
-      {"lag_max", positive(s.schedule.lag_max)},
-      {"lags_per_decade", int_in(s.schedule.lags_per_decade, 1, 1000)},
+      {"origins", int_in(c, s.schedule.origins, 1, 1000000)},
+      {"origin_spacing", positive(c, s.schedule.origin_spacing)},
+      {"lag_min", positive(c, s.schedule.lag_min)},
+      {"lag_max", positive(c, s.schedule.lag_max)},
+      {"lags_per_decade", int_in(c, s.schedule.lags_per_decade, 1, 1000)},
       {"extra_lags",
        [&](const std::string& key, const toml::node& n) {
          const auto* arr = n.as_array();
@@ -372,24 +230,10 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
        }},
   };
   schema["overlap"] = {
-      {"subbox_particles", int_in(s.overlap_subbox_particles, 1, std::numeric_limits<int32_t>::max())},
-  };
-  // A non-empty list of sub-box sizes (target particles per sub-box).
-  auto subbox_sizes = [&](std::vector<int>& out) {
-    return [&c, &out](const std::string& key, const toml::node& n) {
-      const auto* arr = n.as_array();
-      if (!arr || arr->empty()) return c.bad_type(key, n, "a non-empty array of integers");
-      out.clear();
-      for (const auto& e : *arr) {
-        int64_t v;
-        if (!c.get_int(key, e, v)) return;
-        if (v < 1) return c.bad_value(key, e, "every size must be >= 1 particle per sub-box");
-        out.push_back(static_cast<int>(std::min<int64_t>(v, 1 << 30)));
-      }
-    };
+      {"subbox_particles", int_in(c, s.overlap_subbox_particles, 1, std::numeric_limits<int32_t>::max())},
   };
   schema["chi4"] = {
-      {"subbox_particles", subbox_sizes(s.chi4_subbox_particles)},
+      {"subbox_particles", subbox_sizes(c, s.chi4_subbox_particles)},
   };
   schema["s4"] = {
       {"lags",
@@ -409,28 +253,14 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
            s.s4_lags.push_back(v);
          }
        }},
-      {"q_max", positive(s.s4_q_max)},
-      {"grid_spacing", non_negative(s.s4_grid_spacing)},
-      {"half_width", int_in(s.s4_half_width, 2, 16)},
-      {"subbox_particles", subbox_sizes(s.s4_subbox_particles)},
+      {"q_max", positive(c, s.s4_q_max)},
+      {"grid_spacing", non_negative(c, s.s4_grid_spacing)},
+      {"half_width", int_in(c, s.s4_half_width, 2, 16)},
+      {"subbox_particles", subbox_sizes(c, s.s4_subbox_particles)},
   };
   auto& cl = s.clusters;
-  auto int_list = [&](std::vector<int64_t>& out, size_t size) {
-    return [&c, &out, size](const std::string& key, const toml::node& n) {
-      const auto* arr = n.as_array();
-      if (!arr || arr->size() != size)
-        return c.bad_type(key, n, "an array of " + std::to_string(size) + " integers");
-      std::vector<int64_t> v;
-      for (const auto& e : *arr) {
-        int64_t x;
-        if (!c.get_int(key, e, x)) return;
-        v.push_back(x);
-      }
-      out = v;
-    };
-  };
   schema["clusters"] = {
-      {"lag", number_or(cl.lag, "tau_alpha")},
+      {"lag", number_or(c, cl.lag, "tau_alpha")},
       {"neighbour_cutoffs",
        [&](const std::string& key, const toml::node& n) {
          if (n.is_string()) {
@@ -450,44 +280,21 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
          }
          cl.neighbour_cutoffs = v;
        }},
-      {"cutoff_frames", int_in(cl.cutoff_frames, 1, 1000000)},
-      {"gr_r_max", positive(cl.gr_r_max)},
-      {"gr_bin", positive(cl.gr_bin)},
-      {"gr_smoothing", non_negative(cl.gr_smoothing)},
-      {"bins_per_decade", int_in(cl.bins_per_decade, 1, 100)},
-      {"power_law_sizes", int_list(cl.power_law_sizes, 2)},
-      {"min_bin_count", int_in(cl.min_bin_count, 1, 1000000000)},
-      {"fractal_min_size", int_in(cl.fractal_min_size, 1, 1000000000)},
-      {"error_blocks", int_in(cl.error_blocks, 2, 1000)},
-  };
-  // A fraction of a set of particles for the fastest and slowest subsets.
-  auto subset_fraction = [&](double& out) {
-    return [&c, &out](const std::string& key, const toml::node& n) {
-      double v;
-      if (!c.get_double(key, n, v)) return;
-      if (!(v > 0 && v <= 0.5)) return c.bad_value(key, n, "allowed: 0 < fraction <= 0.5");
-      out = v;
-    };
-  };
-  auto positive_list = [&](std::vector<double>& out) {
-    return [&c, &out](const std::string& key, const toml::node& n) {
-      const auto* arr = n.as_array();
-      if (!arr) return c.bad_type(key, n, "an array of numbers > 0 (may be empty)");
-      std::vector<double> v;
-      for (const auto& e : *arr) {
-        double x;
-        if (!c.get_double(key, e, x)) return;
-        if (x <= 0) return c.bad_value(key, e, "every entry must be > 0");
-        v.push_back(x);
-      }
-      out = v;
-    };
+      {"cutoff_frames", int_in(c, cl.cutoff_frames, 1, 1000000)},
+      {"gr_r_max", positive(c, cl.gr_r_max)},
+      {"gr_bin", positive(c, cl.gr_bin)},
+      {"gr_smoothing", non_negative(c, cl.gr_smoothing)},
+      {"bins_per_decade", int_in(c, cl.bins_per_decade, 1, 100)},
+      {"power_law_sizes", int_list(c, cl.power_law_sizes, 2)},
+      {"min_bin_count", int_in(c, cl.min_bin_count, 1, 1000000000)},
+      {"fractal_min_size", int_in(c, cl.fractal_min_size, 1, 1000000000)},
+      {"error_blocks", int_in(c, cl.error_blocks, 2, 1000)},
   };
   schema["msd"] = {
-      {"fraction_all", subset_fraction(s.msd.fraction_all)},
-      {"fraction_small", subset_fraction(s.msd.fraction_small)},
+      {"fraction_all", subset_fraction(c, s.msd.fraction_all)},
+      {"fraction_small", subset_fraction(c, s.msd.fraction_small)},
       {"fs", [&](const std::string& key, const toml::node& n) { c.get_bool(key, n, s.msd.fs); }},
-      {"fs_q", positive_list(s.msd.fs_q)},
+      {"fs_q", positive_list(c, s.msd.fs_q)},
   };
   schema["bond_breaking"] = {
       {"a1", [&](const std::string& key, const toml::node& n) { c.get_double(key, n, s.bond_breaking.a1); }},
@@ -495,16 +302,16 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
   };
   auto& dp = s.displacement;
   schema["displacement"] = {
-      {"lags_tau_alpha", positive_list(dp.lags_tau_alpha)},
-      {"lags", positive_list(dp.lags)},
-      {"x_max", positive(dp.x_max)},
-      {"bin_width", positive(dp.bin_width)},
-      {"tail_sigmas", non_negative(dp.tail_sigmas)},
-      {"min_bin_count", int_in(dp.min_bin_count, 1, 1000000000)},
-      {"error_blocks", int_in(dp.error_blocks, 2, 1000)},
+      {"lags_tau_alpha", positive_list(c, dp.lags_tau_alpha)},
+      {"lags", positive_list(c, dp.lags)},
+      {"x_max", positive(c, dp.x_max)},
+      {"bin_width", positive(c, dp.bin_width)},
+      {"tail_sigmas", non_negative(c, dp.tail_sigmas)},
+      {"min_bin_count", int_in(c, dp.min_bin_count, 1, 1000000000)},
+      {"error_blocks", int_in(c, dp.error_blocks, 2, 1000)},
   };
   schema["transport"] = {
-      {"chunk_particles", int_in(s.chunk_particles, 1, 65000)}, // 16 B each: < 1 MiB
+      {"chunk_particles", int_in(c, s.chunk_particles, 1, 65000)}, // 16 B each: < 1 MiB
   };
 
   for (const auto& [table_name, node] : root) {
@@ -532,120 +339,7 @@ Scene parse_scene_text(const std::string& text, const std::string& origin) {
     }
   }
   c.throw_if_failed();
-
-  // Relations between keys.
-  const auto& sch = s.schedule;
-  for (double t : sch.extra_lags)
-    if (t < sch.lag_min || t > sch.lag_max)
-      c.fail("schedule.extra_lags", "value " + num(t) + " is outside [lag_min, lag_max] = [" + num(sch.lag_min) +
-                                        ", " + num(sch.lag_max) + "]");
-  if (sch.lag_min >= sch.lag_max)
-    c.fail("schedule.lag_min", "value " + num(sch.lag_min) +
-                                   " must be smaller than schedule.lag_max = " +
-                                   num(sch.lag_max));
-  // Every (origin, lag) pair is a frame to publish and a pass to make, and
-  // the run info carries them all (4 bytes each, in one LCM message).
-  const double n_lags = std::floor(std::log10(sch.lag_max / sch.lag_min) * sch.lags_per_decade) + 2;
-  if (sch.lag_min < sch.lag_max && sch.origins * n_lags > 1e6)
-    c.fail("schedule", "origins x lags = " + std::to_string(sch.origins) + " x " +
-                           std::to_string(static_cast<long>(n_lags)) +
-                           " pairs is more than 10^6 (the run info could not carry them); use fewer origins "
-                           "or lags per decade");
-  const double needed = (sch.origins - 1) * sch.origin_spacing + sch.lag_max;
-  if (s.production_time < 0) {
-    s.production_time = needed;
-  } else if (s.production_time < needed * (1 - 1e-12)) {
-    c.fail("run.production_time",
-           "value " + num(s.production_time) + " is shorter than the schedule needs: " +
-               "(origins - 1) * origin_spacing + lag_max = " + num(needed));
-  }
-  const Model m = make_model(s.n_particles, s.packing_fraction, s.radius_ratio);
-  const double min_box = 3 * 2 * std::max(m.radius[0], m.radius[1]);
-  if (m.box_length < min_box)
-    c.fail("system.n_particles",
-           "value " + std::to_string(s.n_particles) + " is too small at this packing fraction: " +
-               "the box side " + num(m.box_length) +
-               " must hold 3 cells of the largest diameter (" + num(min_box) + ")");
-  // The NUFFT grid must resolve q_max (Nyquist: h < pi / q_max).
-  if (s.s4_grid_spacing > 0 && s.s4_grid_spacing * s.s4_q_max >= 3.14159265358979)
-    c.fail("s4.grid_spacing", "value " + num(s.s4_grid_spacing) +
-                                  " is too coarse for s4.q_max = " + num(s.s4_q_max) +
-                                  "; allowed: 0 (the default, pi / (2 q_max)) or spacing < pi / q_max");
-  for (double t : s.s4_lags)
-    if (t < sch.lag_min * (1 - 1e-12) || t > sch.lag_max * (1 + 1e-12))
-      c.fail("s4.lags", "value " + num(t) + " is outside the scheduled lags [" +
-                            num(sch.lag_min) + ", " + num(sch.lag_max) + "]");
-  if (cl.cutoff_frames > sch.origins)
-    c.fail("clusters.cutoff_frames", "value " + std::to_string(cl.cutoff_frames) +
-                                         " is more than the schedule's origins (" +
-                                         std::to_string(sch.origins) + ")");
-  if (cl.gr_r_max > m.box_length / 2)
-    c.fail("clusters.gr_r_max", "value " + num(cl.gr_r_max) + " is more than half the box side (" +
-                                    num(m.box_length / 2) + ")");
-  if (cl.gr_r_max / cl.gr_bin > 1e5)
-    c.fail("clusters.gr_bin", "value " + num(cl.gr_bin) + " makes more than 10^5 bins below clusters.gr_r_max = " +
-                                  num(cl.gr_r_max));
-  // The whole box's NUFFT grid: L / h points per side, h the spacing.
-  if (s.wants("s4")) {
-    const double h = s.s4_grid_spacing > 0 ? s.s4_grid_spacing : 3.14159265358979 / (2 * s.s4_q_max);
-    if (m.box_length / h > 8192)
-      c.fail(s.s4_grid_spacing > 0 ? "s4.grid_spacing" : "s4.q_max",
-             "makes a NUFFT grid of " + num(std::ceil(m.box_length / h)) +
-                 " points per box side (more than 8192); allowed: grid_spacing >= box side / 8192 = " +
-                 num(m.box_length / 8192) + ", q_max <= " + num(8192 * 3.14159265358979 / (2 * m.box_length)));
-  }
-  // Kicks so frequent that simulated time hardly moves.
-  if (s.driving && s.restitution < 1 && scene_kick_rate(s) > 1e4)
-    c.fail("driving.kick_rate", "value " + num(scene_kick_rate(s)) +
-                                    " kicks per particle per unit time is more than 10^4: the clock would "
-                                    "hardly move (the Enskog rate, the default, is about 1-100)");
-  // Inelastic collapse: without the TC model, strongly inelastic disks
-  // collide infinitely often in finite time.
-  if (s.restitution < 0.3 && s.tc_time <= 0)
-    c.fail("system.restitution", "value " + num(s.restitution) +
-                                     " below 0.3 needs the TC model (system.tc_time > 0): without it "
-                                     "inelastic collapse stops the clock");
-  if ((s.equilibration_time + s.production_time) / s.checkpoint_interval > 1e6)
-    c.fail("run.checkpoint_interval", "value " + num(s.checkpoint_interval) +
-                                          " makes more than 10^6 checkpoints (and synchronisations) in the run");
-  if (cl.gr_bin * 10 > cl.gr_r_max)
-    c.fail("clusters.gr_bin", "value " + num(cl.gr_bin) +
-                                  " leaves fewer than 10 bins below clusters.gr_r_max = " +
-                                  num(cl.gr_r_max));
-  if (const auto& r = cl.neighbour_cutoffs; !r.empty() && *std::max_element(r.begin(), r.end()) * 3 > m.box_length)
-    c.fail("clusters.neighbour_cutoffs", "the largest cutoff must be under a third of the box side (" +
-                                             num(m.box_length / 3) + ")");
-  if (const auto& p = cl.power_law_sizes; !(p[0] >= 1 && p[0] < p[1]))
-    c.fail("clusters.power_law_sizes", "[" + std::to_string(p[0]) + ", " + std::to_string(p[1]) +
-                                           "] is not allowed; allowed: [lo, hi] with 1 <= lo < hi");
-  // P(dx, t): a message of 2 sets x targets x bins x 24 bytes must stay well
-  // under what survives UDP whole (~200 KB).
-  const size_t targets = dp.lags_tau_alpha.size() + dp.lags.size();
-  const double bins = 2 * dp.x_max / dp.bin_width;
-  if (s.wants("displacement") && targets == 0)
-    c.fail("displacement.lags_tau_alpha", "and displacement.lags are both empty; name at least one lag");
-  if (targets > 16)
-    c.fail("displacement.lags_tau_alpha", "with displacement.lags names " + std::to_string(targets) +
-                                              " lags; at most 16");
-  if (!(bins >= 10 && bins <= 4000))
-    c.fail("displacement.bin_width", "value " + num(dp.bin_width) + " makes " +
-                                         std::to_string(static_cast<long>(bins)) +
-                                         " bins over [-x_max, x_max); allowed: 10 to 4000 bins");
-  else if (targets * dp.bins() > 4096)
-    c.fail("displacement.bin_width", "value " + num(dp.bin_width) + ": " + std::to_string(targets) +
-                                         " lags x " + std::to_string(dp.bins()) +
-                                         " bins is more than 4096 (the message would not survive UDP)");
-  if (s.cage_relative && std::none_of(s.observables.begin(), s.observables.end(), has_cage_relative))
-    c.fail("observables.cage_relative", "is true, but no observable named has a cage-relative version (overlap, "
-                                        "chi4, msd, displacement, s4 and clusters have)");
-  if (const auto& bb = s.bond_breaking; !(bb.a1 > 0 && bb.a2 > bb.a1 && bb.a2 < 10))
-    c.fail("bond_breaking.a2", "with a1 = " + num(bb.a1) + ", a2 = " + num(bb.a2) +
-                                   " is not allowed; allowed: 0 < a1 < a2 < 10 (a bond forms below a1 sigma_ij "
-                                   "and breaks beyond a2 sigma_ij)");
-  if (s.msd.fs_q.size() > 16)
-    c.fail("msd.fs_q", "lists " + std::to_string(s.msd.fs_q.size()) + " wave numbers; at most 16");
-  if (s.observables.empty())
-    c.fail("observables.compute", "is empty; name at least one of the known observables");
+  check_relations(s, c);
   c.throw_if_failed();
   // Sub-box sizes as the grids realise them: no size twice (notes say what
   // was dropped, and which sizes lie far from what was asked).
