@@ -84,7 +84,8 @@ for round in 1 2 3 4; do
     if [[ -n $p ]]; then kill -KILL "$p"; fi
   fi
   set +e; wait $run_pid; rc=$?; set -e
-  cut=$(ls -d "$out"/checkpoints/cut-*/WHOLE 2>/dev/null | tail -1 | sed 's/.*cut-0*\([0-9]*\)\/WHOLE/\1/')
+  # (no whole cut: the run ended before the kill, or its cuts were off; the checks below then say so)
+  cut=$(ls -d "$out"/checkpoints/cut-*/WHOLE 2>/dev/null | tail -1 | sed 's/.*cut-0*\([0-9]*\)\/WHOLE/\1/' || true)
   echo "     round $round: SIGKILL of $v at $t ms: run_scene exit $rc, newest whole cut ${cut:-none}"
 done
 finish_run "$out" || true
