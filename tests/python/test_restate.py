@@ -33,3 +33,26 @@ def test_each_differing_row_is_restated(tmp_path):
     assert "now not judged |" in text
     assert "| gone row | 1.66 ± 0.005; differs (26.6 σ) | — | no such row now |" in text
     assert "3 rows differed; 0 still differ, 2 have another verdict now, 1 have no row now." in text
+
+
+def test_tables_between_say_at_which_step_a_verdict_moved(tmp_path):
+    old = tmp_path / "old.md"
+    old.write_text(OLD, encoding="utf-8")
+    fixed = tmp_path / "fixed.md"   # the errors fixed: d_f' agrees, φ_c not judged
+    fixed.write_text(OLD.replace("| 0.95 ± 0.09 | differs (7.4 σ) |", "| 0.84 ± 0.52 | agrees (1.5 σ) |")
+                        .replace("| differs (40.0 σ); χ²/dof 22 |", "| not judged: χ²/dof 10 |"), encoding="utf-8")
+    seeds = tmp_path / "seeds.md"   # other seeds: d_f' differs again; the gone row has no row there
+    seeds.write_text(OLD.replace("| 0.95 ± 0.09 | differs (7.4 σ) |", "| 0.7 ± 0.2 | differs (4.5 σ) |")
+                        .replace("| gone row |", "| another row |"), encoding="utf-8")
+    rows = [dict(item="d_f'", ours="1.3 ± 0.2", verdict="agrees (1.2 σ)"),
+            dict(item="φ_c (own)", ours="0.801", verdict="not judged: χ²/dof 9"),
+            dict(item="gone row", ours="1.72 ± 0.006", verdict="differs (13.0 σ)")]
+    text = "\n".join(restate(str(old), rows, [("errors fixed", str(fixed)), ("other seeds", str(seeds))]))
+    assert "| result (earlier) | earlier: ours, verdict | errors fixed | other seeds | now: ours, verdict | change |" in text
+    assert ("| d_f' | 0.95 ± 0.09; differs (7.4 σ) | 0.84 ± 0.52; agrees (1.5 σ) | 0.7 ± 0.2; differs (4.5 σ) | "
+            "1.3 ± 0.2; agrees (1.2 σ) | now agrees (agrees at errors fixed, differs at other seeds, agrees at now) |"
+            in text)
+    # the row is not in "other seeds": its column says so, and the verdict compared across the gap
+    assert "| gone row | 1.66 ± 0.005; differs (26.6 σ) | 1.66 ± 0.005; differs (26.6 σ) | — | 1.72 ± 0.006; " \
+           "differs (13.0 σ) | same verdict |" in text
+    assert "now not judged (not judged at errors fixed, differs at other seeds, not judged at now) |" in text

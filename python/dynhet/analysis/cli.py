@@ -62,9 +62,22 @@ def main(argv=None):
                          "studies for every row and fit (the table says which N each density has)")
     ap.add_argument("--restate", metavar="OLD_TABLE",
                     help="an earlier reproduction.md: append, for each row it judged \"differs\", the verdict now")
+    ap.add_argument("--restate-via", action="append", default=[], metavar="LABEL=TABLE",
+                    help="a table made between --restate's and this one (repeatable, in order): a column of its "
+                         "verdicts, and the change column says at which step each verdict moved")
     a = ap.parse_args(argv)
     if a.restate and not os.path.isfile(a.restate):
         raise SystemExit(f"analyse_study: --restate {a.restate}: no such file")
+    via = []
+    for v in a.restate_via:
+        label, eq, path = v.rpartition("=")  # the last "=": a label may hold one (N = 4096)
+        if not eq or not label or not path:
+            raise SystemExit(f"analyse_study: --restate-via {v}: give LABEL=TABLE (e.g. \"other seeds=old.md\")")
+        if not os.path.isfile(path):
+            raise SystemExit(f"analyse_study: --restate-via {v}: no such file {path}")
+        via.append((label, path))
+    if via and not a.restate:
+        raise SystemExit("analyse_study: --restate-via needs --restate (the table the steps start from)")
     t0 = time.time()
     A = Analysis(a.study_dir, a.also)
     if a.largest_n:
@@ -138,9 +151,9 @@ def main(argv=None):
     driving_rows(A)
     write_h5(A, os.path.join(A.dir, "study.h5"))
     cmd = "launch_scripts/analyse_study.sh " + " ".join(argv if argv is not None else sys.argv[1:])
-    write_table(A, os.path.join(A.dir, "reproduction.md"), cmd, a.discussion, a.restate)
+    write_table(A, os.path.join(A.dir, "reproduction.md"), cmd, a.discussion, a.restate, via)
     if a.table:
-        write_table(A, a.table, cmd, a.discussion, a.restate)
+        write_table(A, a.table, cmd, a.discussion, a.restate, via)
     try:
         densities = write_finite_size(A, os.path.join(A.dir, "finite_size.md"), cmd)
         if a.finite_size:

@@ -90,7 +90,7 @@ def hms(s):
     return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
 
 
-def write_table(A, path, command, discussion=None, restate_from=None):
+def write_table(A, path, command, discussion=None, restate_from=None, via=()):
     n_runs = sum(len(p.runs) for p in A.points.values())
     total = sum(A.cpu.values())
     L = ["# The paper from our own runs", "",
@@ -137,7 +137,7 @@ def write_table(A, path, command, discussion=None, restate_from=None):
             cells.append(fmt(m, e))
         L.append(f"| {p.pairs} | {p.eps:g} | {p.phi:g} | {p.N} | {len(p.runs)} | " + " | ".join(cells) + " |")
     if restate_from:
-        L += restate(restate_from, A.rows)
+        L += restate(restate_from, A.rows, via)
     L.append("")
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path + ".tmp", "w") as fh:

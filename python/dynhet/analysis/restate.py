@@ -27,37 +27,74 @@ def _key(item):
 
 def kind(verdict):
     v = verdict.split(" (")[0].split(";")[0].strip()
-    return "not judged" if v.startswith("not judged") else v
+    for k in ("not judged", "not comparable", "not determined"):
+        if v.startswith(k):
+            return k
+    return v
 
 
-def restate(old_path, rows):
+def find(item, table):
+    """The row of `table` ({name: value}) for an earlier row named `item`: the
+    same name, the same without a trailing parenthesis, the shortest name
+    that grew from it (a range or an estimator added), else the closest
+    name; None where none is close."""
+    by_key = {_key(k): k for k in table}
+    name = item if item in table else by_key.get(_key(item))
+    if name is None:
+        longer = sorted((k for k in table if k.startswith(item) or k.startswith(_key(item))), key=len)
+        name = longer[0] if longer else None
+    if name is None:
+        close = difflib.get_close_matches(_key(item), list(by_key), n=1, cutoff=0.75)
+        name = by_key[close[0]] if close else None
+    return None if name is None else table[name]
+
+
+def short(ours, verdict):
+    """A cell of a step: the value (up to its first parenthesis) and the verdict's kind with its sigma."""
+    sig = re.search(r"\(([0-9.]+ σ)\)", verdict)
+    return f"{ours.split(' (')[0]}; {kind(verdict)}" + (f" ({sig.group(1)})" if sig else "")
+
+
+def restate(old_path, rows, via=()):
     """Markdown lines: each row the old table had as "differs", against the
-    row of the same result now (matched by name, ignoring a trailing
-    parenthesis; else the closest name)."""
+    row of the same result now (matched by name: `find`). `via`: [(label,
+    table path)], tables made between the old one and now, in order: each
+    gets a column, and the last column says at which step the verdict
+    changed, so that each change is laid to what the step changed (a
+    method, other seeds, a larger N)."""
     old = read_rows(old_path)
-    now = {r["item"]: r for r in rows}
-    by_key = {_key(k): k for k in now}
+    now = {r["item"]: (r["ours"], r["verdict"]) for r in rows}
+    steps = [(label, read_rows(path)) for label, path in via]
+    head = "| result (earlier) | earlier: ours, verdict | " + "".join(f"{label} | " for label, _ in steps)
     out = ["", f"## Row by row against `{old_path}`", "",
-           "Every row the earlier table judged \"differs\", and what this table says of the same result.", "",
-           "| result (earlier) | earlier: ours, verdict | now: ours, verdict | change |", "|---|---|---|---|"]
+           "Every row the earlier table judged \"differs\", and what this table says of the same result"
+           + (" (and, between them, " + ", ".join(f"`{path}` ({label})" for label, path in via) + ")"
+              if via else "") + ".", "",
+           head + "now: ours, verdict | change |", "|---|---|" + "---|" * len(steps) + "---|---|"]
     n = {"same": 0, "new": 0, "gone": 0}
     for item, (ours, verdict) in old.items():
         if kind(verdict) != "differs":
             continue
-        match = now.get(item) or now.get(by_key.get(_key(item), ""))
-        if match is None:  # a name that grew (a range or an estimator added): the shortest that starts with it
-            longer = sorted((k for k in now if k.startswith(item) or k.startswith(_key(item))), key=len)
-            match = now[longer[0]] if longer else None
+        mids = [find(item, t) for _, t in steps]
+        match = find(item, now)
+        cells = [short(*m) if m else "—" for m in mids]
         if match is None:
-            close = difflib.get_close_matches(_key(item), list(by_key), n=1, cutoff=0.75)
-            match = now[by_key[close[0]]] if close else None
-        if match is None:
-            out.append(f"| {item} | {ours}; {verdict} | — | no such row now |")
+            out.append(f"| {item} | {ours}; {verdict} | " + "".join(c + " | " for c in cells) + "— | no such row now |")
             n["gone"] += 1
             continue
-        change = "same verdict" if kind(match["verdict"]) == "differs" else f"now {kind(match['verdict'])}"
-        n["same" if change == "same verdict" else "new"] += 1
-        out.append(f"| {item} | {ours}; {verdict} | {match['ours']}; {match['verdict']} | {change} |")
+        change = "same verdict" if kind(match[1]) == "differs" else f"now {kind(match[1])}"
+        if steps:  # where the verdict moved: each step whose kind differs from the one before
+            prev, moves = kind(verdict), []
+            for lab, k in zip([label for label, _ in steps] + ["now"],
+                              [kind(m[1]) if m else None for m in mids] + [kind(match[1])]):
+                if k is not None and k != prev:
+                    moves.append(f"{k} at {lab}")
+                    prev = k
+            if moves:
+                change += " (" + ", ".join(moves) + ")"
+        n["same" if kind(match[1]) == "differs" else "new"] += 1
+        out.append(f"| {item} | {ours}; {verdict} | " + "".join(c + " | " for c in cells)
+                   + f"{match[0]}; {match[1]} | {change} |")
     out += ["", f"{n['same'] + n['new'] + n['gone']} rows differed; {n['same']} still differ, {n['new']} have another "
             f"verdict now, {n['gone']} have no row now."]
     return out
