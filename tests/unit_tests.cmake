@@ -1,5 +1,5 @@
 # Unit tests: in-process, no bus.
-foreach(name test_collision test_engine test_scene test_schedule test_chunking test_overlap)
+foreach(name test_collision test_engine test_theory test_scene test_schedule test_chunking test_overlap)
   add_executable(${name} ${CMAKE_CURRENT_SOURCE_DIR}/${name}.cpp)
   target_link_libraries(${name} PRIVATE dynhet_engine dynhet_analysis dynhet_common GTest::gtest_main)
   gtest_discover_tests(${name} DISCOVERY_TIMEOUT 30 PROPERTIES LABELS unit)
