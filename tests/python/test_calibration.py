@@ -94,3 +94,14 @@ def test_a_study_with_too_few_seeds_borrows_the_pooled_ratio():
     assert dof == 12 and math.isclose(k, math.sqrt(3.0))            # all studies together: a's 12 dof
     assert math.isclose(one[0].mean(tau)[1], math.sqrt(3.0))         # its quoted 1, times the pooled ratio
     assert math.isclose(a[0].factor(tau), math.sqrt(3.0))             # a keeps its own
+
+
+def test_a_mean_over_seeds_of_which_some_quote_no_error_takes_the_seeds_spread():
+    # 1000 +- 5 and 2000 without an error: not "1500 +- 5" but the standard
+    # error of the two seeds, 500.
+    p = Point(("neighbours", 0.9, 0.79, 4096))
+    p.runs = [{"seed": 1, "tau": 1000.0, "tau_err": 5.0}, {"seed": 2, "tau": 2000.0, "tau_err": math.nan}]
+    m, e, sem, n = p.mean(tau)
+    assert (m, n) == (1500.0, 2) and math.isclose(sem, 500.0) and math.isclose(e, 500.0)
+    p.runs[1]["tau_err"] = 5.0          # both quote one: the quoted errors combined
+    assert math.isclose(p.mean(tau)[1], math.sqrt(50.0) / 2)

@@ -206,3 +206,67 @@ def test_a_tau_b_error_whose_blocks_cannot_span_it_is_dropped_on_reading(tmp_pat
     assert blocks_span(2 * 263.72614, sch) and not blocks_span(2.01 * 263.72614, sch)
     assert blocks_span(1950.0, (32, 263.72614))           # 8 blocks of 8 origins span it
     assert blocks_span(1950.0, None) and blocks_span(math.nan, sch)   # cannot be told: kept
+
+
+def c_b_run(seed, n, t_max, tau_b=100.0, origins=8, spacing=1000.0):
+    lag = np.geomspace(1.0, t_max, 40)
+    return {"seed": seed, "N": n, "packing_fraction": 0.79,
+            "cut": {0.6: {"tau_alpha": 10.0, "tau_alpha_err": 1.0}},
+            "c_b_lag": lag, "c_b": np.exp(-lag / tau_b), "c_b_err": np.full(40, 0.01),
+            "tau_b": tau_b if t_max > tau_b else math.nan, "tau_b_err": 2.0, "schedule": (origins, spacing)}
+
+
+def test_tau_b_comes_from_the_point_that_followed_c_b_furthest_not_from_the_seeds_that_crossed():
+    from dynhet.analysis.finite_size import bound_conflict, tau_b_bound, tau_b_points
+    A = Analysis.__new__(Analysis)
+    A.dir, A.also = "study", []
+    A.points, A.extra = {}, {}
+    main = Point(("neighbours", 0.9, 0.79, 4096))
+    main.runs = [c_b_run(1, 4096, 200.0, 180.0), c_b_run(2, 4096, 200.0, 190.0), c_b_run(3, 4096, 200.0, 250.0)]
+    early = Point(("neighbours", 0.9, 0.79, 4096))    # the same lags, two seeds that happened to cross early
+    early.runs = [c_b_run(1, 4096, 200.0, 150.0), c_b_run(2, 4096, 200.0, 160.0)]
+    early.study = "early"
+    A.points[main.pairs, main.eps, main.phi, main.N] = main
+    A.extra[("early",) + (early.pairs, early.eps, early.phi, early.N)] = early
+    multi = {0.79: {4096: main}}
+    assert tau_b_points(A, multi)[0.79][4096] is main         # equal reach: the more runs, bound and all
+    assert math.isclose(tau_b_bound(main), (180.0 + 190.0 + 200.0) / 3)
+    longer = Point(("neighbours", 0.9, 0.79, 4096))         # lags 10 times longer: its tau_B is measured
+    longer.runs = [c_b_run(1, 4096, 2000.0, 200.0), c_b_run(2, 4096, 2000.0, 220.0)]
+    longer.study = "longer"
+    A.extra[("longer",) + (longer.pairs, longer.eps, longer.phi, longer.N)] = longer
+    assert tau_b_points(A, multi)[0.79][4096] is longer
+    assert tau_b_bound(longer) is None
+    # a run whose C_B was below 1/e from its first lag gives no bound
+    odd = Point(("neighbours", 0.9, 0.79, 1024))
+    odd.runs = [c_b_run(1, 1024, 200.0, 300.0), c_b_run(2, 1024, 200.0, 0.5)]
+    odd.runs[1]["tau_b"] = math.nan
+    assert tau_b_bound(odd) is None
+    # a bound above the largest measured N's value: the sizes do not agree
+    ms = [(100.0, 2.0, 2.0, 2), (101.0, 2.0, 2.0, 2), (math.nan, math.nan, math.nan, 0)]
+    text = bound_conflict([1024, 4096, 16384], ms, [None, None, 350.0])
+    assert text.startswith("not converged: N = 16384's bound > 350 lies above N = 4096's 101 ± 2")
+    assert bound_conflict([1024, 4096, 16384], ms, [None, None, 102.0]) == ""
+
+
+def test_c_b_keeps_its_quoted_error_only_where_origin_blocks_span_the_lag():
+    from dynhet.analysis.finite_size import c_b_at
+    fn = c_b_at(((0.79, 60.0),))
+    v, e = fn(c_b_run(1, 4096, 1000.0, spacing=1000.0))     # 60 within one spacing: blocks span it
+    assert abs(v - math.exp(-0.6)) < 2e-3 and 0.01 <= e < 0.02
+    v, e = fn(c_b_run(1, 4096, 1000.0, spacing=20.0))       # 3 spacings, blocks of 2 origins: no error
+    assert abs(v - math.exp(-0.6)) < 2e-3 and math.isnan(e)
+
+
+def test_a_whole_box_xi_or_chi0_without_a_value_says_why():
+    from dynhet.analysis.finite_size import s4_reason
+    L = 100.0
+    resolved, few = {"cut": {0.6: s4_cut(2.0, L)}}, {"cut": {0.6: s4_cut(4.0, L)}}
+    refused, tiny = {"cut": {0.6: s4_cut(math.nan, L)}}, {"cut": {0.6: s4_cut(0.2, L)}}
+    assert s4_reason(resolved, False, "xi") is None
+    assert s4_reason(few, False, "xi") == "not resolved"        # 3 shells below q xi = 1
+    assert s4_reason(refused, False, "xi") == "no OZ fit" == s4_reason(refused, False, "chi0")
+    assert s4_reason(tiny, False, "xi") == "ξ < 0.3"
+    unreached = {"cut": {0.6: dict(s4_cut(2.0, L), tau_alpha=math.nan)}}
+    assert s4_reason(unreached, False, "xi") == "τ_α not reached"
+    assert s4_reason({"cut": {0.6: {"tau_alpha": 1.0}}}, False, "xi") is None   # no S4 measured

@@ -56,3 +56,21 @@ def test_tables_between_say_at_which_step_a_verdict_moved(tmp_path):
     assert "| gone row | 1.66 ± 0.005; differs (26.6 σ) | 1.66 ± 0.005; differs (26.6 σ) | — | 1.72 ± 0.006; " \
            "differs (13.0 σ) | same verdict |" in text
     assert "now not judged (not judged at errors fixed, differs at other seeds, not judged at now) |" in text
+
+
+def test_restate_via_takes_label_equals_table_and_names_what_is_wrong(tmp_path, capsys):
+    import pytest
+    from dynhet.analysis.cli import main
+    old = tmp_path / "old.md"
+    old.write_text(OLD, encoding="utf-8")
+    study = str(tmp_path / "no-study")
+    for args, says in ((["--restate-via", "errors fixed (N = 4096)=" + str(old)], "needs --restate"),
+                       (["--restate", str(old), "--restate-via", str(old)], "give LABEL=TABLE"),
+                       (["--restate", str(old), "--restate-via", "x (N = 4096)=missing.md"], "no such file missing.md")):
+        with pytest.raises(SystemExit) as e:
+            main([study] + args)
+        assert says in str(e.value)
+    # a label holding "=" is split at the last one: the file is found, and the study is next to be read
+    with pytest.raises(SystemExit) as e:
+        main([study, "--restate", str(old), "--restate-via", "errors fixed (N = 4096)=" + str(old)])
+    assert "does not exist" in str(e.value) and "no-study" in str(e.value)

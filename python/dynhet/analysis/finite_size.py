@@ -13,6 +13,7 @@ import numpy as np
 from .config import A_MAIN, EPS_MAIN
 from .plotting import colours, errorbar
 from .quantities import PER_RUN, XI_MIN, chi0_at_tau, kappa_of, whole_box_s4
+from .runs import blocks_span
 from .points import MIN_CAL_DOF, ensure_calibrated, spread_ratio as pooled_spread
 from .size import points_by_phi_n
 from .verdicts import fmt
@@ -104,14 +105,19 @@ def tau_b_of(r, cr=False):
 
 def c_b_at(times):
     """C_B(t), the fraction of bonds intact (bond breaking), at a fixed time
-    per density, interpolated in ln t, with the run's quoted error (jackknife
-    over origin blocks) and the interpolation's in quadrature. `times` is
-    ((phi, t), ...); NaN beyond a run's lags."""
+    per density, interpolated in ln t. Its error: the run's quoted one (the
+    standard error over origins, taken as independent) and the
+    interpolation's in quadrature, but only where jackknife blocks of origins
+    spanning t fit four times into the run's origins (runs.blocks_span, the
+    nodes' rule); else none, and the point takes its seeds' spread. `times`
+    is ((phi, t), ...); NaN beyond a run's lags."""
     at = dict(times)
 
     def fn(r, cr=False):
         t = at.get(round(float(r["packing_fraction"]), 6), math.nan)
         v, ie = interp_ln_t(r["c_b_lag"], r["c_b"], t)
+        if not blocks_span(t, r.get("schedule")):
+            return v, math.nan
         e, _ = interp_ln_t(r["c_b_lag"], r["c_b_err"], t)
         return v, math.hypot(e, ie if np.isfinite(ie) else 0.0)
     return fn
@@ -161,10 +167,18 @@ def tau_b_bound(p):
         tb = r.get("tau_b", math.nan)
         if np.isfinite(tb):
             vals.append(tb)
-        else:
+        elif beyond_lags(r):
             vals.append(float(lag[-1]))
             short = True
+        else:  # no tau_B for another reason (C_B below 1/e at the first lag): no bound either
+            return None
     return float(np.mean(vals)) if short else None
+
+
+def beyond_lags(r):
+    """Whether a run's C_B stayed above 1/e to its last lag (tau_B beyond it)."""
+    cb = r.get("c_b")
+    return cb is not None and len(cb) > 0 and np.isfinite(cb[-1]) and cb[-1] > math.exp(-1)
 
 
 def missing_cell(slug, p, cr):
@@ -175,12 +189,39 @@ def missing_cell(slug, p, cr):
     if slug == "tau_b":
         b = tau_b_bound(p)
         if b is not None:
-            n = sum(1 for r in p.runs if not np.isfinite(r.get("tau_b", math.nan)) and len(r.get("c_b_lag", ())))
-            return f"> {b:.3g} ({n} of {len(p.runs)} seeds: C_B > 1/e at the last lag)"
-    if slug in ("xi", "chi0") and any(len(cutx(r, cr).get("xi_t", ())) for r in p.runs if A_MAIN in r.get(
-            "cut_cr" if cr else "cut", {})):
-        return "not resolved"
+            measured = [r for r in p.runs if len(r.get("c_b_lag", ()))]
+            n = sum(1 for r in measured if not np.isfinite(r.get("tau_b", math.nan)))
+            return f"> {b:.3g} ({n} of {len(measured)} seeds: C_B > 1/e at the last lag)"
+    if slug in ("xi", "chi0"):
+        why = sorted({s4_reason(r, cr, slug) for r in p.runs} - {None})
+        return " / ".join(why) if why else None
     return None
+
+
+def s4_reason(r, cr, slug):
+    """Why a run has no whole-box xi (or chi0) at tau_alpha: "τ_α not
+    reached", "no OZ fit" (the S4 node refused its fit at that lag: xi beyond
+    the box, below the q range, or its jackknife error not below xi), "ξ <
+    0.3" (not determined), "not resolved" (fewer than MIN_SHELLS q shells
+    below q xi = 1); None where it has one, or no S4."""
+    try:
+        c = cutx(r, cr)
+        if not len(c.get("xi_t", ())):
+            return None
+        t = c["tau_alpha"]
+        if not np.isfinite(t):
+            return "τ_α not reached"
+        g = whole_box_s4(c)
+        xi = np.interp(math.log(t), np.log(c["s4_lag"]), c["xi_t"][:, g])
+        if not np.isfinite(xi):
+            return "no OZ fit"
+        if slug == "chi0":
+            return None
+        if xi < XI_MIN:
+            return f"ξ < {XI_MIN:g}"
+        return "not resolved" if xi_shells(r, cr)[2] < MIN_SHELLS else None
+    except (KeyError, TypeError, IndexError, ValueError):
+        return None
 
 
 def size_verdict(ns, vals, errs):
@@ -279,27 +320,48 @@ def quantity_rows(d, fn, cr, ns=None, slug=None):
     return ns, ms, verdict
 
 
-def reached_tau_b(p):
-    return bool(p.runs) and all(np.isfinite(r.get("tau_b", math.nan)) for r in p.runs)
+def c_b_reach(p):
+    """The longest lag every run of a point followed C_B to (0 without bond breaking)."""
+    lags = [float(r["c_b_lag"][-1]) for r in p.runs if len(r.get("c_b_lag", ()))]
+    return min(lags) if lags and len(lags) == len(p.runs) else 0.0
 
 
 def tau_b_points(A, multi):
-    """{phi: {N: Point}} for the tau_B rows: at each density and N the point
-    (of this study or an --also study) every run of which saw C_B fall to
-    1/e, most runs first; else the report's own point (whose cell then gives
-    the bound). Studies with longer lags (studies/cage_bonds.toml) thus give
-    tau_B where the main runs stop short of it."""
+    """{phi: {N: Point}} for the tau_B rows: at each density and N the point,
+    of this study or an --also study, that followed C_B furthest (the
+    longest lags every run of it reached; then the most runs), chosen by
+    its protocol, never by whether its seeds saw C_B fall to 1/e (that would
+    pick the seeds that crossed early). Studies with longer lags
+    (studies/cage_bonds.toml) thus give tau_B where the main runs stop short
+    of it; where the chosen point's seeds did not all reach it, its cell is
+    the bound."""
     out = {}
     for phi, d in multi.items():
         dd = dict(d)
         for p in list(A.points.values()) + list(A.extra.values()):
-            if p.phi != phi or p.pairs != "neighbours" or abs(p.eps - EPS_MAIN) > 1e-9 or not reached_tau_b(p):
+            if p.phi != phi or p.pairs != "neighbours" or abs(p.eps - EPS_MAIN) > 1e-9 or not c_b_reach(p):
                 continue
             q = dd.get(p.N)
-            if q is None or not reached_tau_b(q) or len(p.runs) > len(q.runs):
+            if q is None or (c_b_reach(p), len(p.runs)) > (c_b_reach(q), len(q.runs)):
                 dd[p.N] = p
         out[phi] = dd
     return out
+
+
+def bound_conflict(ns, ms, bounds):
+    """Where a size's tau_B is only a bound and the bound lies above the
+    largest measured N's value by more than Z_CONVERGED of its errors, the
+    sizes do not agree whatever the verdict over the measured ones says:
+    the text saying so, else ""."""
+    d = [(n, m[0], measured_error(m)) for n, m in zip(ns, ms) if np.isfinite(m[0]) and np.isfinite(measured_error(m))]
+    if not d:
+        return ""
+    nmax, vmax, emax = max(d)
+    over = [(n, b) for n, b in zip(ns, bounds) if b is not None and b > vmax + Z_CONVERGED * emax]
+    if not over:
+        return ""
+    return ("not converged: " + ", ".join(f"N = {n}'s bound > {b:.3g}" for n, b in over)
+            + f" lies above N = {nmax}'s {fmt(vmax, emax)}")
 
 
 def lags_in_tau_cr(d, ns):
@@ -353,13 +415,16 @@ def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr):
     return A.save(fig, f"fs_{slug}.png")
 
 
-def calibration_note(A, multi, multi_cr):
+def calibration_note(A, multi, multi_cr, multi_tb=None):
     """The factors by which each quantity's quoted errors are scaled
     (points.calibration, pooled over each study's points)."""
     ensure_calibrated(list(A.points.values()) + list(A.extra.values()))
-    pops = {id(p.population): p.population for src in (multi, multi_cr) for d in src.values() for p in d.values()}
+    def populations(*sources):
+        return {id(p.population): p.population for src in sources for d in src.values() for p in d.values()}
+    main_pops, tb_pops = populations(multi, multi_cr), populations(multi, multi_tb or {})
     applied = []
     for name, slug, fn, has_cr_version, _ in quantities(multi):
+        pops = tb_pops if slug == "tau_b" else main_pops   # the tau_B rows may take another study's points
         for cr in ((False, True) if has_cr_version else (False,)):
             f = lambda run: fn(run, cr)  # noqa: E731
             groups = {}   # (factor, ratio, uncertainty, dof, borrowed) -> the studies
@@ -370,7 +435,7 @@ def calibration_note(A, multi, multi_cr):
                     groups.setdefault((k, r, u, dof, borrowed), []).append(pop.name or os.path.basename(A.dir))
             for (k, r, u, dof, borrowed), names in groups.items():
                 where = ""
-                if len(pops) > 1:
+                if len(main_pops) > 1 or len(tb_pops) > 1:
                     where = f", {'studies' if len(names) > 1 else 'study'} {', '.join(sorted(names))}"
                     where += " (too few seeds of their own: pooled over all studies)" if borrowed else ""
                 applied.append(f"{name}{' — cage-relative' if cr else ''} × {k:.2f} (ratio {r:.2f} ± {u:.2f}, "
@@ -402,15 +467,16 @@ def write_finite_size(A, path, command):
          f"N's within {Z_CONVERGED:g} combined errors; otherwise **drifting**, with the change per doubling of N "
          f"between the two largest sizes. χ4^P is the peak of χ4(t) of sub-boxes of about that many particles "
          f"(interior peaks only); ξ is the whole box's Ornstein-Zernike ξ at τ_α, taken only where at least "
-         f"{MIN_SHELLS} q shells lie below q ξ = 1 (else \"not resolved\" at this N); [k q]: the shells below "
+         f"{MIN_SHELLS} q shells lie below q ξ = 1 (else \"not resolved\" at this N; \"no OZ fit\": the S4 node refused the fit at τ_α, for ξ beyond the "
+         f"box, below the q range, or with a jackknife error not below ξ); [k q]: the shells below "
          f"q ξ = 1 of its runs (the range over seeds), which are the q points its OZ fit ran over (the S4 node "
          f"fits over q ξ ≤ 1, and over the 3 smallest q where fewer lie there). a = {A_MAIN}, ε = 0.9, "
          f"neighbour kick pairs. Nothing here is tuned toward the paper's numbers.", ""]
     if not multi:
         L += ["No density was run at more than one N.", ""]
-    L += calibration_note(A, multi, multi_cr)
-    rows, cb_at = quantities(multi), c_b_times(multi)
     multi_tb = tau_b_points(A, multi)
+    L += calibration_note(A, multi, multi_cr, multi_tb)
+    rows, cb_at = quantities(multi), c_b_times(multi)
     figures = []
     for phi, d in multi.items():
         ns = sorted(d)
@@ -428,7 +494,9 @@ def write_finite_size(A, path, command):
                     continue
                 if not any(np.isfinite(m[0]) for m in ms):
                     text = ("not reached at any N: C_B stays above 1/e over the runs' lags" if slug == "tau_b"
-                            else "not resolved at any N")
+                            else "no value at any N")
+                elif slug == "tau_b":
+                    text = bound_conflict(qn, ms, [tau_b_bound(dd[n]) if n in dd else None for n in qn]) or text
                 label = name + (" — cage-relative" if cr else "")
                 if slug == "c_b":
                     label = f"C_B at t = {dict(cb_at).get(round(float(phi), 6), math.nan):.4g} (bond breaking)"

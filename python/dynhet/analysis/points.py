@@ -137,7 +137,11 @@ class Point:
         if not vals:
             return math.nan, math.nan, math.nan, 0
         m, sem, n = sf.seed_mean([v for _, v, _ in vals])
-        q = sf.quoted_mean_error([e for _, _, e in vals])
+        # The runs' quoted errors only where every seed quotes one: a mean
+        # over seeds of which some quote none has no quoted error (the
+        # others' would claim it), and takes the seeds' spread.
+        quoted = all(np.isfinite(e) and e > 0 for _, _, e in vals)
+        q = sf.quoted_mean_error([e for _, _, e in vals]) if quoted else math.nan
         err = q * self.factor(fn) if np.isfinite(q) else sem
         return m, err, sem, n
 

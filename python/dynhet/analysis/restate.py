@@ -33,17 +33,17 @@ def kind(verdict):
     return v
 
 
-def find(item, table):
+def find(item, table, fuzzy=True):
     """The row of `table` ({name: value}) for an earlier row named `item`: the
     same name, the same without a trailing parenthesis, the shortest name
-    that grew from it (a range or an estimator added), else the closest
-    name; None where none is close."""
+    that grew from it (a range or an estimator added), else (fuzzy) the
+    closest name; None where none is close."""
     by_key = {_key(k): k for k in table}
     name = item if item in table else by_key.get(_key(item))
     if name is None:
         longer = sorted((k for k in table if k.startswith(item) or k.startswith(_key(item))), key=len)
         name = longer[0] if longer else None
-    if name is None:
+    if name is None and fuzzy:
         close = difflib.get_close_matches(_key(item), list(by_key), n=1, cutoff=0.75)
         name = by_key[close[0]] if close else None
     return None if name is None else table[name]
@@ -75,7 +75,7 @@ def restate(old_path, rows, via=()):
     for item, (ours, verdict) in old.items():
         if kind(verdict) != "differs":
             continue
-        mids = [find(item, t) for _, t in steps]
+        mids = [find(item, t, fuzzy=False) for _, t in steps]  # a step without the row says "—", never another row
         match = find(item, now)
         cells = [short(*m) if m else "—" for m in mids]
         if match is None:

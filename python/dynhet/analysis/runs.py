@@ -17,7 +17,7 @@ def fnum(v):
     return float(v) if v is not None else math.nan
 
 
-MIN_JACKKNIFE_BLOCKS = 4   # kMinJackknifeBlocks of analysis_nodes/kernels/fits.hpp
+MIN_JACKKNIFE_BLOCKS = 4   # kMinJackknifeBlocks of analysis_nodes/kernels/include/dynhet/analysis/fits.hpp
 
 
 def run_schedule(path):
@@ -110,6 +110,7 @@ def read_run(path, meta):
         obs = run.observables()
         r["N"] = int(meta["n_particles"])
         r["cut"] = read_cutoffs(run)
+        r["schedule"] = run_schedule(path)
         # The same of the cage-relative displacements (observables.cage_relative),
         # and their tau_alpha beside the standard one.
         r["cut_cr"] = read_cutoffs(run, "_cr")
@@ -132,7 +133,7 @@ def read_run(path, meta):
         if "bond_breaking" in obs:
             b = run.observable("bond_breaking")
             r["tau_b"], r["tau_b_err"] = fnum(last(b, "tau_b")), fnum(last(b, "tau_b_err"))
-            if not blocks_span(r["tau_b"], run_schedule(path)):
+            if not blocks_span(r["tau_b"], r["schedule"]):
                 r["tau_b_err"] = math.nan  # a run recorded before the node applied the same rule
             r["c_b_lag"], r["c_b"] = b["lag_time"][:], last(b, "c_b")
             r["c_b_err"] = last(b, "c_b_err") if "c_b_err" in b else np.full(len(r["c_b"]), np.nan)
