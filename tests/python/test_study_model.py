@@ -1,6 +1,7 @@
 """dynhet.study.model on study files written here: the points of the
 series with their overrides, each run's scene with run lengths in units of
 its tau_alpha, and every problem of a bad file named at once."""
+import math
 import os
 
 import pytest
@@ -127,3 +128,31 @@ def test_the_executors_take_the_longest_run_first(tmp_path):
     sd.claim()
     order = run_order(sd, sd.study.points(), est)
     assert [p["packing_fraction"] for p in order[:2]] == [0.6, 0.6]
+
+
+def test_a_size_not_yet_piloted_is_estimated_from_the_pilots_of_the_same_system(tmp_path):
+    # A pilot runs min(N, pilot_particles) particles: the pilots of N = 4096
+    # and 16384 ran the same 2048-particle system as N = 65536's will, so
+    # the dry run estimates 65536 from them (times the pilot margin the run
+    # will take), not from tau_guess; a pilot of N = 1024 (1024 particles)
+    # does not count.
+    from dynhet.study.index import plan
+    from dynhet.study.rundir import StudyDir, write_status
+    text = GOOD.replace("packing_fraction = [0.60, 0.70]\n", "packing_fraction = [0.60, 0.70]\nn_particles = [65536]\n") \
+               .replace("lag_max_tau = 30.0", "lag_max_tau = 30.0\ntau_guess = [[0.6, 1.0], [0.7, 1.0]]")
+    sd = StudyDir(study(tmp_path, text), str(tmp_path / "out"))
+    sd.claim()
+    p = [q for q in sd.study.points() if q["packing_fraction"] == 0.7 and q["restitution"] == 0.9][0]
+    assert p["n_particles"] == 65536 and sd.study.run_length["pilot_particles"] == 2048
+    assert sd.guess(p) == (1.0, "the study's tau_guess")
+    for name, n, phi, tau in (("a", 4096, 0.6, 2.0), ("b", 16384, 0.7, 8.0), ("c", 1024, 0.7, 100.0)):
+        d = tmp_path / "out" / "pilots" / name
+        d.mkdir(parents=True)
+        write_status(str(d), {"state": "complete", "tau_alpha": tau, "packing_fraction": phi,
+                              "series": [0.9, "neighbours", n]})
+    got = sd.finished_taus(p)
+    assert [ph for ph, _ in got] == [0.6, 0.7] and math.isclose(got[0][1], 2.0) and math.isclose(got[1][1], 8.0)
+    tau, src = sd.guess(p)
+    assert math.isclose(tau, 8.0) and src == "interpolated from finished points"
+    row = [r for r in plan(sd) if r[0] == p][0]
+    assert math.isclose(row[2], 8.0 * 1.2) and row[3].startswith("guess: interpolated from finished points x 1.2")

@@ -38,7 +38,11 @@ def plan(sd):
             tau, src = st["tau_estimate"], st.get("tau_source", "?")
         else:
             tau, src = sd.guess(p)
-            src = f"guess: {src}" + ("; a pilot will measure it" if sd.study.run_length["tau_alpha"] == "pilot" else "")
+            src = f"guess: {src}"
+            if sd.study.run_length["tau_alpha"] == "pilot":  # the run will take its pilot's tau times the margin
+                m = sd.study.run_length["pilot_margin"]
+                tau *= m
+                src += f" x {m:g}; a pilot will measure it" if m != 1.0 else "; a pilot will measure it"
         out.append((p, sd.study.scene(p, tau), tau, src, st.get("state", "pending")))
     return out
 

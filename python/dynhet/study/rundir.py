@@ -82,9 +82,15 @@ class StudyDir:
         return os.path.join(self.runs_dir, self.study.run_name(p))
 
     def finished_taus(self, p):
-        """(phi, tau_alpha) of complete runs and pilots of p's series."""
+        """(phi, tau_alpha) of complete runs and pilots of p's series; the
+        pilots of another N count where they ran the same system (a pilot
+        runs min(N, run_length.pilot_particles) particles), so that a size
+        not yet piloted is estimated from its density's pilots, not from the
+        study's tau_guess alone."""
         pts = []
         key = self.study.series_key(p)
+        pp = self.study.run_length.get("pilot_particles", 0)
+        pilot_n = min(key[2], pp) if pp else key[2]
         for q in self.study.points():
             if self.study.series_key(q) != key:
                 continue
@@ -95,8 +101,9 @@ class StudyDir:
         if os.path.isdir(pdir):
             for name in os.listdir(pdir):
                 st = read_status(os.path.join(pdir, name))
-                if st.get("state") == "complete" and tuple(st.get("series", [])) == (
-                        key[0], key[1], key[2]):
+                ser = tuple(st.get("series", []))
+                if st.get("state") == "complete" and len(ser) == 3 and ser[:2] == (key[0], key[1]) and (
+                        ser[2] == key[2] or (pp and min(ser[2], pp) == pilot_n)):
                     pts.append((st["packing_fraction"], st["tau_alpha"]))
         by_phi = {}
         for ph, t in pts:
