@@ -270,3 +270,25 @@ def test_a_whole_box_xi_or_chi0_without_a_value_says_why():
     unreached = {"cut": {0.6: dict(s4_cut(2.0, L), tau_alpha=math.nan)}}
     assert s4_reason(unreached, False, "xi") == "τ_α not reached"
     assert s4_reason({"cut": {0.6: {"tau_alpha": 1.0}}}, False, "xi") is None   # no S4 measured
+
+
+def test_s4_of_every_n_is_drawn_standard_and_cage_relative(tmp_path):
+    from dynhet.analysis.finite_size import plot_s4_q
+    A = Analysis.__new__(Analysis)
+    A.dir, A.figdir = str(tmp_path), str(tmp_path / "figures")
+    multi, multi_cr = {0.79: {}}, {0.79: {}}
+    for n, L in ((1024, 50.0), (4096, 100.0)):
+        p = Point(("neighbours", 0.9, 0.79, n))
+        for seed in (1, 2):
+            c = dict(s4_cut(3.0, L), tau_alpha_err=0.5)
+            q = c["s4_q"]
+            c["s4_t"] = np.tile(4.0 / (1 + (3.0 * q) ** 2), (3, 1))   # OZ at every lag
+            p.runs.append({"seed": seed, "N": n, "cut": {0.6: c}, "cut_cr": {0.6: dict(c)}})
+        multi[0.79][n] = multi_cr[0.79][n] = p
+    f = plot_s4_q(A, multi, multi_cr)
+    assert f.endswith("fs_s4_q.png") and (tmp_path / "figures" / "fs_s4_q.png").stat().st_size > 5000
+    # no S4 in any run: no figure
+    for p in multi[0.79].values():
+        for r in p.runs:
+            r["cut"] = r["cut_cr"] = {0.6: {"tau_alpha": 10.0}}
+    assert plot_s4_q(A, multi, multi_cr) == ""
