@@ -156,3 +156,22 @@ def test_a_size_not_yet_piloted_is_estimated_from_the_pilots_of_the_same_system(
     assert math.isclose(tau, 8.0) and src == "interpolated from finished points"
     row = [r for r in plan(sd) if r[0] == p][0]
     assert math.isclose(row[2], 8.0 * 1.2) and row[3].startswith("guess: interpolated from finished points x 1.2")
+
+
+def test_a_running_run_is_described_from_its_sims_last_progress_line(tmp_path):
+    from dynhet.study.progress import describe, sim_progress
+    d = tmp_path / "run"
+    d.mkdir()
+    assert sim_progress(str(d)) is None and "starting" in describe("r", str(d))
+    (d / "sim_node.log").write_text(
+        "sim_node: run 1\n"
+        "[equilibrate] t=1836      /1.989e+04  phi=0.8000  coll/s=7.91e+05  T=0.8661  Z=30.06  frames 0/212  ETA 10:06:45\n"
+        "sim_node: checkpoint: cut 2725 after frame 90 at t=27260 (sim part 0.9 MB in 0.00 s)\n"
+        "\r[production ] t=2.726e+04 /4.177e+04  phi=0.8000  coll/s=1.27e+06  T=0.8705  Z=29.37  frames 91/212  "
+        "ETA 0:33:52   \r[production ] t=2.73e+04 /4.177e+04  phi=0.8000  coll/s=1.2e+06  T=0.87  Z=29.4  "
+        "frames 92/212  ETA 0:33:10   ")
+    p = sim_progress(str(d))
+    assert p == {"phase": "production", "t": 27300.0, "end": 41770.0, "frames": 92, "frames_total": 212,
+                 "eta": "0:33:10"}
+    assert describe("r", str(d)) == ("  r: production t = 2.73e+04 of 4.177e+04 (65% of the phase), frames 92/212, "
+                                     "the sim's ETA 0:33:10")

@@ -12,6 +12,7 @@ from .rundir import read_status, write_status
 from .children import STOPPING, stop_children
 from .runner import do_run
 from .index import run_estimates, run_order, write_index
+from .progress import PROGRESS_EVERY, describe
 
 
 def run_local(sd, jobs):
@@ -23,7 +24,8 @@ def run_local(sd, jobs):
     est = run_estimates(sd)
     todo = run_order(sd, todo, est)
     lock = threading.Lock()
-    state = {"done": done0, "failed": 0, "running": 0, "left": len(todo), "cpu_done": 0.0, "est_done": 0.0}
+    state = {"done": done0, "failed": 0, "running": 0, "left": len(todo), "cpu_done": 0.0, "est_done": 0.0,
+             "active": {}}
     queue = list(todo)
     failures = []
     t_start = time.time()
@@ -50,6 +52,8 @@ def run_local(sd, jobs):
                 state["left"] -= 1
                 state["running"] += 1
             name = sd.study.run_name(p)
+            with lock:
+                state["active"][name] = sd.run_dir(p)
             try:
                 st = do_run(sd, p, say)
             except StudyError as e:
@@ -65,6 +69,7 @@ def run_local(sd, jobs):
                 st = {"state": "failed", "message": f"{type(e).__name__}: {e}"}
                 write_status(sd.run_dir(p), dict(st, **{a: p[a] for a in AXES}))
             with lock:
+                state["active"].pop(name, None)
                 state["running"] -= 1
                 if st.get("state") == "complete":
                     state["done"] += 1
@@ -86,8 +91,16 @@ def run_local(sd, jobs):
     for t in threads:
         t.start()
     try:
+        last = time.time()
         while any(t.is_alive() for t in threads):
             time.sleep(0.5)
+            if time.time() - last >= PROGRESS_EVERY:  # runs of hours: say where each stands
+                last = time.time()
+                progress()
+                with lock:
+                    active = sorted(state["active"].items())
+                for name, d in active:
+                    say(describe(name, d))
     except KeyboardInterrupt:
         say(f"study {sd.study.name}: stopping the runs (each writes a checkpoint)")
         stop_children()

@@ -1,0 +1,41 @@
+"""What a running run is doing, from its sim's own progress line (sim_node's
+reporter: "[phase] t=T /END ... frames F/M  ETA h:mm:ss"), for the study's
+periodic progress lines: a run of hours otherwise says nothing until it ends."""
+import os
+import re
+
+LINE = re.compile(r"\[(\w+)\s*\] t=(\S+)\s*/(\S+)\s+phi=.*?frames (\d+)/(\d+)\s+ETA (\S+)")
+PROGRESS_EVERY = 600.0   # seconds between the study's progress lines while runs go on
+
+
+def sim_progress(run_dir, tail_bytes=8192):
+    """The run's last sim progress line as a dict (phase, t, end, frames,
+    frames_total, eta), from the end of run_dir/sim_node.log; None without
+    one (a run still in its pilot or its prepared state, or not started)."""
+    try:
+        with open(os.path.join(run_dir, "sim_node.log"), "rb") as f:
+            f.seek(0, os.SEEK_END)
+            f.seek(max(0, f.tell() - tail_bytes))
+            text = f.read().decode("utf-8", "replace")
+    except OSError:
+        return None
+    for line in reversed(re.split(r"[\r\n]", text)):  # a terminal's lines end in \r, a log's in \n
+        m = LINE.search(line)
+        if m:
+            try:
+                t, end = float(m.group(2)), float(m.group(3))
+            except ValueError:
+                continue
+            return {"phase": m.group(1), "t": t, "end": end, "frames": int(m.group(4)),
+                    "frames_total": int(m.group(5)), "eta": m.group(6)}
+    return None
+
+
+def describe(name, run_dir):
+    """One line of a running run: its phase, how far in simulated time, frames and the sim's ETA."""
+    p = sim_progress(run_dir)
+    if p is None:
+        return f"  {name}: starting (a pilot, a prepared state, or the sim's first line)"
+    share = f" ({100 * p['t'] / p['end']:.0f}% of the phase)" if p["end"] > 0 else ""
+    return (f"  {name}: {p['phase']} t = {p['t']:.4g} of {p['end']:.4g}{share}, frames {p['frames']}/"
+            f"{p['frames_total']}, the sim's ETA {p['eta']}")
