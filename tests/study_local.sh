@@ -15,8 +15,12 @@ study=(bash "$root/launch_scripts/run_study.sh" --no-build)
 fail=0
 check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
 
-"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/a" --jobs 2 >"$tmp/a.out" 2>&1 || { cat "$tmp/a.out"; exit 1; }
+DYNHET_STUDY_PROGRESS_EVERY=1 "${study[@]}" "$root/studies/tiny.toml" --out "$tmp/a" --jobs 2 >"$tmp/a.out" 2>&1 ||
+  { cat "$tmp/a.out"; exit 1; }
 check 'grep -q "4 of 4 runs complete, 0 failed" "$tmp/a.out"' "tiny study: 4 of 4 runs complete"
+# Progress while runs go on (every second here): a line per running run, from its sim's own progress line.
+check 'grep -Eq "^  phi0\.[0-9]+_eps0\.900_n300_seed[12]: (equilibrate|production|done) t = .* of the phase\), frames [0-9]+/[0-9]+, the sim.s ETA" "$tmp/a.out"' \
+  "progress lines name each running run's phase, time, frames and ETA"
 # Every run's schedule came from a pilot's tau_alpha (or, if the run came out
 # too short for it, from 1.3 times the run's own), and is long enough for
 # the tau_alpha it measured: equilibration 10 estimates >= 9 tau_alpha.

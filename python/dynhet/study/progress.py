@@ -5,7 +5,9 @@ import os
 import re
 
 LINE = re.compile(r"\[(\w+)\s*\] t=(\S+)\s*/(\S+)\s+phi=.*?frames (\d+)/(\d+)\s+ETA (\S+)")
-PROGRESS_EVERY = 600.0   # seconds between the study's progress lines while runs go on
+# Seconds between the study's progress lines while runs go on
+# (DYNHET_STUDY_PROGRESS_EVERY: the tests' shorter interval).
+PROGRESS_EVERY = float(os.environ.get("DYNHET_STUDY_PROGRESS_EVERY", "600"))
 
 
 def sim_progress(run_dir, tail_bytes=8192):
