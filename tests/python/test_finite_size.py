@@ -8,7 +8,8 @@ import numpy as np
 
 matplotlib.use("Agg")
 
-from dynhet.analysis.finite_size import MIN_SHELLS, size_verdict, spread_ratio, write_finite_size, xi_shells  # noqa: E402
+from dynhet.analysis.finite_size import size_verdict, spread_ratio, write_finite_size  # noqa: E402
+from dynhet.analysis.size_rows import MIN_SHELLS, xi_shells  # noqa: E402
 from dynhet.analysis.points import Point  # noqa: E402
 from dynhet.analysis.study import Analysis  # noqa: E402
 
@@ -144,7 +145,7 @@ def test_errors_are_scaled_to_the_seeds_spread_when_it_is_larger(tmp_path):
 
 
 def test_xi_cells_say_how_many_q_shells_their_fits_had():
-    from dynhet.analysis.finite_size import shells_note
+    from dynhet.analysis.size_rows import shells_note
     p = Point(("neighbours", 0.9, 0.79, 4096))
     p.runs = [{"seed": 1, "cut": {0.6: s4_cut(2.0, 100.0)}}, {"seed": 2, "cut": {0.6: s4_cut(4.0, 100.0)}}]
     assert shells_note(p, False) == " [3-7 q]"  # xi = 2: 7 shells below q xi = 1; xi = 4: 3
@@ -217,7 +218,8 @@ def c_b_run(seed, n, t_max, tau_b=100.0, origins=8, spacing=1000.0):
 
 
 def test_tau_b_comes_from_the_point_that_followed_c_b_furthest_not_from_the_seeds_that_crossed():
-    from dynhet.analysis.finite_size import bound_conflict, tau_b_bound, tau_b_points
+    from dynhet.analysis.finite_size import bound_conflict
+    from dynhet.analysis.size_rows import tau_b_bound, tau_b_points
     A = Analysis.__new__(Analysis)
     A.dir, A.also = "study", []
     A.points, A.extra = {}, {}
@@ -250,7 +252,7 @@ def test_tau_b_comes_from_the_point_that_followed_c_b_furthest_not_from_the_seed
 
 
 def test_c_b_keeps_its_quoted_error_only_where_origin_blocks_span_the_lag():
-    from dynhet.analysis.finite_size import c_b_at
+    from dynhet.analysis.size_rows import c_b_at
     fn = c_b_at(((0.79, 60.0),))
     v, e = fn(c_b_run(1, 4096, 1000.0, spacing=1000.0))     # 60 within one spacing: blocks span it
     assert abs(v - math.exp(-0.6)) < 2e-3 and 0.01 <= e < 0.02
@@ -259,7 +261,7 @@ def test_c_b_keeps_its_quoted_error_only_where_origin_blocks_span_the_lag():
 
 
 def test_a_whole_box_xi_or_chi0_without_a_value_says_why():
-    from dynhet.analysis.finite_size import s4_reason
+    from dynhet.analysis.size_rows import s4_reason
     L = 100.0
     resolved, few = {"cut": {0.6: s4_cut(2.0, L)}}, {"cut": {0.6: s4_cut(4.0, L)}}
     refused, tiny = {"cut": {0.6: s4_cut(math.nan, L)}}, {"cut": {0.6: s4_cut(0.2, L)}}

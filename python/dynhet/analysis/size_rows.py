@@ -1,0 +1,270 @@
+"""The rows of the finite-size report (finite_size.py): each quantity's
+per-run function (standard and cage-relative), the points its rows take
+(tau_B's may come from another study), and what a cell without a value says
+(tau_B beyond the lags, as a bound; xi and chi0 not resolved, and why)."""
+import math
+
+import numpy as np
+
+from .config import A_MAIN, EPS_MAIN
+from .quantities import PER_RUN, XI_MIN, chi0_at_tau, kappa_of, whole_box_s4
+from .runs import blocks_span
+from ..fits import interp_ln_t
+
+# chi4^P (the peak of chi4(t)) per sub-box size: a run's grid counts for a
+# size when its <N_r> is within a factor 1.6 of it and is not the whole box.
+SUBBOX_SIZES = (32, 128, 512, 2048, 8192, 32768)
+
+
+MIN_SHELLS = 5      # xi needs at least this many q shells below q xi = 1 (issue 27, item 4)
+
+
+def cutx(r, cr):
+    return r["cut_cr" if cr else "cut"][A_MAIN]
+
+
+def chi4p_of(size):
+    """chi4^P of the grid with sub-boxes of about `size` particles; NaN where the
+    run has no such grid or its peak is not interior (a bound, not a peak)."""
+    def fn(r, cr=False):
+        c = cutx(r, cr)
+        ns = np.asarray(c["chi4_N"], float)
+        for g in np.argsort(np.abs(np.log(ns / size))):
+            if ns[g] >= 0.999 * r["N"] or not (size / 1.6 <= ns[g] <= size * 1.6):
+                continue
+            if not c["tau4_interior"][g]:
+                return math.nan, math.nan
+            return c["chi4_peak"][g], c["chi4_peak_err"][g]
+        return math.nan, math.nan
+    return fn
+
+
+def xi_shells(r, cr=False):
+    """(xi, error, shells): the whole box's OZ xi at tau_alpha and how many q
+    shells lie below q xi = 1; xi is NaN with fewer than MIN_SHELLS shells
+    (not resolved at this N) or below XI_MIN."""
+    c = cutx(r, cr)
+    t = c["tau_alpha"]
+    g = whole_box_s4(c)
+    off = int(np.sum(c["s4_nshells"][:g]))
+    q = np.asarray(c["s4_q"][off:off + int(c["s4_nshells"][g])])
+    xi = np.interp(math.log(t), np.log(c["s4_lag"]), c["xi_t"][:, g]) if np.isfinite(t) else math.nan
+    if not np.isfinite(xi):
+        return math.nan, math.nan, 0
+    shells = int(np.sum((q > 0) & (q * xi <= 1.0)))
+    rel = c["s4_oz_xi_err"][g] / c["s4_oz_xi"][g] if c["s4_oz_xi"][g] > 0 else math.nan
+    if shells < MIN_SHELLS or xi < XI_MIN:
+        return math.nan, math.nan, shells
+    return xi, abs(xi) * rel, shells
+
+
+def shells_note(p, cr):
+    """The q shells below q xi = 1 of a point's runs, as a cell's suffix:
+    " [7 q]" (the fewest over its seeds, " [5-7 q]" where they differ); ""
+    without runs or where no run has xi."""
+    if p is None:
+        return ""
+    ks = []
+    for r in p.runs:
+        try:
+            _, _, k = xi_shells(r, cr)
+        except (KeyError, TypeError, IndexError, ValueError):
+            continue
+        if k:
+            ks.append(k)
+    if not ks:
+        return ""
+    return f" [{min(ks)} q]" if min(ks) == max(ks) else f" [{min(ks)}-{max(ks)} q]"
+
+
+def with_cr(fn):
+    """A per-run function of the standard results made to take cr=True."""
+    def f(r, cr=False):
+        if not cr:
+            return fn(r)
+        view = dict(r, cut=r["cut_cr"])
+        return fn(view)
+    return f
+
+
+def tau_of(r, cr=False):
+    c = cutx(r, cr)
+    return c["tau_alpha"], c["tau_alpha_err"]
+
+
+def tau_b_of(r, cr=False):
+    return PER_RUN["tau_b"](r)
+
+
+def c_b_at(times):
+    """C_B(t), the fraction of bonds intact (bond breaking), at a fixed time
+    per density, interpolated in ln t. Its error: the run's quoted one (the
+    standard error over origins, taken as independent) and the
+    interpolation's in quadrature, but only where jackknife blocks of origins
+    spanning t fit four times into the run's origins (runs.blocks_span, the
+    nodes' rule); else none, and the point takes its seeds' spread. `times`
+    is ((phi, t), ...); NaN beyond a run's lags."""
+    at = dict(times)
+
+    def fn(r, cr=False):
+        t = at.get(round(float(r["packing_fraction"]), 6), math.nan)
+        v, ie = interp_ln_t(r["c_b_lag"], r["c_b"], t)
+        if not blocks_span(t, r.get("schedule")):
+            return v, math.nan
+        e, _ = interp_ln_t(r["c_b_lag"], r["c_b_err"], t)
+        return v, math.hypot(e, ie if np.isfinite(ie) else 0.0)
+    return fn
+
+
+def c_b_times(multi):
+    """Per density, the longest lag that every run of it (at every N) reached:
+    where C_B is compared across N."""
+    out = []
+    for phi, d in multi.items():
+        last = [float(r["c_b_lag"][-1]) for p in d.values() for r in p.runs if len(r.get("c_b_lag", ()))]
+        if last:
+            out.append((round(float(phi), 6), min(last)))
+    return tuple(out)
+
+
+# (name, file name, per-run function (r, cr) -> (value, error), has a
+# cage-relative version, log axis). C_B's time depends on the runs: quantities().
+TAU_ROWS = [("τ_α", "tau_alpha", tau_of, True, True),
+            ("τ_B (bond breaking)", "tau_b", tau_b_of, False, True)]
+CHI4P_ROWS = [(f"χ4^P, sub-boxes of {n}", f"chi4p_{n}", chi4p_of(n), True, True) for n in SUBBOX_SIZES]
+
+
+REST_ROWS = [("χ0 of S4 (whole box, at τ_α)", "chi0", with_cr(chi0_at_tau), True, True),
+             ("ξ of S4 (whole box, at τ_α)", "xi", lambda r, cr=False: xi_shells(r, cr)[:2], True, True),
+             ("κ (slow clusters)", "kappa", with_cr(kappa_of), True, False),
+             ("d_f (slow clusters)", "d_f", lambda r, cr=False: (cutx(r, cr)["cl_slow_d_f"], cutx(r, cr)["cl_slow_d_f_err"]),
+              True, False)]
+
+
+QUANTITIES = TAU_ROWS + CHI4P_ROWS + REST_ROWS
+
+
+def quantities(multi):
+    """Every row of the report: QUANTITIES and C_B at each density's common
+    last lag (bond breaking measured where tau_B lies beyond the lags)."""
+    cb = [("C_B at the longest common lag (bond breaking)", "c_b", c_b_at(c_b_times(multi)), False, False)]
+    return TAU_ROWS + cb + CHI4P_ROWS + REST_ROWS
+
+
+def tau_b_bound(p):
+    """Where some run of the point never saw C_B fall to 1/e: the mean over
+    its seeds of tau_B or, where not reached, the last lag, a lower bound on
+    the point's tau_B; None where every run reached it (or none measured
+    C_B)."""
+    vals, short = [], False
+    for r in p.runs:
+        lag = r.get("c_b_lag")
+        if lag is None or not len(lag):
+            continue
+        tb = r.get("tau_b", math.nan)
+        if np.isfinite(tb):
+            vals.append(tb)
+        elif beyond_lags(r):
+            vals.append(float(lag[-1]))
+            short = True
+        else:  # no tau_B for another reason (C_B below 1/e at the first lag): no bound either
+            return None
+    return float(np.mean(vals)) if short else None
+
+
+def beyond_lags(r):
+    """Whether a run's C_B stayed above 1/e to its last lag (tau_B beyond it)."""
+    cb = r.get("c_b")
+    return cb is not None and len(cb) > 0 and np.isfinite(cb[-1]) and cb[-1] > math.exp(-1)
+
+
+def missing_cell(slug, p, cr):
+    """The text of a cell with no value that says why: tau_B beyond the lags
+    (with a lower bound), xi not resolved; None for a plain "—"."""
+    if p is None:
+        return None
+    if slug == "tau_b":
+        b = tau_b_bound(p)
+        if b is not None:
+            measured = [r for r in p.runs if len(r.get("c_b_lag", ()))]
+            n = sum(1 for r in measured if not np.isfinite(r.get("tau_b", math.nan)))
+            return f"> {b:.3g} ({n} of {len(measured)} seeds: C_B > 1/e at the last lag)"
+    if slug in ("xi", "chi0"):
+        why = sorted({s4_reason(r, cr, slug) for r in p.runs} - {None})
+        return " / ".join(why) if why else None
+    return None
+
+
+def s4_reason(r, cr, slug):
+    """Why a run has no whole-box xi (or chi0) at tau_alpha: "τ_α not
+    reached", "no OZ fit" (the S4 node refused its fit at that lag: xi beyond
+    the box, below the q range, or its jackknife error not below xi), "ξ <
+    0.3" (not determined), "not resolved" (fewer than MIN_SHELLS q shells
+    below q xi = 1); None where it has one, or no S4."""
+    try:
+        c = cutx(r, cr)
+        if not len(c.get("xi_t", ())):
+            return None
+        t = c["tau_alpha"]
+        if not np.isfinite(t):
+            return "τ_α not reached"
+        g = whole_box_s4(c)
+        xi = np.interp(math.log(t), np.log(c["s4_lag"]), c["xi_t"][:, g])
+        if not np.isfinite(xi):
+            return "no OZ fit"
+        if slug == "chi0":
+            return None
+        if xi < XI_MIN:
+            return f"ξ < {XI_MIN:g}"
+        return "not resolved" if xi_shells(r, cr)[2] < MIN_SHELLS else None
+    except (KeyError, TypeError, IndexError, ValueError):
+        return None
+
+
+def c_b_reach(p):
+    """The longest lag every run of a point followed C_B to (0 without bond breaking)."""
+    lags = [float(r["c_b_lag"][-1]) for r in p.runs if len(r.get("c_b_lag", ()))]
+    return min(lags) if lags and len(lags) == len(p.runs) else 0.0
+
+
+def tau_b_points(A, multi):
+    """{phi: {N: Point}} for the tau_B rows: at each density and N the point,
+    of this study or an --also study, that followed C_B furthest (the
+    longest lags every run of it reached; then the most runs), chosen by
+    its protocol, never by whether its seeds saw C_B fall to 1/e (that would
+    pick the seeds that crossed early). Studies with longer lags
+    (studies/cage_bonds.toml) thus give tau_B where the main runs stop short
+    of it; where the chosen point's seeds did not all reach it, its cell is
+    the bound."""
+    out = {}
+    for phi, d in multi.items():
+        dd = dict(d)
+        for p in list(A.points.values()) + list(A.extra.values()):
+            if p.phi != phi or p.pairs != "neighbours" or abs(p.eps - EPS_MAIN) > 1e-9 or not c_b_reach(p):
+                continue
+            q = dd.get(p.N)
+            if q is None or (c_b_reach(p), len(p.runs)) > (c_b_reach(q), len(q.runs)):
+                dd[p.N] = p
+        out[phi] = dd
+    return out
+
+
+def lags_in_tau_cr(d, ns):
+    """Per N, the longest lag of the overlap over the run's own measured
+    tau_alpha^CR (the range over seeds): whether every N ran as long in
+    units of the structural relaxation; "" without tau_alpha^CR."""
+    out = []
+    for n in ns:
+        x = []
+        for r in d[n].runs:
+            c = r.get("cut", {}).get(A_MAIN, {})
+            lag, t = c.get("lag"), c.get("tau_cr", math.nan)
+            if lag is not None and len(lag) and np.isfinite(t) and t > 0:
+                x.append(float(lag[-1]) / t)
+        if x:
+            out.append(f"N {n}: {min(x):.2g}" + (f"-{max(x):.2g}" if max(x) > min(x) * 1.005 else ""))
+    return ", ".join(out)
+
+
+def has_cr(p):
+    return any(r.get("cut_cr") and A_MAIN in r["cut_cr"] for r in p.runs)
