@@ -135,7 +135,7 @@ def bound_conflict(ns, ms, bounds):
 
 
 def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr):
-    fig, ax = plt.subplots(figsize=(6, 4.3))
+    fig, ax = plt.subplots(figsize=(7.6, 4.3))
     drawn = False
     for (phi, d), col in zip(multi.items(), colours(len(multi))):
         for cr in ((False, True) if has_cr_version else (False,)):
@@ -160,7 +160,7 @@ def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr):
     ax.set_xlabel("N")
     ax.set_ylabel(name)
     ax.set_title(f"{name} against N")
-    ax.legend(fontsize=7)
+    ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0))  # beside the data, never on it
     return A.save(fig, f"fs_{slug}.png")
 
 
