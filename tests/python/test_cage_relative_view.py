@@ -93,3 +93,33 @@ def test_values_without_any_error_are_still_drawn(tmp_path):
     lines = errorbar(ax, [1.0, 2.0], [3.0, 4.0], [math.nan, math.nan], fmt="o")
     assert list(lines[0].get_ydata()) == [3.0, 4.0]
     plt.close(fig)
+
+
+def test_a_real_verdict_reaches_the_note_and_both_measures_stand_side_by_side(tmp_path):
+    # Verdicts read "differs (3.2 σ)" or "agrees (0.4 σ); ...": the note of
+    # the cage-relative row had only ever matched a bare "differs".
+    from dynhet.analysis.output import side_by_side
+    A = analysis(tmp_path)
+    C = A.cage_relative_view()
+    A.row("τ4 ∝ τ_α^z", "3.4", "1.19", "1.06 ± 0.1", "agrees (1.3 σ)", "", A.series())
+    C.row("τ4 ∝ τ_α^z", "3.4", "1.19", "1 ± 0.02", "differs (9.5 σ)", "", C.series())
+    C.row("κ", "3.3", "≈ 1.8", "1.72 ± 0.01", "not judged: χ² improbable", "", C.series())
+    cr = A.rows[1]
+    assert cr["verdict"] == "—" and cr["note"] == "against the paper's standard measure: differs (9.5 σ)"
+    assert A.rows[2]["note"] == ""                                    # not judged: nothing to say against it
+    lines = side_by_side(A.rows)
+    assert "| τ4 ∝ τ_α^z | 1.19 | 1.06 ± 0.1; agrees (1.3 σ) | 1 ± 0.02; differs (9.5 σ) |" in lines
+    assert not any(line.startswith("| κ |") for line in lines)         # no standard row: not a pair
+    assert side_by_side(A.rows[2:]) == []
+
+
+def test_the_view_takes_the_cage_relative_d_and_never_the_standard_one(tmp_path):
+    import math
+    A = analysis(tmp_path)
+    runs = A.series()[0].runs
+    runs[0].update(D=0.01, D_err=0.001, D_cr=0.004, D_cr_err=0.0002)
+    runs[1].update(D=0.012, D_err=0.001)                  # a run without the cage-relative MSD
+    C = A.cage_relative_view()
+    got = [(r["D"], r["D_err"]) for r in C.series()[0].runs]
+    assert got[0] == (0.004, 0.0002) and all(math.isnan(x) for x in got[1])
+    assert [r["D"] for r in A.series()[0].runs] == [0.01, 0.012]   # the study untouched

@@ -28,7 +28,7 @@ from .config import A_MAIN, CONVENTIONS, EPS_MAIN, say
 from .study import Analysis
 
 # What a section needs (a key of a run's cut), and the observable that gives it.
-NEEDS = {"chi4": "chi4", "s4_q": "s4", "cl_lag": "clusters", "D": "msd"}
+NEEDS = {"chi4": "chi4", "s4_q": "s4", "cl_lag": "clusters", "D": "msd", "D_cr": "msd with cage_relative"}
 from .overlap import ageing_results, overlap_results, tau_results
 from .transport import d_results, pdx_results
 from .clusters import cluster_results
@@ -146,6 +146,7 @@ def main(argv=None):
         step("clusters", cluster_results, phi_c_cr, why_cr, joint_cr, needs=("cl_lag",), on=C)
         step("chi4", chi4_results, phi_c_cr, joint_cr, needs=("chi4",), on=C)
         step("S4 and xi", s4_results, joint_cr, needs=("s4_q",), on=C)
+        step("D", d_results, needs=("D_cr",), on=C)   # theta of the cage-relative D against tau_alpha^CR
     A.driving = ({}, "")
     step("driving rules", driving_results)
     driving_rows(A)

@@ -1,5 +1,6 @@
 """study.h5 and the reproduction table."""
 import os
+import re
 import time
 
 import h5py
@@ -90,6 +91,27 @@ def hms(s):
     return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
 
 
+def side_by_side(rows):
+    """Issue 27, item 3: every result the table states both ways, the
+    standard measure beside the cage-relative one (its rows "... (cage-
+    relative)"), in the table's order; [] where there are none."""
+    cr = {r["item"][:-len(" (cage-relative)")]: r for r in rows if r["item"].endswith(" (cage-relative)")}
+    pairs = [(r, cr[r["item"]]) for r in rows if r["item"] in cr]
+    if not pairs:
+        return []
+    out = ["", "## Standard and cage-relative side by side", "",
+           "Every result stated both ways: the standard measure (the paper's; its verdict as in the table) and the "
+           "cage-relative one (displacements relative to the cage's centre, which removes the long-wavelength "
+           "motion of two dimensions; its comparison with the paper's number is for information only).", "",
+           "| result | paper | standard: ours, verdict | cage-relative: ours, against the paper |", "|---|---|---|---|"]
+    for r, c in pairs:
+        against = re.search(r"against the paper's standard measure: ((?:agrees|differs)(?: \([0-9.]+ σ\))?)",
+                            c["note"] or "")
+        out.append(f"| {r['item']} | {r['paper']} | {r['ours']}; {r['verdict']} | {c['ours']}"
+                   + (f"; {against.group(1)}" if against else "") + " |")
+    return out
+
+
 def write_table(A, path, command, discussion=None, restate_from=None, via=()):
     n_runs = sum(len(p.runs) for p in A.points.values())
     total = sum(A.cpu.values())
@@ -119,6 +141,7 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=()):
         note = f" ({r['note']})" if r["note"] else ""
         L.append(f"| {r['item']} | {r['section']} | {r['paper']} | {r['ours']}{note} | {r['verdict']} | "
                  f"{'`' + r['figure'] + '`' if r['figure'] else '—'} | {hms(r['cpu'])} |")
+    L += side_by_side(A.rows)
     if getattr(A, "driving_table", None):
         L += ["", "## The two driving rules side by side (ε = 0.9)", "",
               "`driving.pairs = \"neighbours\"` (a kick's partner within reach of the first particle) against `\"any\"` "

@@ -118,6 +118,9 @@ def read_run(path, meta):
             if a in r["cut_cr"]:
                 c["tau_cr"], c["tau_cr_err"] = r["cut_cr"][a]["tau_alpha"], r["cut_cr"][a]["tau_alpha_err"]
                 c["q_cr"] = r["cut_cr"][a]["q"]
+        if "msd_cr" in obs:  # the cage-relative D (observables.cage_relative), which the cage-relative view takes
+            mc = run.observable("msd_cr")
+            r["D_cr"], r["D_cr_err"] = fnum(last(mc, "diffusion")), fnum(last(mc, "diffusion_err"))
         m = run.msd() if "msd" in obs else None
         if m is not None:
             r["D"], r["D_err"] = fnum(last(m, "diffusion")), fnum(last(m, "diffusion_err"))

@@ -1,4 +1,5 @@
 """A study's complete runs as points (and those of --also studies), with the table rows and fits made of them."""
+import math
 import os
 import tomllib
 
@@ -193,7 +194,10 @@ class CageRelativeView(Analysis):
             out = {}
             for k, p in points.items():
                 if id(p) not in copies:
-                    runs = [dict(r, cut=r["cut_cr"]) for r in p.runs if A_MAIN in r.get("cut_cr", {})]
+                    # (D: the cage-relative one where the run has it, else none: never the standard D
+                    # against the cage-relative tau_alpha)
+                    runs = [dict(r, cut=r["cut_cr"], D=r.get("D_cr", math.nan), D_err=r.get("D_cr_err", math.nan))
+                            for r in p.runs if A_MAIN in r.get("cut_cr", {})]
                     q = None
                     if runs:
                         q = Point((p.pairs, p.eps, p.phi, p.N))
@@ -212,7 +216,9 @@ class CageRelativeView(Analysis):
         return self.base.save(fig, "cr_" + name)
 
     def row(self, item, section, paper, ours, verdict, figure, pts, note=""):
-        against = f"against the paper's standard measure: {verdict}" if verdict in ("agrees", "differs") else ""
+        # (a verdict reads "differs (3.2 σ)", "agrees (0.4 σ); ...": its kind starts it)
+        against = (f"against the paper's standard measure: {verdict}"
+                   if verdict.split(" (")[0].split(";")[0] in ("agrees", "differs") else "")
         self.base.row(f"{item} (cage-relative)", section, paper, ours, "—", figure, pts,
                       "; ".join(x for x in (against, note) if x))
 
