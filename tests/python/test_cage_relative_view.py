@@ -109,8 +109,8 @@ def test_a_real_verdict_reaches_the_note_and_both_measures_stand_side_by_side(tm
     assert A.rows[2]["note"] == ""                                    # not judged: nothing to say against it
     lines = side_by_side(A.rows)
     assert "| τ4 ∝ τ_α^z | 1.19 | 1.06 ± 0.1; agrees (1.3 σ) | 1 ± 0.02; differs (9.5 σ) |" in lines
-    assert not any(line.startswith("| κ |") for line in lines)         # no standard row: not a pair
-    assert side_by_side(A.rows[2:]) == []
+    assert "| κ (cage-relative) | ≈ 1.8 | — | 1.72 ± 0.01 |" in lines     # no standard row: it stands alone
+    assert side_by_side(A.rows[:1]) == []                                 # no cage-relative row: no section
 
 
 def test_the_view_takes_the_cage_relative_d_and_never_the_standard_one(tmp_path):
@@ -123,3 +123,22 @@ def test_the_view_takes_the_cage_relative_d_and_never_the_standard_one(tmp_path)
     got = [(r["D"], r["D_err"]) for r in C.series()[0].runs]
     assert got[0] == (0.004, 0.0002) and all(math.isnan(x) for x in got[1])
     assert [r["D"] for r in A.series()[0].runs] == [0.01, 0.012]   # the study untouched
+
+
+def test_pairs_are_found_across_numbers_in_the_names_and_a_lone_row_is_kept():
+    from dynhet.analysis.output import side_by_side
+
+    def row(item, ours, verdict="—", note="", section="3.4"):
+        return dict(item=item, section=section, paper="2.5", ours=ours, verdict=verdict, note=note)
+    rows = [row("γχ (φ_c held at the joint fit's 0.8006)", "1.2", "differs (4.0 σ)"),
+            row("d_f at φ = 0.6", "1.6", "agrees (0.5 σ)"), row("d_f at φ = 0.8", "1.9", "agrees (1.0 σ)"),
+            row("γχ (φ_c held at the joint fit's 0.8042) (cage-relative)", "0.9",
+                note="against the paper's standard measure: differs (8.0 σ)"),
+            row("d_f at φ = 0.6 (cage-relative)", "1.64"), row("d_f at φ = 0.78 (cage-relative)", "1.93"),
+            row("θ (cage-relative)", "0.99", section="3.2")]
+    lines = side_by_side(rows)
+    assert ("| γχ (φ_c held at the joint fit's 0.8006) | 2.5 | 1.2; differs (4.0 σ) | "
+            "[γχ (φ_c held at the joint fit's 0.8042)] 0.9; differs (8.0 σ) |") in lines
+    assert "| d_f at φ = 0.6 | 2.5 | 1.6; agrees (0.5 σ) | 1.64 |" in lines          # in order: 0.6 with 0.6
+    assert "| d_f at φ = 0.8 | 2.5 | 1.9; agrees (1.0 σ) | [d_f at φ = 0.78] 1.93 |" in lines
+    assert "| θ (cage-relative) | 2.5 | — | 0.99 |" in lines                        # no standard row: alone

@@ -175,3 +175,32 @@ def test_a_running_run_is_described_from_its_sims_last_progress_line(tmp_path):
                  "eta": "0:33:10"}
     assert describe("r", str(d)) == ("  r: production t = 2.73e+04 of 4.177e+04 (65% of the phase), frames 92/212, "
                                      "the sim's ETA 0:33:10")
+
+
+def test_an_earlier_attempts_log_is_not_the_running_runs_progress(tmp_path):
+    import os
+    import time as _time
+    from dynhet.study.progress import describe
+    d = tmp_path / "run"
+    d.mkdir()
+    log = d / "sim_node.log"
+    log.write_text("[done       ] t=18 /18  phi=0.6000  coll/s=0  T=1.06  Z=6.1  frames 56/56  ETA 0:00:00\n")
+    old = _time.time() - 100
+    os.utime(log, (old, old))
+    assert "starting" in describe("r", str(d), since=_time.time() - 10)   # the run began after that line
+    assert "done t = 18 of 18" in describe("r", str(d), since=old - 1)
+
+
+def test_pilots_of_other_sizes_count_only_where_pilots_set_run_lengths(tmp_path):
+    from dynhet.study.rundir import StudyDir, write_status
+    text = GOOD.replace("packing_fraction = [0.60, 0.70]\n", "packing_fraction = [0.60, 0.70]\nn_particles = [65536]\n")
+    for mode, counted in (("pilot", 1), ("interpolate", 0)):
+        sd = StudyDir(study(tmp_path, text.replace('tau_alpha = "pilot"', f'tau_alpha = "{mode}"')),
+                      str(tmp_path / mode))
+        sd.claim()
+        d = tmp_path / mode / "pilots" / "a"
+        d.mkdir(parents=True)
+        write_status(str(d), {"state": "complete", "tau_alpha": 2.0, "packing_fraction": 0.6,
+                              "series": [0.9, "neighbours", 4096]})
+        p = [q for q in sd.study.points() if q["restitution"] == 0.9][0]
+        assert len(sd.finished_taus(p)) == counted, mode

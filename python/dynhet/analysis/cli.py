@@ -112,8 +112,9 @@ def main(argv=None):
         except Exception as e:  # one result that cannot be made must not cost the others
             import traceback
             traceback.print_exc()
-            failed.append(name)
-            A.row(name, "—", "—", f"analysis failed: {type(e).__name__}: {e}", "failed", "", [])
+            label = name + (" (cage-relative)" if on is not A else "")  # never mistaken for the standard row
+            failed.append(label)
+            A.row(label, "—", "—", f"analysis failed: {type(e).__name__}: {e}", "failed", "", [])
             return None
 
     for name, fn, needs in (("overlap", overlap_results, ()), ("ageing", ageing_results, ()),

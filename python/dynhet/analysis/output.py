@@ -91,24 +91,45 @@ def hms(s):
     return f"{s // 3600}:{s % 3600 // 60:02d}:{s % 60:02d}"
 
 
+CR_SUFFIX = " (cage-relative)"
+
+
 def side_by_side(rows):
     """Issue 27, item 3: every result the table states both ways, the
     standard measure beside the cage-relative one (its rows "... (cage-
-    relative)"), in the table's order; [] where there are none."""
-    cr = {r["item"][:-len(" (cage-relative)")]: r for r in rows if r["item"].endswith(" (cage-relative)")}
-    pairs = [(r, cr[r["item"]]) for r in rows if r["item"] in cr]
-    if not pairs:
+    relative)"), in the table's order; [] where there are none. A pair is
+    the same section and the same name up to its numbers (a phi_c held at
+    another value, the highest density run), taken in order; a cage-relative
+    row without a standard one stands alone."""
+    def key(r, item):
+        return r["section"], re.sub(r"[0-9]+(?:\.[0-9]+)?", "#", item)
+    cr = {}
+    for r in rows:
+        if r["item"].endswith(CR_SUFFIX):
+            cr.setdefault(key(r, r["item"][:-len(CR_SUFFIX)]), []).append(r)
+    if not cr:
         return []
     out = ["", "## Standard and cage-relative side by side", "",
            "Every result stated both ways: the standard measure (the paper's; its verdict as in the table) and the "
            "cage-relative one (displacements relative to the cage's centre, which removes the long-wavelength "
            "motion of two dimensions; its comparison with the paper's number is for information only).", "",
            "| result | paper | standard: ours, verdict | cage-relative: ours, against the paper |", "|---|---|---|---|"]
-    for r, c in pairs:
+
+    def cr_cell(c, std_item):
         against = re.search(r"against the paper's standard measure: ((?:agrees|differs)(?: \([0-9.]+ σ\))?)",
                             c["note"] or "")
-        out.append(f"| {r['item']} | {r['paper']} | {r['ours']}; {r['verdict']} | {c['ours']}"
-                   + (f"; {against.group(1)}" if against else "") + " |")
+        own = c["item"][:-len(CR_SUFFIX)]
+        return ((f"[{own}] " if own != std_item else "") + c["ours"]
+                + (f"; {against.group(1)}" if against else ""))
+    for r in rows:
+        if r["item"].endswith(CR_SUFFIX):
+            continue
+        k = key(r, r["item"])
+        if cr.get(k):
+            out.append(f"| {r['item']} | {r['paper']} | {r['ours']}; {r['verdict']} | {cr_cell(cr[k].pop(0), r['item'])} |")
+    for left in cr.values():   # cage-relative rows no standard row matched
+        for c in left:
+            out.append(f"| {c['item']} | {c['paper']} | — | {cr_cell(c, c['item'][:-len(CR_SUFFIX)])} |")
     return out
 
 

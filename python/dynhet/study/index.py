@@ -39,7 +39,7 @@ def plan(sd):
         else:
             tau, src = sd.guess(p)
             src = f"guess: {src}"
-            if sd.study.run_length["tau_alpha"] == "pilot":  # the run will take its pilot's tau times the margin
+            if sd.study.run_length["tau_alpha"] == "pilot" and tau is not None:  # the run: its pilot's tau x margin
                 m = sd.study.run_length["pilot_margin"]
                 tau *= m
                 src += f" x {m:g}; a pilot will measure it" if m != 1.0 else "; a pilot will measure it"

@@ -53,7 +53,7 @@ def run_local(sd, jobs):
                 state["running"] += 1
             name = sd.study.run_name(p)
             with lock:
-                state["active"][name] = sd.run_dir(p)
+                state["active"][name] = (sd.run_dir(p), time.time())
             try:
                 st = do_run(sd, p, say)
             except StudyError as e:
@@ -99,8 +99,8 @@ def run_local(sd, jobs):
                 progress()
                 with lock:
                     active = sorted(state["active"].items())
-                for name, d in active:
-                    say(describe(name, d))
+                for name, (d, since) in active:
+                    say(describe(name, d, since))
     except KeyboardInterrupt:
         say(f"study {sd.study.name}: stopping the runs (each writes a checkpoint)")
         stop_children()

@@ -10,12 +10,17 @@ LINE = re.compile(r"\[(\w+)\s*\] t=(\S+)\s*/(\S+)\s+phi=.*?frames (\d+)/(\d+)\s+
 PROGRESS_EVERY = float(os.environ.get("DYNHET_STUDY_PROGRESS_EVERY", "600"))
 
 
-def sim_progress(run_dir, tail_bytes=8192):
+def sim_progress(run_dir, since=0.0, tail_bytes=8192):
     """The run's last sim progress line as a dict (phase, t, end, frames,
     frames_total, eta), from the end of run_dir/sim_node.log; None without
-    one (a run still in its pilot or its prepared state, or not started)."""
+    one (a run still in its pilot or its prepared state, or not started),
+    or where the log was last written before `since` (an earlier attempt's,
+    the run started again in the same directory)."""
+    path = os.path.join(run_dir, "sim_node.log")
     try:
-        with open(os.path.join(run_dir, "sim_node.log"), "rb") as f:
+        if os.path.getmtime(path) < since:
+            return None
+        with open(path, "rb") as f:
             f.seek(0, os.SEEK_END)
             f.seek(max(0, f.tell() - tail_bytes))
             text = f.read().decode("utf-8", "replace")
@@ -33,9 +38,10 @@ def sim_progress(run_dir, tail_bytes=8192):
     return None
 
 
-def describe(name, run_dir):
-    """One line of a running run: its phase, how far in simulated time, frames and the sim's ETA."""
-    p = sim_progress(run_dir)
+def describe(name, run_dir, since=0.0):
+    """One line of a running run: its phase, how far in simulated time, frames
+    and the sim's ETA (from a log written since `since`, its start)."""
+    p = sim_progress(run_dir, since)
     if p is None:
         return f"  {name}: starting (a pilot, a prepared state, or the sim's first line)"
     share = f" ({100 * p['t'] / p['end']:.0f}% of the phase)" if p["end"] > 0 else ""

@@ -89,7 +89,9 @@ class StudyDir:
         study's tau_guess alone."""
         pts = []
         key = self.study.series_key(p)
-        pp = self.study.run_length.get("pilot_particles", 0)
+        # (only where pilots set run lengths: with interpolated lengths the count of
+        # finished points decides whether a run interpolates, and must be its own N's)
+        pp = self.study.run_length.get("pilot_particles", 0) if self.study.run_length["tau_alpha"] == "pilot" else 0
         pilot_n = min(key[2], pp) if pp else key[2]
         for q in self.study.points():
             if self.study.series_key(q) != key:
