@@ -204,3 +204,14 @@ def test_pilots_of_other_sizes_count_only_where_pilots_set_run_lengths(tmp_path)
                               "series": [0.9, "neighbours", 4096]})
         p = [q for q in sd.study.points() if q["restitution"] == 0.9][0]
         assert len(sd.finished_taus(p)) == counted, mode
+
+
+def test_the_study_ends_when_its_last_slot_does():
+    from dynhet.study.progress import eta_seconds, study_eta
+    assert eta_seconds("6:52:54") == 6 * 3600 + 52 * 60 + 54 and eta_seconds("?") is None
+    # one slot busy for 7 h with the longest run, the other takes the queue (3 h, 2 h, 1 h): 7 h
+    h = 3600.0
+    assert study_eta([7 * h, 0.5 * h], [3 * h, 2 * h, 1 * h], 2) == 7 * h
+    # the queue alone on two free slots: 4 | 2 + 2 -> 4 h
+    assert study_eta([], [4 * h, 2 * h, 2 * h], 2) == 4 * h
+    assert study_eta([], [], 2) == 0.0

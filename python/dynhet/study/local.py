@@ -12,7 +12,7 @@ from .rundir import read_status, write_status
 from .children import STOPPING, stop_children
 from .runner import do_run
 from .index import run_estimates, run_order, write_index
-from .progress import PROGRESS_EVERY, describe
+from .progress import PROGRESS_EVERY, describe, eta_seconds, sim_progress, study_eta
 
 
 def run_local(sd, jobs):
@@ -36,12 +36,20 @@ def run_local(sd, jobs):
 
     def progress():
         with lock:
-            left_est = sum(est[sd.study.run_name(p)] for p in queue)
             ratio = state["cpu_done"] / state["est_done"] if state["est_done"] > 0 else 1.0
-            eta = ratio * left_est / max(1, jobs)
+            queued = [ratio * est[sd.study.run_name(p)] for p in queue]
+            active = list(state["active"].values())
+        # The running runs' own ETAs (their sims'), then the queue on the slots they free.
+        left = []
+        for d, since in active:
+            pr = sim_progress(d, since)
+            left.append((eta_seconds(pr["eta"]) if pr else None) or 0.0)
+        eta = study_eta(left, queued, max(1, jobs))
+        with lock:
             print(f"[{fmt_time(time.time() - t_start)}] study {sd.study.name}: {state['done']} done, "
                   f"{state['running']} running, {state['left']} left, {state['failed']} failed; "
-                  f"ETA {fmt_time(eta)} (queued runs, estimated)", flush=True)
+                  f"ETA {fmt_time(eta)} (the running runs' sims, then the queue's estimates on {max(1, jobs)} "
+                  f"slots)", flush=True)
 
     def worker():
         while True:

@@ -47,3 +47,24 @@ def describe(name, run_dir, since=0.0):
     share = f" ({100 * p['t'] / p['end']:.0f}% of the phase)" if p["end"] > 0 else ""
     return (f"  {name}: {p['phase']} t = {p['t']:.4g} of {p['end']:.4g}{share}, frames {p['frames']}/"
             f"{p['frames_total']}, the sim's ETA {p['eta']}")
+
+
+def eta_seconds(text):
+    """The sim's ETA text (h:mm:ss, or "?") in seconds; None where it says none."""
+    parts = text.split(":")
+    if len(parts) != 3 or not all(p.isdigit() for p in parts):
+        return None
+    h, m, sec = (int(p) for p in parts)
+    return 3600 * h + 60 * m + sec
+
+
+def study_eta(running_left, queued, jobs):
+    """When the study ends, in seconds from now: the running runs free their
+    slots after what their sims say is left (0 where unknown), and the
+    queued runs (their estimated seconds, in the order the pool takes them)
+    go each to the slot free first; the last slot to finish ends it."""
+    slots = sorted(list(running_left) + [0.0] * max(0, jobs - len(running_left)))
+    for cost in queued:
+        slots[0] += cost
+        slots.sort()
+    return max(slots) if slots else 0.0
