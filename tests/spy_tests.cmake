@@ -5,6 +5,9 @@ if(TARGET dynhet_spy_plugins)
   set(CMAKE_JAVA_COMPILE_FLAGS -Xlint:all -Werror)
   add_jar(dynhet_spy_check
     SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/spy/dynhet/spycheck/SpyPluginCheck.java
+            ${CMAKE_CURRENT_SOURCE_DIR}/spy/dynhet/spycheck/ExpectedCurves.java
+            ${CMAKE_CURRENT_SOURCE_DIR}/spy/dynhet/spycheck/SpyLog.java
+            ${CMAKE_CURRENT_SOURCE_DIR}/spy/dynhet/spycheck/HostileCases.java
     INCLUDE_JARS dynhet_spy_plugins /usr/share/java/lcm.jar /usr/share/java/jchart2d.jar
                  ${CMAKE_BINARY_DIR}/dynhet_lcmtypes.jar
     OUTPUT_DIR ${CMAKE_BINARY_DIR})
