@@ -294,3 +294,23 @@ def test_s4_of_every_n_is_drawn_standard_and_cage_relative(tmp_path):
         for r in p.runs:
             r["cut"] = r["cut_cr"] = {0.6: {"tau_alpha": 10.0}}
     assert plot_s4_q(A, multi, multi_cr) == ""
+
+
+def test_chi4p_against_the_sub_box_is_drawn_per_n_from_interior_peaks_only(tmp_path):
+    from dynhet.analysis.finite_size import plot_chi4p_subbox
+    A = Analysis.__new__(Analysis)
+    A.dir, A.figdir = str(tmp_path), str(tmp_path / "figures")
+    multi, multi_cr = {0.79: {}}, {0.79: {}}
+    for n in (1024, 4096):
+        p = Point(("neighbours", 0.9, 0.79, n))
+        for seed in (1, 2):
+            c = {"chi4_N": np.array([32.0, 128.0, float(n)]), "chi4_peak": np.array([1.0, 2.0, 5.0]),
+                 "tau4_interior": np.array([True, True, seed == 1])}
+            p.runs.append({"seed": seed, "N": n, "cut": {0.6: c}})
+        multi[0.79][n] = p
+    f = plot_chi4p_subbox(A, multi, multi_cr)
+    assert f.endswith("fs_chi4p_subbox.png") and (tmp_path / "figures" / "fs_chi4p_subbox.png").stat().st_size > 5000
+    for p in multi[0.79].values():
+        for r in p.runs:
+            r["cut"][0.6]["tau4_interior"][:] = False          # no interior peak anywhere: nothing to draw
+    assert plot_chi4p_subbox(A, multi, multi_cr) == ""

@@ -205,6 +205,46 @@ def plot_s4_q(A, multi, multi_cr):
     return A.save(fig, "fs_s4_q.png")
 
 
+def plot_chi4p_subbox(A, multi, multi_cr):
+    """The paper's fig. chi4P(a) at every box size: chi4^P against the
+    sub-box's particles, one panel per density, a curve per N (the mean over
+    seeds; interior peaks only; the last point of a curve is the whole box),
+    standard (filled) and cage-relative (open): where a sub-box's chi4^P
+    does not depend on the box around it, and how far the larger boxes
+    extend the curve."""
+    phis = list(multi)
+    fig, axes = plt.subplots(1, len(phis), figsize=(4.0 * len(phis), 3.7), squeeze=False)
+    drawn = False
+    for ax, phi in zip(axes[0], phis):
+        ns = sorted(multi[phi])
+        for n, col in zip(ns, colours(len(ns))):
+            for cr, ls in ((False, "o-"), (True, "s--")):
+                p = (multi_cr.get(phi, {}) if cr else multi[phi]).get(n)
+                by_size = {}
+                for r in (p.runs if p is not None else []):
+                    c = r.get("cut_cr" if cr else "cut", {}).get(A_MAIN, {})
+                    if "chi4_N" not in c:
+                        continue
+                    for size, peak, inside in zip(c["chi4_N"], c["chi4_peak"], c["tau4_interior"]):
+                        if inside and np.isfinite(peak):
+                            by_size.setdefault(round(float(size)), []).append(float(peak))
+                if not by_size:
+                    continue
+                x = sorted(by_size)
+                ax.loglog(x, [np.mean(by_size[k]) for k in x], ls, ms=3, lw=1, color=col, mfc="none" if cr else col,
+                          label=f"N = {n}" + (" (cage-relative)" if cr else ""))
+                drawn = True
+        ax.set_title(f"φ = {phi:g}: χ4^P against the sub-box")
+        ax.set_xlabel("particles in the sub-box")
+        if ax.has_data():
+            ax.legend(fontsize=6)
+    if not drawn:
+        plt.close(fig)
+        return ""
+    axes[0][0].set_ylabel("χ4^P (mean over seeds)")
+    return A.save(fig, "fs_chi4p_subbox.png")
+
+
 def calibration_note(A, multi, multi_cr, multi_tb=None):
     """The factors by which each quantity's quoted errors are scaled
     (points.calibration, pooled over each study's points)."""
@@ -315,6 +355,12 @@ def write_finite_size(A, path, command):
             if f:
                 figures.append(f)
                 L.append(f"- {name}: ![{name}](finite_size/{os.path.basename(f)})")
+        f = plot_chi4p_subbox(A, multi, multi_cr)
+        if f:
+            figures.append(f)
+            L.append("- χ4^P against the sub-box's particles at every N (the paper's fig. chi4P(a), with the sub-box "
+                     "sizes the larger boxes allow; a curve's last point is its whole box), standard (filled) and "
+                     f"cage-relative (open): ![χ4^P against the sub-box](finite_size/{os.path.basename(f)})")
         f = plot_s4_q(A, multi, multi_cr)
         if f:
             figures.append(f)
