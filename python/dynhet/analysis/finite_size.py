@@ -164,11 +164,10 @@ def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr):
     return A.save(fig, f"fs_{slug}.png")
 
 
-def plot_s4_q(A, multi, multi_cr):
-    """S4(q, tau_alpha) of the whole box at every N, one panel per density,
-    standard (solid) and cage-relative (dashed), the mean over seeds: where
-    the curve has an Ornstein-Zernike plateau below q = 1/xi, and where it
-    still rises at the box's smallest q (xi beyond the box: "no OZ fit")."""
+def panels_per_phi(A, multi, multi_cr, curve, title, xlabel, ylabel, name, ms):
+    """One log-log panel per density, a curve per N, standard (filled, solid)
+    and cage-relative (open, dashed): curve(point, cr) -> (x, y) or None.
+    The saved figure's path, "" where no curve has data."""
     phis = list(multi)
     fig, axes = plt.subplots(1, len(phis), figsize=(4.0 * len(phis), 3.7), squeeze=False)
     drawn = False
@@ -177,32 +176,44 @@ def plot_s4_q(A, multi, multi_cr):
         for n, col in zip(ns, colours(len(ns))):
             for cr, ls in ((False, "o-"), (True, "s--")):
                 p = (multi_cr.get(phi, {}) if cr else multi[phi]).get(n)
-                curves = []
-                for r in (p.runs if p is not None else []):
-                    try:
-                        curves.append(s4_at_tau(dict(r, cut=r["cut_cr"]) if cr else r))
-                    except (KeyError, TypeError, IndexError, ValueError):
-                        continue
-                if not curves:
+                xy = curve(p, cr) if p is not None else None
+                if xy is None:
                     continue
-                q0 = np.asarray(curves[0][0], float)
-                same = [np.asarray(s_, float) for q_, s_ in curves if len(q_) == len(q0) and np.allclose(q_, q0)]
-                y = np.nanmean(same, axis=0)
-                ok = np.isfinite(y) & (y > 0) & (q0 > 0)
-                if not ok.any():
-                    continue
-                ax.loglog(q0[ok], y[ok], ls, ms=2.5, lw=1, color=col, mfc="none" if cr else col,
+                ax.loglog(*xy, ls, ms=ms, lw=1, color=col, mfc="none" if cr else col,
                           label=f"N = {n}" + (" (cage-relative)" if cr else ""))
                 drawn = True
-        ax.set_title(f"φ = {phi:g}: S4(q, τ_α), whole box")
-        ax.set_xlabel("q")
+        ax.set_title(f"φ = {phi:g}: {title}")
+        ax.set_xlabel(xlabel)
         if ax.has_data():
             ax.legend(fontsize=6)
     if not drawn:
         plt.close(fig)
         return ""
-    axes[0][0].set_ylabel("S4(q, τ_α) (mean over seeds)")
-    return A.save(fig, "fs_s4_q.png")
+    axes[0][0].set_ylabel(ylabel)
+    return A.save(fig, name)
+
+
+def plot_s4_q(A, multi, multi_cr):
+    """S4(q, tau_alpha) of the whole box at every N, one panel per density,
+    standard (solid) and cage-relative (dashed), the mean over seeds: where
+    the curve has an Ornstein-Zernike plateau below q = 1/xi, and where it
+    still rises at the box's smallest q (xi beyond the box: "no OZ fit")."""
+    def curve(p, cr):
+        curves = []
+        for r in p.runs:
+            try:
+                curves.append(s4_at_tau(dict(r, cut=r["cut_cr"]) if cr else r))
+            except (KeyError, TypeError, IndexError, ValueError):
+                continue
+        if not curves:
+            return None
+        q0 = np.asarray(curves[0][0], float)
+        same = [np.asarray(s_, float) for q_, s_ in curves if len(q_) == len(q0) and np.allclose(q_, q0)]
+        y = np.nanmean(same, axis=0)
+        ok = np.isfinite(y) & (y > 0) & (q0 > 0)
+        return (q0[ok], y[ok]) if ok.any() else None
+    return panels_per_phi(A, multi, multi_cr, curve, "S4(q, τ_α), whole box", "q", "S4(q, τ_α) (mean over seeds)",
+                          "fs_s4_q.png", 2.5)
 
 
 def plot_chi4p_subbox(A, multi, multi_cr):
@@ -212,37 +223,21 @@ def plot_chi4p_subbox(A, multi, multi_cr):
     standard (filled) and cage-relative (open): where a sub-box's chi4^P
     does not depend on the box around it, and how far the larger boxes
     extend the curve."""
-    phis = list(multi)
-    fig, axes = plt.subplots(1, len(phis), figsize=(4.0 * len(phis), 3.7), squeeze=False)
-    drawn = False
-    for ax, phi in zip(axes[0], phis):
-        ns = sorted(multi[phi])
-        for n, col in zip(ns, colours(len(ns))):
-            for cr, ls in ((False, "o-"), (True, "s--")):
-                p = (multi_cr.get(phi, {}) if cr else multi[phi]).get(n)
-                by_size = {}
-                for r in (p.runs if p is not None else []):
-                    c = r.get("cut_cr" if cr else "cut", {}).get(A_MAIN, {})
-                    if "chi4_N" not in c:
-                        continue
-                    for size, peak, inside in zip(c["chi4_N"], c["chi4_peak"], c["tau4_interior"]):
-                        if inside and np.isfinite(peak):
-                            by_size.setdefault(round(float(size)), []).append(float(peak))
-                if not by_size:
-                    continue
-                x = sorted(by_size)
-                ax.loglog(x, [np.mean(by_size[k]) for k in x], ls, ms=3, lw=1, color=col, mfc="none" if cr else col,
-                          label=f"N = {n}" + (" (cage-relative)" if cr else ""))
-                drawn = True
-        ax.set_title(f"φ = {phi:g}: χ4^P against the sub-box")
-        ax.set_xlabel("particles in the sub-box")
-        if ax.has_data():
-            ax.legend(fontsize=6)
-    if not drawn:
-        plt.close(fig)
-        return ""
-    axes[0][0].set_ylabel("χ4^P (mean over seeds)")
-    return A.save(fig, "fs_chi4p_subbox.png")
+    def curve(p, cr):
+        by_size = {}
+        for r in p.runs:
+            c = r.get("cut_cr" if cr else "cut", {}).get(A_MAIN, {})
+            if "chi4_N" not in c:
+                continue
+            for size, peak, inside in zip(c["chi4_N"], c["chi4_peak"], c["tau4_interior"]):
+                if inside and np.isfinite(peak):
+                    by_size.setdefault(round(float(size)), []).append(float(peak))
+        if not by_size:
+            return None
+        x = sorted(by_size)
+        return x, [np.mean(by_size[k]) for k in x]
+    return panels_per_phi(A, multi, multi_cr, curve, "χ4^P against the sub-box", "particles in the sub-box",
+                          "χ4^P (mean over seeds)", "fs_chi4p_subbox.png", 3)
 
 
 def calibration_note(A, multi, multi_cr, multi_tb=None):
