@@ -350,18 +350,17 @@ def write_finite_size(A, path, command):
             if f:
                 figures.append(f)
                 L.append(f"- {name}: ![{name}](finite_size/{os.path.basename(f)})")
-        f = plot_chi4p_subbox(A, multi, multi_cr)
-        if f:
-            figures.append(f)
-            L.append("- χ4^P against the sub-box's particles at every N (the paper's fig. chi4P(a), with the sub-box "
-                     "sizes the larger boxes allow; a curve's last point is its whole box), standard (filled) and "
-                     f"cage-relative (open): ![χ4^P against the sub-box](finite_size/{os.path.basename(f)})")
-        f = plot_s4_q(A, multi, multi_cr)
-        if f:
-            figures.append(f)
-            L.append("- S4(q, τ_α) of the whole box at every N, standard (filled, solid) and cage-relative (open, "
-                     "dashed): where it levels off below q = 1/ξ (an Ornstein-Zernike ξ the box resolves) and where "
-                     f"it still rises at the box's smallest q: ![S4(q)](finite_size/{os.path.basename(f)})")
+        for plot, caption, alt in (
+                (plot_chi4p_subbox, "χ4^P against the sub-box's particles at every N (the paper's fig. chi4P(a), with "
+                 "the sub-box sizes the larger boxes allow; a curve's last point is its whole box), standard (filled) "
+                 "and cage-relative (open)", "χ4^P against the sub-box"),
+                (plot_s4_q, "S4(q, τ_α) of the whole box at every N, standard (filled, solid) and cage-relative (open, "
+                 "dashed): where it levels off below q = 1/ξ (an Ornstein-Zernike ξ the box resolves) and where it "
+                 "still rises at the box's smallest q", "S4(q)")):
+            f = plot(A, multi, multi_cr)
+            if f:
+                figures.append(f)
+                L.append(f"- {caption}: ![{alt}](finite_size/{os.path.basename(f)})")
         L.append("")
     out_dir = os.path.dirname(os.path.abspath(path))
     os.makedirs(out_dir, exist_ok=True)
