@@ -8,6 +8,7 @@ from .toml_io import read_toml, toml_dump, write_atomic
 from .model import AXES
 from .rundir import read_status, run_h5_result, write_status
 from .children import RESUMABLE, STOPPING, newest_whole_cut, run_scene
+from .progress import sim_progress
 from .states import equilibrated_state, pid_alive, pilot, prepared_state
 
 
@@ -31,7 +32,9 @@ def do_run(sd, p, log=print):
         if cut is not None and os.path.exists(os.path.join(d, "scene.toml")):
             # run_scene.sh on the same directory resumes from the cut itself.
             resume = "cut"
-            log(f"{st.run_name(p)}: was interrupted; resuming mid-production from checkpoint cut {cut}")
+            last = sim_progress(d)  # the phase the sim last reported (a cut is taken in either phase)
+            where = {"equilibrate": " in equilibration", "production": " mid-production"}.get((last or {}).get("phase"), "")
+            log(f"{st.run_name(p)}: was interrupted; resuming{where} from checkpoint cut {cut}")
         elif os.path.exists(ck) and os.path.exists(os.path.join(d, "scene.toml")):
             resume = ck
             log(f"{st.run_name(p)}: was interrupted; resuming from {ck}")
