@@ -198,12 +198,25 @@ cleanup() { # (lcm-logger too: an early exit left it recording)
   [[ -z ${logger_pid:-} ]] || kill -INT "$logger_pid" 2>/dev/null || true
 }
 trap cleanup EXIT
+# A signal while the processes start (before the sim): stop those started
+# and end as interrupted (75), before the sim starts. From the trap itself:
+# a group signal also ends the command the script is in (a sleep, a python
+# check), and under errexit its failure would end the script 143, a failure
+# to a study or a Slurm job, before the script looked at stop_signal again.
+stop_early() {
+  for p in "${pids[@]}"; do kill -"$stop_signal" "$p" 2>/dev/null || true; done
+  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
+  pids=()
+  echo "run_scene: interrupted (SIG$stop_signal) while the run's processes started; the same command starts or resumes it" >&2
+  exit 75
+}
 if [[ -n $cuts ]]; then
   # SIGTERM/SIGINT: every process takes its part of one more cut and stops;
-  # this script waits for them (below) and exits 75.
-  stop_signal=""
-  trap 'stop_signal=TERM; for p in "${pids[@]}" ${sim_pid:-}; do kill -TERM "$p" 2>/dev/null || true; done' TERM
-  trap 'stop_signal=INT; for p in "${pids[@]}" ${sim_pid:-}; do kill -INT "$p" 2>/dev/null || true; done' INT
+  # this script waits for them (below) and exits 75. Before the sim is
+  # launched: stop_early.
+  stop_signal="" launching_sim=""
+  trap 'stop_signal=TERM; [[ -n $launching_sim ]] || stop_early; for p in "${pids[@]}" ${sim_pid:-}; do kill -TERM "$p" 2>/dev/null || true; done' TERM
+  trap 'stop_signal=INT; [[ -n $launching_sim ]] || stop_early; for p in "${pids[@]}" ${sim_pid:-}; do kill -INT "$p" 2>/dev/null || true; done' INT
 else
   trap 'echo "run_scene: interrupted" >&2; exit 130' INT TERM
 fi
@@ -263,16 +276,6 @@ fi
 [[ $bus_epoch =~ ^[0-9]+$ ]] || { echo "run_scene: --bus-epoch is a non-negative integer, not $bus_epoch" >&2; exit 2; }
 key=(--key-file "$key_file" --bus-epoch "$bus_epoch")
 
-# A signal while the processes start (the trap above only passes it on to
-# those already running, and a node without run info then exits at once):
-# stop them all and end as interrupted, before the sim starts.
-stop_early() {
-  for p in "${pids[@]}"; do kill -"$stop_signal" "$p" 2>/dev/null || true; done
-  for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
-  pids=()
-  echo "run_scene: interrupted (SIG$stop_signal) while the run's processes started; the same command starts or resumes it" >&2
-  exit 75
-}
 start() { # name, then the command; waits for its "ready" line
   # On resume the log goes on: only the lines after this start's own
   # separator count (an earlier attempt's "ready" is not this process's),
@@ -285,6 +288,8 @@ start() { # name, then the command; waits for its "ready" line
   else : >"$out/$n.log"; fi
   "$@" 2>>"$out/$n.log" &
   pids+=($!) names+=("$n")
+  # (tests: DYNHET_TEST_READY_PAUSE seconds here, a process launched and not yet seen ready)
+  [[ -z ${DYNHET_TEST_READY_PAUSE:-} ]] || sleep "$DYNHET_TEST_READY_PAUSE"
   for ((i = 1; i <= limit; ++i)); do
     [[ -z ${stop_signal:-} ]] || stop_early
     tail -n +"$from" "$out/$n.log" 2>/dev/null | grep -q "ready" && return 0
@@ -298,6 +303,7 @@ start() { # name, then the command; waits for its "ready" line
 
 echo "run_scene: ${scene:-resuming $resume} -> $out (bus $bus, $url, run $run_id, role $role)" >&2
 if [[ $role == sim ]]; then # the sim alone; the analysis host records and plots
+  launching_sim=1
   "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" "${key[@]}" --pace-nodes --checkpoint "$out/checkpoint.h5" \
     --checkpoint-before-frames "$out/checkpoint_before_frames.h5" 2> >(tee ${resume:+-a} "$out/sim_node.log" >&2)
   exit $?
@@ -338,6 +344,7 @@ fi
 # sim_node.log); with --role analysis it runs on another host.
 set +e
 if [[ $role == analysis ]]; then
+  launching_sim=1  # the sim is another host's: from here a signal is passed on as in a whole run
   echo "run_scene: waiting for run $run_id's sim on the bus (start it with --role sim --run-id $run_id --key-file KEY, KEY a copy of $key_file)" >&2
   sim_rc=0
 elif [[ -n $cuts ]]; then
@@ -348,6 +355,7 @@ elif [[ -n $cuts ]]; then
   # (tests: DYNHET_TEST_START_PAUSE seconds here, the nodes up and the sim not)
   [[ -z ${DYNHET_TEST_START_PAUSE:-} ]] || sleep "$DYNHET_TEST_START_PAUSE"
   [[ -z $stop_signal ]] || stop_early
+  launching_sim=1  # from here a signal is passed on to every process, the sim too
   "$bin/sim_node" "${sim_input[@]}" --run-id "$run_id" "${key[@]}" --pace-nodes --checkpoint "$out/checkpoint.h5" \
     --checkpoint-before-frames "$out/checkpoint_before_frames.h5" "${cut_args[@]}" "${resume_cut[@]}" "${sim_delay[@]}" \
     2> >(trap '' TERM INT; exec tee -a "$out/sim_node.log" >&2) &

@@ -11,6 +11,8 @@
 #  4. SIGTERM of the whole process group at random times, twice: every
 #     process saves its part of one last cut and exits; run_scene.sh exits
 #     75 within a bound; run.h5 says incomplete, interrupted;
+#  4b. SIGTERM while the processes start (the nodes up and the sim not; a
+#     process launched and not yet ready): exit 75, nothing left running;
 #  5. the newest whole cut corrupted (one byte of a node's part): refused
 #     with the file named, the cut before it used;
 #  6. the disk of the checkpoints fills during the run (a 4 MB tmpfs):
@@ -138,25 +140,34 @@ for round in 1 2; do
 done
 finish_run "$out" || true
 check 'complete "$out/run.h5" && same "$out"' "stopped twice by SIGTERM and resumed: run.h5 equals the uninterrupted run's"
-# 4b. SIGTERM while the processes start (the nodes up, the sim not yet):
-# all stop, exit 75, nothing left running; the same command then runs it.
-out=$tmp/early
-export DYNHET_TEST_START_PAUSE=4
-start_run "$out"
-for _ in $(seq 100); do grep -qs ready "$out/s4_node.log" && break; sleep 0.05; done
-sleep 0.5
-kill -TERM -- -$run_pid 2>/dev/null || true
-s0=$(date +%s%N)
-set +e; wait $run_pid; rc=$?; set -e
-ms=$(( ($(date +%s%N) - s0) / 1000000 ))
-unset DYNHET_TEST_START_PAUSE
-sleep 0.5
-left=$( (pgrep -f -- "$out/" || true) | wc -l)
-check '[[ $rc == 75 && $ms -lt 10000 && $left == 0 ]]' \
-  "SIGTERM while the processes start: exit 75 (got $rc) after $ms ms, $left processes left"
-check 'grep -q "interrupted (SIGTERM) while the run.s processes started" "$out.log"' "... and says so"
-finish_run "$out" || true
-check 'complete "$out/run.h5" && same "$out"' "... and the same command then runs it: run.h5 equals the uninterrupted run's"
+# 4b. SIGTERM while the processes start: (a) the nodes up, the sim not yet;
+# (b) a process launched and not yet seen ready (the script in a sleep: a
+# group signal ends the sleep too, which under errexit had ended the script
+# 143 before it looked at the signal). All stop, exit 75, nothing left
+# running; the same command then runs it.
+for pause in START READY; do
+  out=$tmp/early_$pause
+  export DYNHET_TEST_${pause}_PAUSE=4
+  start_run "$out"
+  if [[ $pause == START ]]; then
+    for _ in $(seq 100); do grep -qs ready "$out/s4_node.log" && break; sleep 0.05; done
+  else
+    for _ in $(seq 100); do [[ -e $out/recorder.log ]] && break; sleep 0.05; done
+  fi
+  sleep 0.5
+  kill -TERM -- -$run_pid 2>/dev/null || true
+  s0=$(date +%s%N)
+  set +e; wait $run_pid; rc=$?; set -e
+  ms=$(( ($(date +%s%N) - s0) / 1000000 ))
+  unset DYNHET_TEST_${pause}_PAUSE
+  sleep 0.5
+  left=$( (pgrep -f -- "$out/" || true) | wc -l)
+  check '[[ $rc == 75 && $ms -lt 10000 && $left == 0 ]]' \
+    "SIGTERM while the processes start ($pause pause): exit 75 (got $rc) after $ms ms, $left processes left"
+  check 'grep -q "interrupted (SIGTERM) while the run.s processes started" "$out.log"' "... and says so"
+  finish_run "$out" || true
+  check 'complete "$out/run.h5" && same "$out"' "... and the same command then runs it: run.h5 equals the uninterrupted run's"
+done
 
 # 5. The newest whole cut corrupted: the one before is used.
 out=$tmp/corrupt

@@ -91,7 +91,8 @@ def run_local(sd, jobs):
                     failures.append((name, st.get("message", "")))
             say(f"{name}: {st.get('state')}" + (f", tau_alpha {st['tau_alpha']:.4g}" if st.get("tau_alpha") else "")
                 + (f" ({st.get('message')})" if st.get("state") != "complete" else ""))
-            write_index(sd)
+            with lock:  # one writer at a time: the index written last is the newest
+                write_index(sd)
             progress()
 
     progress()

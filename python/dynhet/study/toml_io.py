@@ -1,6 +1,7 @@
 """TOML written (scenes, status files, the index) atomically, and read."""
 import math
 import os
+import threading
 import tomllib
 
 
@@ -38,7 +39,11 @@ def toml_dump(tables, header=""):
 
 
 def write_atomic(path, text):
-    tmp = f"{path}.tmp{os.getpid()}"
+    """Write text to path through a temporary file and a rename: a reader sees
+    the old file or the new, never part. The temporary name is the process's
+    and the thread's: two workers of one study writing the index at once had
+    shared a name, and one's rename took the other's file away."""
+    tmp = f"{path}.tmp{os.getpid()}_{threading.get_ident()}"
     with open(tmp, "w") as f:
         f.write(text)
         f.flush()
