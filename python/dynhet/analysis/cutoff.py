@@ -3,7 +3,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .. import fits as sf
-from .config import A_THREE, EPS_MAIN
+from .config import A_MAIN, A_THREE, EPS_MAIN, XI_MIN_DF
 from .points import fit_series, series_arrays
 from .quantities import XI_MIN, chi4_at_tau, cut, proper_subbox, xi_at_tau
 from .verdicts import fit_verdict, fmt
@@ -88,6 +88,14 @@ def cutoff_results(A):
           "figure only", f"{len(cuts)} cutoffs, {len(pts)} densities (φ {pts[0].phi:g}-{pts[-1].phi:g}), study {', '.join(src)} (lags to {lags:.3g} τ_α(0.6))" +
           (f"; ξ at τ_α(a) not determined at some φ for a = {', '.join(short)} (τ_α(a) beyond the lags, "
            f"{lags:.3g} τ_α(0.6), or ξ < {XI_MIN:g})" if short else ""), "figure", f, pts)
+    # At the main cutoff the same fit is the main series' d_f' row, whose
+    # points may come from larger boxes (--largest-n): said beside it.
+    main = A.fits.get("chi4_xi")
+    sizes = sorted({p.N for p in A.series()})
     for a, fd in outs:
+        note = fd.note + (f"; N = {', '.join(sorted({str(p.N) for p in pts}))} ({', '.join(src)})" if pts else "")
+        if abs(a - A_MAIN) < 1e-9 and main is not None and main.ok:
+            note += (f"; the main series' d_f' at a = {A_MAIN:g} (ξ ≥ {XI_MIN_DF:g}, N {sizes[0]}-{sizes[-1]}): "
+                     f"{fmt(main.p['s'], main.error('s'))}, {fit_verdict(main, 's', 1.6)}")
         A.row(f"χ4 ∝ ξ^d_f' at a = {a:g} (at τ_α(a))", "3.4, fig. diff-a(b)", "similar for all a (≈ 1.6)", fmt(fd.p["s"], fd.error("s")),
-              fit_verdict(fd, "s", 1.6), f, pts, fd.note)
+              fit_verdict(fd, "s", 1.6), f, pts, note)
