@@ -2,44 +2,59 @@
 
 The paper's kappa (sec. 3.3, fig. dist-collapse) is not the slope of one
 density's P(N_c) but the exponent of a collapse over densities: P(N_c)
-N_c^kappa against N_c / N*. Here each curve is (x = N_c / N*, n = N_c,
-P, error of P); the quality of a collapse at kappa is the mean, over
-every point of every curve that lies inside another curve's x range, of
-the squared difference between its ln(P n^kappa) and the other curve's
-(linear in ln x between that curve's two points around it), over the sum
-of both variances (Houdayer and Hartmann's measure, PRB 70, 014418
-(2004)): about 1 where the curves agree within their errors. kappa is its
-minimum; its error is a parametric bootstrap (each P drawn again within
-its error, the minimum found again; ln P drawn within sigma_P / P), since the quality is not a chi^2 of
-independent terms: the width at which it rises by 1 overstates the error
-several times (seen against independent seeds: docs/reproduction_findings.md).
+N_c^kappa against N_c / N*. Each curve is a histogram (n = N_c, bin
+widths w, P, error of P); N* = <N_c^3>/<N_c^2> of its P (below). The quality of a
+collapse at kappa is the mean, over every point of every curve that lies
+inside another curve's x = N_c / N* range, of the squared difference
+between its ln(P n^kappa) and the other curve's (linear in ln x between
+that curve's two points around it), over the sum of both variances
+(Houdayer and Hartmann, PRB 70, 014418 (2004)): about 1 where the curves
+agree within their errors (somewhat below: an interpolated point is less
+noisy than the variance interpolated). Interpolation is linear and the
+overlaps do not depend on kappa, so the quality is a parabola in kappa and
+its minimum is found in closed form. The error: a parametric bootstrap,
+each curve's P drawn again within its errors and N* recomputed from the
+draw. (The width at which the quality rises by 1 overstates the error
+several times: the terms are not independent.)
 """
 import math
 
 import numpy as np
-from scipy.optimize import minimize_scalar
 
 from .fits import Fit
 
-GRID = np.arange(0.5, 3.5001, 0.02)   # exponents scanned before the minimum is refined
+M = 4  # N* = <N_c^M>/<N_c^(M-1)>
+KAPPA_RANGE = (0.5, 3.5)   # an exponent outside is no collapse of a size distribution
 
 
-def prepare(curves):
-    """[(x, n, P, sP)] -> [(ln x, ln n, ln P, sigma of ln P)], bins with P > 0
-    and an error below P only, curves with at least 2 such bins."""
+def n_star(n, w, p):
+    """<N_c^M>/<N_c^(M-1)> of a histogram (P per unit N_c, bin widths w)."""
+    p = np.where(np.isfinite(p) & (p > 0), p, 0.0)
+    s1, s2 = np.sum(p * n ** (M - 1) * w), np.sum(p * n ** M * w)
+    return s2 / s1 if s1 > 0 else math.nan
+
+
+def prepare(curves, lo):
+    """Histograms [(n, w, P, sP)] -> [(ln x, ln n, ln P, sigma of ln P)]:
+    x = n / N*, bins with n >= lo, P > 0 and an error below P (a bin whose
+    error exceeds its value says nothing of ln P); curves with >= 2 bins."""
     out = []
-    for x, n, p, sp in curves:
-        x, n, p, sp = (np.asarray(v, float) for v in (x, n, p, sp))
-        m = np.isfinite(x) & (x > 0) & np.isfinite(n) & (n > 0) & np.isfinite(p) & (p > 0) & np.isfinite(sp) & (sp > 0) & (sp < p)
+    for n, w, p, sp in curves:
+        n, w, p, sp = (np.asarray(v, float) for v in (n, w, p, sp))
+        ns = n_star(n, w, p)
+        if not (np.isfinite(ns) and ns > 0):
+            continue
+        m = (n >= lo) & np.isfinite(p) & (p > 0) & np.isfinite(sp) & (sp > 0) & (sp < p)
         if m.sum() >= 2:
-            o = np.argsort(x[m])
-            out.append((np.log(x[m])[o], np.log(n[m])[o], np.log(p[m])[o], (sp[m] / p[m])[o]))
+            o = np.argsort(n[m])
+            out.append((np.log(n[m] / ns)[o], np.log(n[m])[o], np.log(p[m])[o], (sp[m] / p[m])[o]))
     return out
 
 
-def quality(curves, k):
-    """(the collapse's quality at exponent k, the number of terms) for prepared curves."""
-    num, cnt = 0.0, 0
+def _sums(curves):
+    """The parabola: quality(k) = (c + 2 b k + a k^2) / cnt."""
+    a = b = c = 0.0
+    cnt = 0
     for i, (ui, li, yi, si) in enumerate(curves):
         for j, (uj, lj, yj, sj) in enumerate(curves):
             if i == j:
@@ -47,55 +62,65 @@ def quality(curves, k):
             m = (ui >= uj[0]) & (ui <= uj[-1])
             if not m.any():
                 continue
-            yint = np.interp(ui[m], uj, yj + k * lj)
-            sint = np.interp(ui[m], uj, sj)
-            num += float(np.sum((yi[m] + k * li[m] - yint) ** 2 / (si[m] ** 2 + sint ** 2)))
+            dy = yi[m] - np.interp(ui[m], uj, yj)
+            dl = li[m] - np.interp(ui[m], uj, lj)
+            d = si[m] ** 2 + np.interp(ui[m], uj, sj) ** 2
+            a += float(np.sum(dl * dl / d))
+            b += float(np.sum(dy * dl / d))
+            c += float(np.sum(dy * dy / d))
             cnt += int(m.sum())
-    return (num / cnt if cnt else math.nan), cnt
+    return a, b, c, cnt
 
 
-def best(curves, near=None):
-    """The exponent of the best collapse: the grid's minimum (within 0.3 of
-    `near` where given), refined between its neighbours."""
-    grid = GRID if near is None else GRID[np.abs(GRID - near) <= 0.3]
-    s = np.array([quality(curves, k)[0] for k in grid])
-    if not np.isfinite(s).any():
-        return math.nan
-    i = int(np.nanargmin(s))
-    if i == 0 or i == len(grid) - 1:
-        return math.nan   # no minimum inside the scanned exponents
-    r = minimize_scalar(lambda k: quality(curves, k)[0], bounds=(grid[i - 1], grid[i + 1]), method="bounded",
-                        options={"xatol": 1e-4})
-    return float(r.x)
+def quality(curves, k):
+    """(the collapse's quality at exponent k, the number of terms) for prepared curves."""
+    a, b, c, cnt = _sums(curves)
+    return ((c + 2 * b * k + a * k * k) / cnt if cnt else math.nan), cnt
 
 
-def exponent(curves, resamples=0, seed=1):
-    """A Fit("collapse", ["kappa"]) of raw curves [(x, n, P, sP)]: kappa at the
-    best collapse; with resamples > 0 its error from a parametric bootstrap
-    (fixed seed: the same data give the same error). chi2 / dof is the
-    quality at the minimum (Fit.error then widens the error where the
-    curves do not collapse within their errors)."""
-    pc = prepare(curves)
+def best(curves):
+    """(kappa of the best collapse, its quality, terms); NaN kappa where
+    the curves do not overlap or the minimum lies outside KAPPA_RANGE."""
+    a, b, c, cnt = _sums(curves)
+    if cnt == 0 or a <= 0:
+        return math.nan, math.nan, cnt
+    k = -b / a
+    q = (c + 2 * b * k + a * k * k) / cnt
+    return (k if KAPPA_RANGE[0] <= k <= KAPPA_RANGE[1] else math.nan), q, cnt
+
+
+def exponent(curves, lo=1.0, resamples=0, seed=1):
+    """A Fit("collapse", ["kappa"]) of histograms [(n, w, P, sP)], bins
+    with n >= lo: kappa at the best collapse; with resamples > 0, err =
+    the bootstrap's standard deviation (fixed seed: the same data give the
+    same error). The quality goes to fit.quality (it is not a chi^2:
+    each pair is counted both ways and the terms share points), chi2 and
+    dof stay unset."""
+    pc = prepare(curves, lo)
     fit = Fit("collapse", ["kappa"])
+    fit.quality = math.nan
     if len(pc) < 2:
         fit.note = f"{len(pc)} curve(s) with data: no collapse"
         return fit
-    k = best(pc)
+    k, q, cnt = best(pc)
     if not np.isfinite(k):
-        fit.note = f"no minimum of the collapse's quality for kappa in [{GRID[0]:g}, {GRID[-1]:g}]"
+        fit.note = (f"no overlap of the curves' N_c / N*" if cnt == 0 else
+                    f"the best collapse lies outside κ in [{KAPPA_RANGE[0]:g}, {KAPPA_RANGE[1]:g}]")
         return fit
-    q, cnt = quality(pc, k)
-    fit.p["kappa"] = k
-    fit.chi2, fit.n, fit.dof = q * (cnt - 1), cnt, cnt - 1
+    fit.p["kappa"], fit.quality, fit.n = k, q, cnt
     fit.note = f"{len(pc)} curves, {cnt} overlapping points, quality {q:.2g} at the minimum"
     if resamples > 0:
         rng = np.random.default_rng(seed)
         ks = []
         for _ in range(resamples):
-            drawn = [(u, ln, y + rng.normal(0.0, 1.0, len(y)) * s, s) for u, ln, y, s in pc]
-            ks.append(best(drawn, near=k))
-        ks = np.array([v for v in ks if np.isfinite(v)])
-        if len(ks) >= max(10, resamples // 2):
-            fit.err["kappa"] = float(ks.std(ddof=1))
-            fit.note += f"; error: bootstrap over the bins' errors ({len(ks)} resamples)"
+            drawn = [(n, w, np.asarray(p, float) + rng.normal(0.0, 1.0, len(p)) * np.nan_to_num(np.asarray(sp, float)), sp)
+                     for n, w, p, sp in curves]
+            ks.append(best(prepare(drawn, lo))[0])
+        ks = np.array(ks)
+        ok = np.isfinite(ks)
+        if ok.sum() >= max(10, int(0.9 * resamples)):
+            fit.err["kappa"] = float(ks[ok].std(ddof=1))
+            fit.note += f"; bootstrap over the bins' errors, N* redrawn ({ok.sum()} resamples)"
+        else:
+            fit.note += f"; bootstrap: only {ok.sum()} of {resamples} resamples collapse, no error"
     return fit

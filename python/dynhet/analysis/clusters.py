@@ -41,10 +41,12 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
     ax[1].legend(fontsize=8)
     ax[1].set_title("inset of fig. clusters-VF805: d_f(φ)")
     for p, col in zip(pts, colours(len(pts))):
-        c0 = cut(p.runs[0])
-        pm = np.nanmean([cut(r)["cl_p_slow"] for r in p.runs], axis=0)
+        cv = collapse_curves([p])
+        if not cv:
+            continue
+        n, _, pm, _ = cv[0]
         m = pm > 0
-        ax[2].loglog(c0["cl_size"][m], pm[m], "-o", ms=2, color=col, label=f"{p.phi:g}")
+        ax[2].loglog(n[m], pm[m], "-o", ms=2, color=col, label=f"{p.phi:g}")
     nn = np.geomspace(1, 1e3, 10)
     ax[2].loglog(nn, 0.4 * nn ** -1.8, "k:", label="N_c^-1.8 (paper)")
     ax[2].set_xlabel("N_c")
@@ -91,7 +93,7 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
         knote += "; per density " + ", ".join(f"{k:.3g} (φ {ph:g})" for ph, k in per_phi)
     A.row(f"κ: P(N_c) ∝ N_c^-κ, slow clusters (weighted mean over φ ≥ 0.76, {KAPPA_LO[1]:g} ≤ N_c ≤ N*)",
           "3.3, fig. dist(a), dist-collapse", "≈ 1.8", fmt(kappa, kappa_e), verdict(kappa, kappa_e, 1.8), f1, dense, knote)
-    fc, cpts, cnote = kappa_collapse_rows(A, pts)
+    fc, fc_err, cpts, cnote = kappa_collapse_rows(A, pts)
     # rho: N* = <N_c^2>/<N_c> against (phi_c - phi), phi_c from the tau_alpha power law
     frho = Fitless = None
     if np.isfinite(phi_c):
@@ -102,12 +104,16 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
     fig, ax = plt.subplots(1, 2, figsize=(11, 4.5))
     for p, col in zip(pts, colours(len(pts))):
         c0 = cut(p.runs[0])
-        pm = np.nanmean([cut(r)["cl_p_slow"] for r in p.runs], axis=0)
-        ns = p.mean(n_star)[0]
-        mm = pm > 0
-        if np.isfinite(k_fig) and np.isfinite(ns):
-            ax[0].loglog(c0["cl_size"][mm] / ns, pm[mm] * c0["cl_size"][mm] ** k_fig, "-o" if p in cpts else ":",
-                         ms=2, color=col, label=f"{p.phi:g}")
+        cv = collapse_curves([p])  # the collapse's own curves and N*
+        if cv and np.isfinite(k_fig):
+            n, w, pm, _ = cv[0]
+            ns = collapse.n_star(n, w, pm)
+            mm = pm > 0
+            if np.isfinite(ns):
+                ax[0].loglog(n[mm] / ns, pm[mm] * n[mm] ** k_fig, "-o" if p in cpts else ":", ms=2, color=col,
+                             label=f"{p.phi:g}")
+        if "cl_p_fast" not in c0:
+            continue
         pf = np.nanmean([cut(r)["cl_p_fast"] for r in p.runs], axis=0)
         sg, nsig, p0 = (p.mean(lambda r, k=k: (cut(r)[k], math.nan))[0] for k in ("cl_fast_sigma", "cl_fast_n_sigma", "cl_fast_p0"))
         mf = pf > 0
@@ -115,7 +121,7 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
             ax[1].semilogx(c0["cl_size"][mf] / nsig, (pf[mf] / p0) ** (2 * sg * sg), "o", ms=3, color=col, label=f"{p.phi:g}")
     u = np.geomspace(0.05, 50, 100)
     ax[1].semilogx(u, np.exp(-np.log(u) ** 2), "k-", lw=0.8, label="exp(-ln²(N_c/N_σ))")
-    ax[0].set_xlabel("N_c / N*  (N* = <N_c²>/<N_c>)")
+    ax[0].set_xlabel("N_c / N*  (N* = <N_c³>/<N_c²>, the collapse's)")
     ax[0].set_ylabel(f"P(N_c) N_c^κ, κ = {k_fig:.3g}" + (" (the collapse's)" if fc.ok else " (the slopes')"))
     ax[0].set_title(f"Fig. dist-collapse; N* ∝ (φc-φ)^(-1/ρ), ρ = {rho:.3g}")
     ax[1].set_xlabel("N_c / N_σ")
@@ -125,8 +131,8 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
         a_.legend(fontsize=6, ncol=2)
     f2 = A.save(fig, "clusters_collapse.png")
     A.row(f"κ by the paper's collapse: P(N_c) N_c^κ against N_c / N*, slow clusters (every φ but the lowest, N_c ≥ {KAPPA_LO[0]:g})",
-          "3.3, fig. dist-collapse", "≈ 1.8", fmt(fc.p["kappa"], fc.error("kappa")),
-          verdict(fc.p["kappa"], fc.error("kappa"), 1.8) if fc.ok else "not determined", f2, cpts, cnote)
+          "3.3, fig. dist-collapse", "≈ 1.8", fmt(fc.p["kappa"], fc_err),
+          verdict(fc.p["kappa"], fc_err, 1.8) if fc.ok else "not determined", f2, cpts, cnote)
     # rho against (phi_c - phi): a phi_c on the edge of the data gives the
     # last point all the leverage, so that verdict is not judged; rho is also
     # given with the joint fit's phi_c.
@@ -171,46 +177,63 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
     return kappa
 
 
-def collapse_curves(pts, lo, drop=None):
-    """Per point the slow clusters' P(N_c) (mean over its seeds, seed `drop`
-    left out) against N_c / N* (N* = <N_c^2>/<N_c>, the mean over the same
-    seeds), bins with N_c >= lo: the curves of fig. dist-collapse."""
+def has_clusters(r, like=None):
+    """Whether run r has the slow clusters' P(N_c) (and, given another run,
+    on the same sizes)."""
+    c = cut(r)
+    if not all(k in c for k in ("cl_size", "cl_width", "cl_p_slow", "cl_p_slow_err")):
+        return False
+    return like is None or np.array_equal(c["cl_size"], cut(like)["cl_size"])
+
+
+def collapse_curves(pts, drop=None):
+    """Per point the slow clusters' P(N_c), the mean over its seeds (seed
+    `drop` left out) with the runs' errors combined: the histograms of fig.
+    dist-collapse (collapse.py takes N* from each)."""
     curves = []
     for p in pts:
-        runs = [r for r in p.runs if r["seed"] != drop]
+        runs = [r for r in p.runs if r["seed"] != drop and has_clusters(r)]
+        runs = [r for r in runs if has_clusters(r, runs[0])] if runs else []
         if not runs:
             continue
         cs = [cut(r) for r in runs]
-        P, E = np.array([c["cl_p_slow"] for c in cs]), np.array([c["cl_p_slow_err"] for c in cs])
-        n = cs[0]["cl_size"]
-        ns = float(np.nanmean([n_star(r)[0] for r in runs]))
-        m = n >= lo
-        curves.append((n[m] / ns, n[m], P.mean(axis=0)[m], (np.sqrt((E ** 2).sum(axis=0)) / len(runs))[m]))
+        P, E = np.array([c["cl_p_slow"] for c in cs], float), np.array([c["cl_p_slow_err"] for c in cs], float)
+        curves.append((cs[0]["cl_size"], cs[0]["cl_width"], P.mean(axis=0), np.sqrt((E ** 2).sum(axis=0)) / len(runs)))
     return curves
 
 
 def kappa_collapse_rows(A, pts):
     """kappa as the paper takes it: the exponent of the best collapse of
     P(N_c) N_c^kappa against N_c / N* over every density but the lowest
-    (collapse.py), lower bound of N_c scanned as for the slopes; its error
-    the jackknife over seeds and the bootstrap over the bins' errors
-    (Fit.error). Returns (the fit, its densities, its note)."""
-    cpts = [p for p in pts[1:] if any("cl_p_slow" in cut(r) for r in p.runs)] if len(pts) >= 3 else []
-    if len(cpts) < 2:
-        f = collapse.exponent([])
-        return f, cpts, "fewer than 2 densities above the lowest"
-    scan = {}
-    for lo in KAPPA_LO:
-        if lo == KAPPA_LO[0]:
-            f = sf.jackknife_over_seeds(lambda d: collapse.exponent(collapse_curves(cpts, lo, d)), seeds_of(cpts),
-                                        fit=collapse.exponent(collapse_curves(cpts, lo), resamples=40))
-            A.fit("kappa_collapse", f)
-            scan[lo] = f
-        else:
-            scan[lo] = collapse.exponent(collapse_curves(cpts, lo))
-    vals = {lo: g.p["kappa"] for lo, g in scan.items() if g.ok}
-    note = f"φ {cpts[0].phi:g}-{cpts[-1].phi:g}; {scan[KAPPA_LO[0]].note}; scan of the lower bound: " + ", ".join(
-        f"{lo:g}: {v:.3g}" for lo, v in vals.items())
+    (collapse.py), the lower bound of N_c scanned as for the slopes.
+    Its error: the larger of the bootstrap over the bins' errors and the
+    jackknife over seeds, times sqrt(quality) where the curves do not
+    collapse within their errors. Returns (the fit, its error, its
+    densities, its note)."""
+    cpts = [p for p in pts[1:] if any(has_clusters(r) for r in p.runs)] if len(pts) >= 3 else []
+    f = collapse.exponent(collapse_curves(cpts), KAPPA_LO[0], resamples=200)
+    if len(cpts) < 2 or not f.ok:
+        return f, math.nan, cpts, (f.note if cpts else "fewer than 2 densities above the lowest")
+    seeds = seeds_of(cpts)
+    reps = [collapse.exponent(collapse_curves(cpts, s), KAPPA_LO[0]).p["kappa"] for s in seeds] if len(seeds) >= 2 else []
+    jk = (math.sqrt((len(reps) - 1) / len(reps) * np.sum((np.array(reps) - np.mean(reps)) ** 2))
+          if reps and np.all(np.isfinite(reps)) else math.nan)
+    f.jk["kappa"], f.jk_seeds = jk, len(reps) if np.isfinite(jk) else 0
+    parts = [e for e in (f.err["kappa"], jk) if np.isfinite(e)]
+    err = max(parts) * math.sqrt(max(f.quality, 1.0)) if parts else math.nan
+    f.quoted = {"kappa": err}
+    f.error_from = ("the larger of err_fit (a bootstrap over the bins' errors, N* redrawn) and the jackknife over "
+                    "seeds, times sqrt(quality) where the quality exceeds 1")
+    A.fit("kappa_collapse", f)
+    vals = {KAPPA_LO[0]: f.p["kappa"]}
+    for lo in KAPPA_LO[1:]:
+        g = collapse.exponent(collapse_curves(cpts), lo)
+        if g.ok:
+            vals[lo] = g.p["kappa"]
+    note = (f"φ {cpts[0].phi:g}-{cpts[-1].phi:g}; {f.note}; jackknife over {len(reps)} seeds "
+            + (f"{jk:.2g}" if np.isfinite(jk) else "not taken (fewer than 2 seeds, or a replicate without a collapse)")
+            + (f"; error × sqrt(quality) = {math.sqrt(f.quality):.2g}" if f.quality > 1 else "")
+            + "; scan of the lower bound: " + ", ".join(f"{lo:g}: {v:.3g}" for lo, v in vals.items()))
     if len(vals) >= 2:
         note += f" (systematic ± {(max(vals.values()) - min(vals.values())) / 2:.2g})"
-    return scan[KAPPA_LO[0]], cpts, note
+    return f, err, cpts, note

@@ -1,4 +1,5 @@
 """study.h5 and the reproduction table."""
+import math
 import os
 import re
 import time
@@ -42,11 +43,15 @@ def write_h5(A, path):
             h = fg.create_group(name)
             h.attrs.update(form=fit.form, chi2=fit.chi2, dof=fit.dof, n_points=fit.n, x_min=fit.x_range[0],
                            x_max=fit.x_range[1], note=fit.note or "",
-                           error_from="jackknife over seeds; with fewer than 4 seeds at least err_fit, and where "
-                                      "chi2/dof > 1 at least err_fit * sqrt(chi2/dof) (err_fit: the fit's own covariance)")
+                           error_from=getattr(fit, "error_from", None) or
+                           "jackknife over seeds; with fewer than 4 seeds at least err_fit, and where "
+                           "chi2/dof > 1 at least err_fit * sqrt(chi2/dof) (err_fit: the fit's own covariance)")
+            if np.isfinite(getattr(fit, "quality", math.nan)):
+                h.attrs["quality"] = fit.quality  # a collapse's (collapse.py): not a chi2
+            quoted = getattr(fit, "quoted", {})
             for n_ in fit.names:
                 h.attrs[n_] = fit.p[n_]
-                h.attrs[n_ + "_err"] = fit.error(n_)
+                h.attrs[n_ + "_err"] = quoted.get(n_, fit.error(n_))
                 h.attrs[n_ + "_err_fit"] = fit.err[n_]
         rg = f.create_group("reproduction")
         dt = h5py.string_dtype()
