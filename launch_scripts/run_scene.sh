@@ -204,7 +204,7 @@ trap cleanup EXIT
 # check), and under errexit its failure would end the script 143, a failure
 # to a study or a Slurm job, before the script looked at stop_signal again.
 stop_early() {
-  for p in "${pids[@]}"; do kill -"$stop_signal" "$p" 2>/dev/null || true; done
+  for p in "${pids[@]}"; do kill -TERM "$p" 2>/dev/null || true; done
   for p in "${pids[@]}"; do wait "$p" 2>/dev/null || true; done
   pids=()
   echo "run_scene: interrupted (SIG$stop_signal) while the run's processes started; the same command starts or resumes it" >&2
@@ -213,10 +213,12 @@ stop_early() {
 if [[ -n $cuts ]]; then
   # SIGTERM/SIGINT: every process takes its part of one more cut and stops;
   # this script waits for them (below) and exits 75. Before the sim is
-  # launched: stop_early.
+  # launched: stop_early. Either is passed on as SIGTERM (the programs take
+  # both alike, and a process started with & by a non-interactive bash
+  # ignores SIGINT until its own handler is in place).
   stop_signal="" launching_sim=""
   trap 'stop_signal=TERM; [[ -n $launching_sim ]] || stop_early; for p in "${pids[@]}" ${sim_pid:-}; do kill -TERM "$p" 2>/dev/null || true; done' TERM
-  trap 'stop_signal=INT; [[ -n $launching_sim ]] || stop_early; for p in "${pids[@]}" ${sim_pid:-}; do kill -INT "$p" 2>/dev/null || true; done' INT
+  trap 'stop_signal=INT; [[ -n $launching_sim ]] || stop_early; for p in "${pids[@]}" ${sim_pid:-}; do kill -TERM "$p" 2>/dev/null || true; done' INT
 else
   trap 'echo "run_scene: interrupted" >&2; exit 130' INT TERM
 fi
@@ -225,9 +227,9 @@ if [[ $bus == tcpq ]]; then
   # LCM's TCP hub on a free loopback port of this (private) namespace; it
   # goes when the run's processes have gone (hub_pid, below).
   port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
+  trap 'cleanup; [[ -z ${hub_pid:-} ]] || kill "$hub_pid" 2>/dev/null || true' EXIT
   java -cp /usr/share/java/lcm.jar lcm.lcm.TCPService "$port" >"$out/tcpservice.log" 2>&1 &
   hub_pid=$!
-  trap 'cleanup; kill "$hub_pid" 2>/dev/null || true' EXIT
   hub_up=0
   for _ in $(seq 150); do
     # Connect, and read the hub's 8-byte greeting (a close with it unread
@@ -362,7 +364,7 @@ elif [[ -n $cuts ]]; then
   sim_pid=$!
   # A signal between the check above and this line reached every process
   # but the sim: pass it on.
-  [[ -z $stop_signal ]] || kill -"$stop_signal" "$sim_pid" 2>/dev/null || true
+  [[ -z $stop_signal ]] || kill -TERM "$sim_pid" 2>/dev/null || true
   died=""
   while kill -0 "$sim_pid" 2>/dev/null; do
     for i in "${!pids[@]}"; do
@@ -403,7 +405,7 @@ if [[ $sim_rc -ne 0 ]]; then
     alive=0
     for p in "${pids[@]}"; do kill -0 "$p" 2>/dev/null && alive=1; done
     ((alive)) || break
-    sleep 0.1
+    sleep 0.1 || true  # (a second signal ends the sleep: errexit must not end the script 143)
   done
   for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
 fi
@@ -411,7 +413,11 @@ fi
 status=$sim_rc
 for i in "${!pids[@]}"; do
   set +e
-  if [[ -n ${reaped[$i]:-} ]]; then rc=${reaped[$i]}; else wait "${pids[$i]}"; rc=$?; fi
+  if [[ -n ${reaped[$i]:-} ]]; then rc=${reaped[$i]}; else
+    wait "${pids[$i]}"; rc=$?
+    # A signal ends the wait, not the process (still writing its last cut): wait on.
+    while kill -0 "${pids[$i]}" 2>/dev/null; do wait "${pids[$i]}"; rc=$?; done
+  fi
   set -e
   if [[ $rc -ne 0 ]]; then
     echo "run_scene: ${names[$i]} failed (exit $rc); its log: $out/${names[$i]}.log" >&2
@@ -430,7 +436,7 @@ if [[ -n $record ]]; then
     now=$(stat -c %s "$record" 2>/dev/null || echo 0)
     if [[ $now == "$size" ]]; then still=$((still + 1)); else still=0 size=$now; fi
     ((still >= 8)) && break # 0.8 s without growth: 8 of lcm-logger's 0.1 s flushes
-    sleep 0.1
+    sleep 0.1 || true
   done
   kill -INT "$logger_pid" 2>/dev/null || true
   wait "$logger_pid" 2>/dev/null || true

@@ -89,7 +89,7 @@ cpu_before=$(sed -n 's/^cpu_s = //p' "$stopped")
 cpu_after=$(sed -n 's/^cpu_s = //p' "$stopped") cpu_attempt=$(sed -n 's/^cpu_s_attempt = //p' "$stopped")
 check 'awk -v b="$cpu_before" -v a="$cpu_after" -v t="$cpu_attempt" "BEGIN { exit !(b > 0 && t > 0 && (a - b - t) ^ 2 < 1e-12) }"' \
   "the resumed run's CPU is its two attempts' ($cpu_before + $cpu_attempt = $cpu_after s)"
-check 'grep -qE "was interrupted; resuming(( mid-production| in equilibration)? from checkpoint cut [0-9]+| from .*checkpoint_before_frames.h5)" "$tmp/b2.out"' \
+check 'grep -qE "was interrupted; resuming from (checkpoint cut [0-9]+( \\(its sim last said: (equilibrate|production) t = )?|.*checkpoint_before_frames.h5)" "$tmp/b2.out"' \
   "run again: the interrupted run resumes from its last checkpoint cut (or, before any, from its state before the frames)"
 check 'grep -q "4 of 4 runs complete, 0 failed" "$tmp/b2.out"' "run again: 4 of 4 complete"
 /usr/bin/python3 "$root/tests/compare_studies.py" "$tmp/a" "$tmp/b" || fail=1

@@ -92,10 +92,11 @@ def cutoff_results(A):
     # points may come from larger boxes (--largest-n): said beside it.
     main = A.fits.get("chi4_xi")
     sizes = sorted({p.N for p in A.series()})
+    span = f"{sizes[0]}" + (f"-{sizes[-1]}" if sizes and sizes[-1] != sizes[0] else "") if sizes else "?"
     for a, fd in outs:
-        note = fd.note + (f"; N = {', '.join(sorted({str(p.N) for p in pts}))} ({', '.join(src)})" if pts else "")
+        note = fd.note + (f"; N = {', '.join(str(n) for n in sorted({p.N for p in pts}))} ({', '.join(src)})" if pts else "")
         if abs(a - A_MAIN) < 1e-9 and main is not None and main.ok:
-            note += (f"; the main series' d_f' at a = {A_MAIN:g} (ξ ≥ {XI_MIN_DF:g}, N {sizes[0]}-{sizes[-1]}): "
+            note += (f"; the main series' d_f' at a = {A_MAIN:g} (ξ ≥ {XI_MIN_DF:g}, N {span}): "
                      f"{fmt(main.p['s'], main.error('s'))}, {fit_verdict(main, 's', 1.6)}")
         A.row(f"χ4 ∝ ξ^d_f' at a = {a:g} (at τ_α(a))", "3.4, fig. diff-a(b)", "similar for all a (≈ 1.6)", fmt(fd.p["s"], fd.error("s")),
               fit_verdict(fd, "s", 1.6), f, pts, note)

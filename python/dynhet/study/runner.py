@@ -32,9 +32,9 @@ def do_run(sd, p, log=print):
         if cut is not None and os.path.exists(os.path.join(d, "scene.toml")):
             # run_scene.sh on the same directory resumes from the cut itself.
             resume = "cut"
-            last = sim_progress(d)  # the phase the sim last reported (a cut is taken in either phase)
-            where = {"equilibrate": " in equilibration", "production": " mid-production"}.get((last or {}).get("phase"), "")
-            log(f"{st.run_name(p)}: was interrupted; resuming{where} from checkpoint cut {cut}")
+            last = sim_progress(d)  # what the sim last reported (a cut is taken in either phase)
+            said = f" (its sim last said: {last['phase']} t = {last['t']:.6g} of {last['end']:.6g})" if last else ""
+            log(f"{st.run_name(p)}: was interrupted; resuming from checkpoint cut {cut}{said}")
         elif os.path.exists(ck) and os.path.exists(os.path.join(d, "scene.toml")):
             resume = ck
             log(f"{st.run_name(p)}: was interrupted; resuming from {ck}")

@@ -1,6 +1,7 @@
 """TOML written (scenes, status files, the index) atomically, and read."""
 import math
 import os
+import socket
 import threading
 import tomllib
 
@@ -40,10 +41,10 @@ def toml_dump(tables, header=""):
 
 def write_atomic(path, text):
     """Write text to path through a temporary file and a rename: a reader sees
-    the old file or the new, never part. The temporary name is the process's
-    and the thread's: two workers of one study writing the index at once had
+    the old file or the new, never part. The temporary name is the host's, the
+    process's and the thread's: two workers of one study writing the index at once had
     shared a name, and one's rename took the other's file away."""
-    tmp = f"{path}.tmp{os.getpid()}_{threading.get_ident()}"
+    tmp = f"{path}.tmp.{socket.gethostname()}.{os.getpid()}.{threading.get_ident()}"  # (Slurm tasks share a filesystem)
     with open(tmp, "w") as f:
         f.write(text)
         f.flush()
