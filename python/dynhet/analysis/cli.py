@@ -33,7 +33,7 @@ from .overlap import ageing_results, overlap_results, tau_results
 from .transport import d_results, pdx_results
 from .clusters import cluster_results
 from .chi4_s4 import chi4_results, fss_results, joint_fit, s4_results
-from .size import d_n_results, tau_n_results
+from .size import d_n_results, kappa_n_results, tau_n_results
 from .local_measures import local_n_results, local_phi_results
 from .cutoff import cutoff_results
 from .restitution import restitution_results
@@ -131,6 +131,7 @@ def main(argv=None):
     step("finite size", fss_results, joint, needs=("chi4", "s4_q"))
     step("tau_alpha against N", tau_n_results)
     step("D against N", d_n_results)
+    step("kappa against N", kappa_n_results, needs=("cl_lag",))
     step("cage-relative tau_alpha and bond breaking against phi", local_phi_results)
     step("cage-relative tau_alpha and bond breaking against N", local_n_results)
     step("cutoff a", cutoff_results)

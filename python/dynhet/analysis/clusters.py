@@ -202,18 +202,15 @@ def collapse_curves(pts, drop=None):
     return curves
 
 
-def kappa_collapse_rows(A, pts):
-    """kappa as the paper takes it: the exponent of the best collapse of
-    P(N_c) N_c^kappa against N_c / N* over every density but the lowest
-    (collapse.py), the lower bound of N_c scanned as for the slopes.
-    Its error: the larger of the bootstrap over the bins' errors and the
-    jackknife over seeds, times sqrt(quality) where the curves do not
-    collapse within their errors. Returns (the fit, its error, its
-    densities, its note)."""
-    cpts = [p for p in pts[1:] if any(has_clusters(r) for r in p.runs)] if len(pts) >= 3 else []
+def collapse_fit(A, cpts, key):
+    """The collapse of cpts' slow-cluster P(N_c), N_c >= KAPPA_LO[0]
+    (collapse.py), recorded as fit `key`: (fit, quoted error, the
+    jackknife's words). The error: the larger of the bootstrap over the
+    bins' errors and the jackknife over seeds, times sqrt(quality) where
+    the curves do not collapse within their errors."""
     f = collapse.exponent(collapse_curves(cpts), KAPPA_LO[0], resamples=200)
-    if len(cpts) < 2 or not f.ok:
-        return f, math.nan, cpts, (f.note if cpts else "fewer than 2 densities above the lowest")
+    if not f.ok:
+        return f, math.nan, ""
     seeds = seeds_of(cpts)
     reps = [collapse.exponent(collapse_curves(cpts, s), KAPPA_LO[0]).p["kappa"] for s in seeds] if len(seeds) >= 2 else []
     jk = (math.sqrt((len(reps) - 1) / len(reps) * np.sum((np.array(reps) - np.mean(reps)) ** 2))
@@ -224,16 +221,29 @@ def kappa_collapse_rows(A, pts):
     f.quoted = {"kappa": err}
     f.error_from = ("the larger of err_fit (a bootstrap over the bins' errors, N* redrawn) and the jackknife over "
                     "seeds, times sqrt(quality) where the quality exceeds 1")
-    A.fit("kappa_collapse", f)
+    A.fit(key, f)
+    words = (f"jackknife over {len(reps)} seeds " + (f"{jk:.2g}" if np.isfinite(jk) else
+             "not taken (fewer than 2 seeds, or a replicate without a collapse)")
+             + (f"; error × sqrt(quality) = {math.sqrt(f.quality):.2g}" if f.quality > 1 else ""))
+    return f, err, words
+
+
+def kappa_collapse_rows(A, pts):
+    """kappa as the paper takes it: the exponent of the best collapse of
+    P(N_c) N_c^kappa against N_c / N* over every density but the lowest
+    (collapse_fit), the lower bound of N_c scanned as for the slopes.
+    Returns (the fit, its error, its densities, its note)."""
+    cpts = [p for p in pts[1:] if any(has_clusters(r) for r in p.runs)] if len(pts) >= 3 else []
+    f, err, words = collapse_fit(A, cpts, "kappa_collapse")
+    if len(cpts) < 2 or not f.ok:
+        return f, math.nan, cpts, (f.note if cpts else "fewer than 2 densities above the lowest")
     vals = {KAPPA_LO[0]: f.p["kappa"]}
     for lo in KAPPA_LO[1:]:
         g = collapse.exponent(collapse_curves(cpts), lo)
         if g.ok:
             vals[lo] = g.p["kappa"]
-    note = (f"φ {cpts[0].phi:g}-{cpts[-1].phi:g}; {f.note}; jackknife over {len(reps)} seeds "
-            + (f"{jk:.2g}" if np.isfinite(jk) else "not taken (fewer than 2 seeds, or a replicate without a collapse)")
-            + (f"; error × sqrt(quality) = {math.sqrt(f.quality):.2g}" if f.quality > 1 else "")
-            + "; scan of the lower bound: " + ", ".join(f"{lo:g}: {v:.3g}" for lo, v in vals.items()))
+    note = (f"φ {cpts[0].phi:g}-{cpts[-1].phi:g}; {f.note}; {words}; scan of the lower bound: "
+            + ", ".join(f"{lo:g}: {v:.3g}" for lo, v in vals.items()))
     if len(vals) >= 2:
         note += f" (systematic ± {(max(vals.values()) - min(vals.values())) / 2:.2g})"
     return f, err, cpts, note

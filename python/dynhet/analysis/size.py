@@ -108,3 +108,50 @@ def tau_n_results(A):
     ax.set_title("τ_α against the number of particles")
     f = A.save(fig, "tau_alpha_N.png")
     A.row("τ_α against N (finite size)", "2 (N = 3.6 x 10^5 to 4 x 10^6)", "not studied", "; ".join(cells), "figure", f, used)
+
+
+def kappa_n_results(A):
+    """kappa of the slow clusters' collapse (clusters.collapse_fit) at each N,
+    over the same densities at every N (those of the largest N with at
+    least 3, as for theta): whether the paper's estimator moves with the box
+    (at small N the box cuts the largest clusters off)."""
+    from .clusters import collapse_fit, has_clusters
+    multi = points_by_phi_n(A, lambda p: any(has_clusters(r) for r in p.runs))
+    per_n = {}
+    for d in multi.values():
+        for n, p in d.items():
+            per_n.setdefault(n, {})[p.phi] = p
+    wide = [n for n, ps in per_n.items() if len(ps) >= 3]
+    if not wide:
+        A.row("κ by the collapse against N", "3.3, fig. dist-collapse", "not studied",
+              "fewer than 3 densities with clusters at several N", "not run", "", [])
+        return
+    common = sorted(per_n[max(wide)])
+    ks, used = {}, []
+    for n, ps in sorted(per_n.items()):
+        if all(phi in ps for phi in common):
+            f, err, _ = collapse_fit(A, [ps[phi] for phi in common], f"kappa_collapse_N{n}")
+            if f.ok:
+                ks[n] = (f.p["kappa"], err, f.quality)
+                used += [ps[phi] for phi in common]
+    if len(ks) < 2:
+        A.row("κ by the collapse against N", "3.3, fig. dist-collapse", "not studied",
+              "the collapse at fewer than 2 N", "not determined", "", used)
+        return
+    ns = sorted(ks)
+    fig, ax = plt.subplots(figsize=(5.5, 4.2))
+    errorbar(ax, ns, [ks[n][0] for n in ns], [ks[n][1] for n in ns], fmt="o-", color="k")
+    ax.axhline(1.8, color="0.6", ls=":", label="paper ≈ 1.8")
+    ax.set_xscale("log")
+    ax.set_xlabel("N")
+    ax.set_ylabel("κ of the collapse (N_c ≥ 1)")
+    ax.set_title("κ against N, φ = " + ", ".join(f"{x:g}" for x in common))
+    ax.legend(fontsize=8)
+    f = A.save(fig, "kappa_N.png")
+    lo, hi = ks[ns[0]], ks[ns[-1]]
+    z = abs(hi[0] - lo[0]) / math.hypot(lo[1], hi[1]) if np.isfinite(math.hypot(lo[1], hi[1])) else math.nan
+    A.row("κ by the collapse against N (the paper's estimator at each N)", "3.3, fig. dist-collapse", "not studied",
+          ", ".join(f"N {n}: {fmt(ks[n][0], ks[n][1])} (quality {ks[n][2]:.2g})" for n in ns)
+          + " (each over φ = " + ", ".join(f"{x:g}" for x in common) + ")",
+          ("moves with N" if z > 2 else "no change with N resolved") + f" ({z:.1f} σ from N {ns[0]} to {ns[-1]})"
+          if np.isfinite(z) else "not determined", f, used)
