@@ -1,0 +1,71 @@
+"""The kappa collapse rows on Points (clusters.collapse_fit, size.kappa_n_results):
+runs without clusters or with other bins are left out, not fatal; exact
+scaling histograms give back their exponent at every N."""
+import numpy as np
+
+from dynhet.analysis.clusters import collapse_curves, collapse_fit
+from dynhet.analysis.points import Point
+from dynhet.analysis.size import kappa_n_results
+from dynhet.analysis.study import Analysis
+
+SIZES = np.unique(np.round(np.geomspace(1, 3e4, 30)))
+WIDTHS = np.gradient(SIZES)
+CUTOFF = {0.76: 60.0, 0.78: 200.0, 0.79: 700.0, 0.80: 2500.0}
+
+
+def run(phi, seed, rng, sizes=SIZES):
+    c = CUTOFF[phi]
+    p = sizes ** -1.8 * np.exp(-sizes / c)
+    sp = 0.04 * p * (1 + sizes / c)
+    return {"seed": seed, "cut": {0.6: {"cl_size": sizes, "cl_width": np.gradient(sizes), "cl_p_slow_err": sp,
+                                         "cl_p_slow": p + rng.normal(0, 1, len(p)) * sp, "tau_alpha": 1.0}}}
+
+
+def analysis(tmp_path, ns=(4096, 16384)):
+    rng = np.random.default_rng(7)
+    A = Analysis.__new__(Analysis)
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    A.dir, A.figdir = str(tmp_path), str(tmp_path / "figures")
+    for n in ns:
+        for phi in CUTOFF:
+            p = Point(("neighbours", 0.9, phi, n))
+            p.runs = [run(phi, s, rng) for s in (1, 2, 3)]
+            (A.points if n == ns[0] else A.extra)[(p.pairs, p.eps, p.phi, p.N) if n == ns[0] else
+                                                  ("big", p.pairs, p.eps, p.phi, p.N)] = p
+            if n != ns[0]:
+                p.study = "big"
+    return A
+
+
+def test_runs_without_clusters_or_with_other_bins_are_left_out(tmp_path):
+    A = analysis(tmp_path, ns=(4096,))
+    pts = sorted(A.points.values(), key=lambda p: p.phi)
+    del pts[0].runs[0]["cut"][0.6]["cl_size"]                           # no clusters at this cutoff
+    pts[1].runs[2] = run(0.78, 3, np.random.default_rng(1), SIZES[:-3])  # other bins than its point's first run
+    cv = collapse_curves(pts)
+    assert len(cv) == 4 and all(len(c[0]) == len(SIZES) for c in cv)
+    f, err, _ = collapse_fit(A, pts, "k")
+    assert f.ok and abs(f.p["kappa"] - 1.8) < 3 * err, (f.p["kappa"], err)
+    assert "k" in A.fits and A.fits["k"].quoted["kappa"] == err
+
+
+def test_kappa_against_n_finds_no_change_where_there_is_none(tmp_path):
+    A = analysis(tmp_path)
+    kappa_n_results(A)
+    row = A.rows[-1]
+    assert row["item"].startswith("κ by the collapse against N")
+    assert "N 4096" in row["ours"] and "N 16384" in row["ours"]
+    assert row["verdict"].startswith("no change with N resolved"), row
+
+
+def test_kappa_against_n_sees_a_change(tmp_path):
+    A = analysis(tmp_path)
+    rng = np.random.default_rng(9)
+    for p in A.extra.values():           # the larger box with another exponent
+        for r in p.runs:
+            c = r["cut"][0.6]
+            p_ = SIZES ** -2.1 * np.exp(-SIZES / CUTOFF[p.phi])
+            c["cl_p_slow"] = p_ + rng.normal(0, 1, len(p_)) * 0.04 * p_ * (1 + SIZES / CUTOFF[p.phi])
+            c["cl_p_slow_err"] = 0.04 * p_ * (1 + SIZES / CUTOFF[p.phi])
+    kappa_n_results(A)
+    assert A.rows[-1]["verdict"].startswith("moves with N"), A.rows[-1]
