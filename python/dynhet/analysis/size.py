@@ -27,6 +27,28 @@ def points_by_phi_n(A, has=lambda p: True):
     return {phi: d for phi, d in sorted(by_phi.items()) if len(d) > 1}
 
 
+def common_densities(multi):
+    """({N: {phi: Point}}, the densities of the largest N that has at least
+    3 of them): a cross-density fit at each N over the same densities."""
+    per_n = {}
+    for d in multi.values():
+        for n, p in d.items():
+            per_n.setdefault(n, {})[p.phi] = p
+    wide = [n for n, ps in per_n.items() if len(ps) >= 3]
+    return per_n, (sorted(per_n[max(wide)]) if wide else [])
+
+
+def n_verdict(vals):
+    """Whether a value {N: (value, error)} moves from the smallest N to the largest (2 combined errors)."""
+    ns = sorted(vals)
+    lo, hi = vals[ns[0]], vals[ns[-1]]
+    e = math.hypot(lo[1], hi[1])
+    if not np.isfinite(e) or e == 0:
+        return "not determined"
+    z = abs(hi[0] - lo[0]) / e
+    return ("moves with N" if z > 2 else "no change with N resolved") + f" ({z:.1f} σ from N {ns[0]} to {ns[-1]})"
+
+
 def d_n_results(A):
     """D against N at each density run at several N, and theta of
     D ~ tau_alpha^-theta at each N over the densities it has (studies/d_size.toml):
@@ -50,14 +72,9 @@ def d_n_results(A):
     # theta at each N over the same densities at every N (like with like: the
     # densities of the largest N with at least 3 of them; theta' of the
     # highest densities differs from theta), at each N that has them all
-    per_n = {}
-    for d in multi.values():
-        for n, p in d.items():
-            per_n.setdefault(n, {})[p.phi] = p
-    th, common = {}, []
-    wide = [n for n, ps in per_n.items() if len(ps) >= 3]
-    if wide:
-        common = sorted(per_n[max(wide)])
+    per_n, common = common_densities(multi)
+    th = {}
+    if common:
         for n, ps in sorted(per_n.items()):
             if all(phi in ps for phi in common):
                 f = A.fit(f"D_tau_N{n}", fit_series([ps[phi] for phi in common], dD, sf.power, xrun=tau))
@@ -73,14 +90,9 @@ def d_n_results(A):
     f = A.save(fig, "D_N.png")
     A.row("D against N (box-scale flows)", "3.2 (D, θ)", "not studied", "; ".join(cells), "figure", f, used)
     if len(th) >= 2:
-        ns = sorted(th)
-        lo, hi = th[ns[0]], th[ns[-1]]
-        z = abs(hi[0] - lo[0]) / math.hypot(lo[1], hi[1]) if np.isfinite(math.hypot(lo[1], hi[1])) else math.nan
         A.row("θ against N (D ∝ τ_α^-θ at each N)", "3.2, fig. D-vs-tau", "not studied",
-              ", ".join(f"N {n}: {fmt(th[n][0], th[n][1])}" for n in ns)
-              + " (each over φ = " + ", ".join(f"{x:g}" for x in common) + ")",
-              ("moves with N" if z > 2 else "no change with N resolved") + f" ({z:.1f} σ from N {ns[0]} to {ns[-1]})"
-              if np.isfinite(z) else "not determined", f, used)
+              ", ".join(f"N {n}: {fmt(th[n][0], th[n][1])}" for n in sorted(th))
+              + " (each over φ = " + ", ".join(f"{x:g}" for x in common) + ")", n_verdict(th), f, used)
 
 
 def tau_n_results(A):
@@ -117,16 +129,11 @@ def kappa_n_results(A):
     (at small N the box cuts the largest clusters off)."""
     from .clusters import collapse_fit, has_clusters
     multi = points_by_phi_n(A, lambda p: any(has_clusters(r) for r in p.runs))
-    per_n = {}
-    for d in multi.values():
-        for n, p in d.items():
-            per_n.setdefault(n, {})[p.phi] = p
-    wide = [n for n, ps in per_n.items() if len(ps) >= 3]
-    if not wide:
+    per_n, common = common_densities(multi)
+    if not common:
         A.row("κ by the collapse against N", "3.3, fig. dist-collapse", "not studied",
               "fewer than 3 densities with clusters at several N", "not run", "", [])
         return
-    common = sorted(per_n[max(wide)])
     ks, used = {}, []
     for n, ps in sorted(per_n.items()):
         if all(phi in ps for phi in common):
@@ -148,10 +155,6 @@ def kappa_n_results(A):
     ax.set_title("κ against N, φ = " + ", ".join(f"{x:g}" for x in common))
     ax.legend(fontsize=8)
     f = A.save(fig, "kappa_N.png")
-    lo, hi = ks[ns[0]], ks[ns[-1]]
-    z = abs(hi[0] - lo[0]) / math.hypot(lo[1], hi[1]) if np.isfinite(math.hypot(lo[1], hi[1])) else math.nan
     A.row("κ by the collapse against N (the paper's estimator at each N)", "3.3, fig. dist-collapse", "not studied",
           ", ".join(f"N {n}: {fmt(ks[n][0], ks[n][1])} (quality {ks[n][2]:.2g})" for n in ns)
-          + " (each over φ = " + ", ".join(f"{x:g}" for x in common) + ")",
-          ("moves with N" if z > 2 else "no change with N resolved") + f" ({z:.1f} σ from N {ns[0]} to {ns[-1]})"
-          if np.isfinite(z) else "not determined", f, used)
+          + " (each over φ = " + ", ".join(f"{x:g}" for x in common) + ")", n_verdict(ks), f, used)
