@@ -202,13 +202,13 @@ def collapse_curves(pts, drop=None):
     return curves
 
 
-def collapse_fit(A, cpts, key):
+def collapse_fit(A, cpts, key, curves=None):
     """The collapse of cpts' slow-cluster P(N_c), N_c >= KAPPA_LO[0]
     (collapse.py), recorded as fit `key`: (fit, quoted error, the
     jackknife's words). The error: the larger of the bootstrap over the
     bins' errors and the jackknife over seeds, times sqrt(quality) where
-    the curves do not collapse within their errors."""
-    f = collapse.exponent(collapse_curves(cpts), KAPPA_LO[0], resamples=200)
+    the curves do not collapse within their errors. (curves: collapse_curves(cpts), where made already.)"""
+    f = collapse.exponent(collapse_curves(cpts) if curves is None else curves, KAPPA_LO[0], resamples=200)
     if not f.ok:
         return f, math.nan, ""
     seeds = seeds_of(cpts)
@@ -234,12 +234,13 @@ def kappa_collapse_rows(A, pts):
     (collapse_fit), the lower bound of N_c scanned as for the slopes.
     Returns (the fit, its error, its densities, its note)."""
     cpts = [p for p in pts[1:] if any(has_clusters(r) for r in p.runs)] if len(pts) >= 3 else []
-    f, err, words = collapse_fit(A, cpts, "kappa_collapse")
+    curves = collapse_curves(cpts)
+    f, err, words = collapse_fit(A, cpts, "kappa_collapse", curves)
     if len(cpts) < 2 or not f.ok:
         return f, math.nan, cpts, (f.note if cpts else "fewer than 2 densities above the lowest")
     vals = {KAPPA_LO[0]: f.p["kappa"]}
     for lo in KAPPA_LO[1:]:
-        g = collapse.exponent(collapse_curves(cpts), lo)
+        g = collapse.exponent(curves, lo)
         if g.ok:
             vals[lo] = g.p["kappa"]
     note = (f"φ {cpts[0].phi:g}-{cpts[-1].phi:g}; {f.note}; {words}; scan of the lower bound: "

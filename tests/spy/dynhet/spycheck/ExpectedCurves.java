@@ -40,21 +40,26 @@ final class ExpectedCurves {
     return e;
   }
 
+  // A decay from 1 (Q(t), C_B(t)) and the 1/e line over its lags.
+  static void decay(List<Curve> out, String name, double[] t, double[] y, int n) {
+    Curve c = new Curve(name);
+    double lo = Double.POSITIVE_INFINITY, hi = 0;
+    for (int j = 0; j < n; ++j) {
+      add(c, t[j], y[j], true, false);
+      if (Double.isFinite(t[j]) && t[j] > 0) {
+        lo = Math.min(lo, t[j]);
+        hi = Math.max(hi, t[j]);
+      }
+    }
+    out.add(c);
+    if (hi > 0) out.add(oneOverE(lo, hi));
+  }
+
   static List<Curve> expected(Object message) {
     List<Curve> out = new ArrayList<>();
     if (message instanceof overlap_t) {
       overlap_t m = (overlap_t)message;
-      Curve q = new Curve("Q(t)");
-      double lo = Double.POSITIVE_INFINITY, hi = 0;
-      for (int j = 0; j < m.n_lags; ++j) {
-        add(q, m.lag_time[j], m.q[j], true, false);
-        if (Double.isFinite(m.lag_time[j]) && m.lag_time[j] > 0) {
-          lo = Math.min(lo, m.lag_time[j]);
-          hi = Math.max(hi, m.lag_time[j]);
-        }
-      }
-      out.add(q);
-      if (hi > 0) out.add(oneOverE(lo, hi));
+      decay(out, "Q(t)", m.lag_time, m.q, m.n_lags);
     } else if (message instanceof chi4_t) {
       chi4_t m = (chi4_t)message;
       for (int g = 0; g < m.n_grids; ++g) {
@@ -74,17 +79,7 @@ final class ExpectedCurves {
       }
     } else if (message instanceof bond_breaking_t) {
       bond_breaking_t m = (bond_breaking_t)message;
-      Curve cb = new Curve("C_B(t)");
-      double lo = Double.POSITIVE_INFINITY, hi = 0;
-      for (int j = 0; j < m.n_lags; ++j) {
-        add(cb, m.lag_time[j], m.c_b[j], true, false);
-        if (Double.isFinite(m.lag_time[j]) && m.lag_time[j] > 0) {
-          lo = Math.min(lo, m.lag_time[j]);
-          hi = Math.max(hi, m.lag_time[j]);
-        }
-      }
-      out.add(cb);
-      if (hi > 0) out.add(oneOverE(lo, hi));
+      decay(out, "C_B(t)", m.lag_time, m.c_b, m.n_lags);
     } else if (message instanceof s4_t) {
       s4_t m = (s4_t)message;
       int v = 0;
