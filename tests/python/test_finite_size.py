@@ -314,3 +314,24 @@ def test_chi4p_against_the_sub_box_is_drawn_per_n_from_interior_peaks_only(tmp_p
         for r in p.runs:
             r["cut"][0.6]["tau4_interior"][:] = False          # no interior peak anywhere: nothing to draw
     assert plot_chi4p_subbox(A, multi, multi_cr) == ""
+
+
+def test_a_tie_at_one_n_goes_to_the_study_that_runs_the_density_at_every_n():
+    """One protocol across N: where a single-N study (quick, other run lengths)
+    and the scale study have as many seeds at N = 4096, the scale study's
+    point is the one in the table; more seeds still win."""
+    from dynhet.analysis.size import points_by_phi_n
+
+    def point(study, n, seeds):
+        p = Point(("neighbours", 0.9, 0.79, n))
+        p.runs = [{"seed": s, "N": n, "study": study} for s in range(1, seeds + 1)]
+        return p
+    A = Analysis.__new__(Analysis)
+    quick = point("quick", 4096, 3)
+    A.points = {(quick.pairs, quick.eps, quick.phi, quick.N): quick}
+    scale = {n: point("scale", n, 3) for n in (1024, 4096, 16384)}
+    A.extra = {("scale", p.pairs, p.eps, p.phi, p.N): p for p in scale.values()}
+    multi = points_by_phi_n(A)
+    assert multi[0.79][4096] is scale[4096] and multi[0.79][1024] is scale[1024]
+    quick.runs.append({"seed": 4, "N": 4096, "study": "quick"})     # four seeds against three
+    assert points_by_phi_n(A)[0.79][4096] is quick

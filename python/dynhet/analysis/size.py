@@ -14,17 +14,28 @@ from .plotting import colours, errorbar, log_axes
 
 def points_by_phi_n(A, has=lambda p: True):
     """{phi: {N: Point}} of the main dynamics over this study and the --also
-    studies, the point with most runs where several have the same phi and N;
-    only densities run at more than one N."""
+    studies, the point with most runs where several have the same phi and N,
+    and among those with as many, the one whose study runs that phi at the
+    most N: one protocol (run lengths in units of tau_alpha^CR) across the
+    sizes, not a single-N study's; only densities run at more than one N."""
     allp = [p for p in list(A.points.values()) + list(A.extra.values())
             if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p)]
+    sizes = {}
+    for p in allp:
+        sizes.setdefault((study_of(p), p.phi), set()).add(p.N)
+    rank = lambda p: (len(p.runs), len(sizes[(study_of(p), p.phi)]))
     by_phi = {}
     for p in allp:
         by_phi.setdefault(p.phi, {})
         q = by_phi[p.phi].get(p.N)
-        if q is None or len(p.runs) > len(q.runs):
+        if q is None or rank(p) > rank(q):
             by_phi[p.phi][p.N] = p
     return {phi: d for phi, d in sorted(by_phi.items()) if len(d) > 1}
+
+
+def study_of(p):
+    """The study a point came from (an --also point says; a run says its own)."""
+    return getattr(p, "study", None) or (p.runs[0].get("study") if p.runs else None)
 
 
 def common_densities(multi):
