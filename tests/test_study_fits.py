@@ -78,7 +78,8 @@ def joint_truth():
             "xi": lambda x: 0.1 * (0.82 - x) ** -1.6}
 
 
-devs = {"xc": [], "g_chi4": [], "g_xi": []}
+devs = {"xc": [], "g_chi4": [], "g_xi": [], "g_chi4/g_xi": []}
+own_ratio = []   # the ratio's error from the covariance alone, against the truth
 for _ in range(R // 2):
     data = {k: f(phi)[None, :] * (1 + S * rng.standard_normal((K, len(phi)))) for k, f in joint_truth().items()}
 
@@ -89,6 +90,15 @@ for _ in range(R // 2):
     f = sf.jackknife_over_seeds(one, list(range(K)))
     for p, true in (("xc", 0.82), ("g_chi4", 2.5), ("g_xi", 1.6)):
         devs[p].append((f.p[p] - true) / f.error(p))
+    # a quantity of two parameters (the exponent ratio of the finite-size collapse): Fit.derived
+    ratio = lambda q: q["g_chi4"] / q["g_xi"]
+    v, e = f.derived(ratio)
+    devs["g_chi4/g_xi"].append((v - 2.5 / 1.6) / e)
+    f.jk_p = []
+    own_ratio.append((v - 2.5 / 1.6) / f.derived(ratio)[1])
+own_ratio = np.array(own_ratio)
+check(0.45 <= np.mean(np.abs(own_ratio) < 1) <= 0.9,
+      f"Fit.derived from the covariance alone (correlations kept): the ratio within one error in {np.mean(np.abs(own_ratio) < 1):.0%} of studies")
 for p, d in devs.items():
     d = np.array(d)
     check(np.mean(np.abs(d) < 3) > 0.9, f"critical_joint: {p} recovered within 3 jackknife errors in {np.mean(np.abs(d) < 3):.0%} of {R // 2} studies")

@@ -36,6 +36,8 @@ class Fit:
         self.err = {n: math.nan for n in names}     # from the covariance of the fit
         self.jk = {n: math.nan for n in names}      # jackknife over seeds (set by jackknife_over_seeds)
         self.jk_seeds = 0                           # the seeds behind jk
+        self.jk_p = []                              # the jackknife replicas' parameters (derived())
+        self.cov, self.cov_names = None, []         # the fit's covariance, where it keeps it (derived())
         self.chi2 = math.nan
         self.dof = 0
         self.n = 0
@@ -55,14 +57,43 @@ class Fit:
         over fewer than MIN_JK_SEEDS seeds (one or two dof: its size is itself
         uncertain by a factor of two or more) is not taken alone: the larger of
         it and the fit's own error."""
-        e = self.jk.get(name, math.nan)
-        e = e if np.isfinite(e) else self.err[name]
-        if self.jk_seeds < MIN_JK_SEEDS and np.isfinite(self.err[name]):
-            e = max(e, self.err[name])
+        return self._quoted(self.jk.get(name, math.nan), self.err[name])
+
+    def _quoted(self, jk, own):
+        e = jk if np.isfinite(jk) else own
+        if self.jk_seeds < MIN_JK_SEEDS and np.isfinite(own):
+            e = max(e, own)
         r = self.chi2_dof()
-        if np.isfinite(r) and r > 1 and np.isfinite(self.err[name]):
-            e = max(e, self.err[name] * math.sqrt(r)) if np.isfinite(e) else self.err[name] * math.sqrt(r)
+        if np.isfinite(r) and r > 1 and np.isfinite(own):
+            e = max(e, own * math.sqrt(r)) if np.isfinite(e) else own * math.sqrt(r)
         return e
+
+    def derived(self, fn):
+        """(fn(p), its quoted error) for a quantity made of the parameters (a
+        ratio of two exponents, say), by the rule of error(): the jackknife
+        over the same seeds' replicas of fn, and the fit's own error
+        propagated through its covariance (correlations kept: two exponents
+        sharing one xc are), where the fit keeps it."""
+        v = float(fn(self.p))
+        jk = math.nan
+        reps = np.array([fn(q) for q in self.jk_p], float)
+        if len(reps) >= 2 and np.all(np.isfinite(reps)):
+            n = len(reps)
+            jk = float(math.sqrt((n - 1) / n * ((reps - reps.mean()) ** 2).sum()))
+        own = math.nan
+        if self.cov is not None and np.all(np.isfinite(self.cov)):
+            g = np.zeros(len(self.cov_names))
+            for i, nm in enumerate(self.cov_names):
+                if nm not in self.p:   # a parameter the fit reports transformed (lnA as A): fn does not see it
+                    continue
+                h = 1e-6 * max(abs(self.p[nm]), 1.0)
+                up, dn = dict(self.p), dict(self.p)
+                up[nm] += h
+                dn[nm] -= h
+                g[i] = (fn(up) - fn(dn)) / (2 * h)
+            var = float(g @ self.cov @ g)
+            own = math.sqrt(var) if var >= 0 else math.nan
+        return v, self._quoted(jk, own)
 
     @property
     def determined(self):
@@ -99,6 +130,7 @@ def _finish(fit, res, names, n):
         cov = np.linalg.inv(J.T @ J)
     except np.linalg.LinAlgError:
         cov = np.full((len(names), len(names)), math.nan)
+    fit.cov, fit.cov_names = cov, list(names)
     for i, nme in enumerate(names):
         fit.p[nme] = float(res.x[i])
         fit.err[nme] = float(math.sqrt(cov[i, i])) if cov[i, i] >= 0 else math.nan
@@ -300,6 +332,8 @@ def critical_joint(series, x_range=None, xc_max=1.0):
         fit.p[f"A_{k}"] = math.exp(tmp.p[f"lnA_{k}"])
         fit.err[f"A_{k}"] = fit.p[f"A_{k}"] * tmp.err[f"lnA_{k}"]
     fit.chi2, fit.n, fit.dof = tmp.chi2, tmp.n, tmp.dof
+    k = 1 + len(keys)   # xc and the exponents: the same names here as in tmp
+    fit.cov, fit.cov_names = tmp.cov[:k, :k], lnames[:k]
     if xc0 >= top + (xc_max - top) * 0.999:
         fit.note = f"xc runs to the scan's end ({xc_max}): no divergence is resolved"
     return fit
@@ -336,6 +370,7 @@ def jackknife_over_seeds(fit_fn, seeds, fit=None):
     reps = [fit_fn(s) for s in seeds]
     n = len(reps)
     fit.jk_seeds = n
+    fit.jk_p = [dict(r.p) for r in reps]
     for name in fit.names:
         th = np.array([r.p.get(name, math.nan) for r in reps], float)
         if np.all(np.isfinite(th)):

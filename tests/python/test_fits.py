@@ -84,3 +84,12 @@ def test_no_verdict_from_a_fit_whose_error_exceeds_its_value():
     y = 0.5 * x ** 1.6 * (1 + 0.01 * rng.standard_normal(6))
     f = sf.power(x, y, 0.01 * y)
     assert fit_verdict(f, "s", 1.6).startswith("agrees")
+
+
+def test_a_value_falls_with_eps_only_where_the_fall_exceeds_its_errors():
+    from dynhet.analysis.restitution import falls_verdict
+    assert falls_verdict([(0.7, 0.810, 0.002), (0.9, 0.800, 0.002), (1.0, 0.782, 0.003)]).startswith("agrees")
+    # the same order, errors as large as the fall: no agreement claimed
+    assert falls_verdict([(0.7, 0.810, 0.02), (0.9, 0.800, 0.02), (1.0, 0.782, 0.02)]).startswith("not resolved")
+    assert falls_verdict([(0.7, 0.780, 0.002), (0.9, 0.800, 0.002)]).startswith("differs (ε 0.7 → 0.9 rises")
+    assert falls_verdict([(0.7, 0.80, math.nan), (1.0, 0.78, math.nan)]).startswith("not resolved")

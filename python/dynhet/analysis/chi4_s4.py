@@ -159,7 +159,7 @@ def s4_results(A, joint):
 def fss_results(A, joint):
     pts = A.series()
     fig, ax = plt.subplots(1, 2, figsize=(12, 4.5))
-    gc = joint.p["g_chi4"] / joint.p["g_xi"] if joint is not None and joint.ok else math.nan
+    gc, gc_err = joint.derived(lambda q: q["g_chi4"] / q["g_xi"]) if joint is not None and joint.ok else (math.nan, math.nan)
     for p, col in zip(pts, colours(len(pts))):
         c = cut(p.runs[0])
         ns = np.asarray(c["chi4_N"], float)
@@ -177,7 +177,7 @@ def fss_results(A, joint):
     ax[1].set_title("Fig. chi4P(b): finite-size collapse")
     f = A.save(fig, "chi4_peak_fss.png")
     A.row("finite-size scaling: χ4^P against sub-box N; collapse against √N/ξ", "3.4, fig. chi4P", "figure only",
-          f"exponent ratio γχ/γξ = {gc:.3g} from our joint fit", "figure", f, pts)
+          f"exponent ratio γχ/γξ = {fmt(gc, gc_err)} from our joint fit", "figure", f, pts)
 
 
 def joint_fit(A):
