@@ -23,3 +23,25 @@ def test_chi4_at_tau_alpha_takes_the_error_at_that_lag():
     # an error growing as a line in ln t: its value at tau_alpha
     v, e = chi4_at_tau(run_with_chi4(lambda t: 0.1 + 0.05 * np.log(t)))
     assert math.isclose(e, 0.1 + 0.05 * math.log(7.3), rel_tol=1e-9)
+
+
+def test_the_median_of_ratios_carries_the_error_its_values_give_it():
+    from dynhet.analysis.appendix import median_error, ratios
+    r, e = ratios([(2.0, 0.2), (3.0, 0.3), (math.nan, 0.1)], [(2.0, 0.0), (2.0, 0.0), (1.0, 0.1)])
+    assert np.allclose(r, [1.0, 1.5]) and np.allclose(e, [0.1, 0.15])
+    # one value: its median is itself, its error its own
+    m, s = median_error([1.3], [0.1], draws=20000)
+    assert m == 1.3 and abs(s - 0.1) < 0.003
+    # 41 equal values of equal error: the median of 41 normal draws, whose
+    # standard deviation is sqrt(pi/2) sigma / sqrt(n) to within a few per cent at this n
+    m, s = median_error(np.ones(41), np.full(41, 0.2), draws=20000)
+    assert m == 1.0 and abs(s / (math.sqrt(math.pi / 2) * 0.2 / math.sqrt(41)) - 1) < 0.06
+    assert median_error([1.0, 2.0], [math.nan, math.nan])[1] == 0.0
+
+
+def test_near_one_claims_a_difference_only_beyond_the_tolerance_and_the_errors():
+    from dynhet.analysis.appendix import near_one
+    assert near_one(1.10, 0.01) == "agrees"                 # within the paper's "≈"
+    assert near_one(1.32, 0.24) == "agrees"                 # 0.32 off, but 1.3 errors: not told apart
+    assert near_one(1.32, 0.10) == "differs (3.2 σ)"
+    assert near_one(1.32, math.nan) == "differs"
