@@ -4,7 +4,8 @@ the runs themselves, recomputed here from each run.h5 without the
 analysis code: every point's tau_alpha, beta, D and Z are the means over
 its seeds of the runs' final values; chi4 and xi at tau_alpha are the
 runs' chi4(t) (largest proper sub-box) and OZ xi(t) (whole box)
-interpolated linearly in ln t at the run's own tau_alpha; the table has a
+interpolated linearly in ln t at the run's own tau_alpha (xi only where
+at least 5 q shells of the whole box lie below q xi = 1); the table has a
 row per result and every figure it names exists; fits that cannot be made
 (too few densities) say why instead of giving numbers.
 Usage: check_study_analysis.py STUDY_DIR"""
@@ -53,8 +54,13 @@ for name, m in runs.items():
         mine["chi4_tau_alpha"] = lin_ln_t(lag, chi, tau)
         s4n = o["s4/a0.6/subbox_particles"][()]
         slag = o["s4/a0.6/lag_time"][()]
-        xi = o["s4/a0.6/xi_lag/value"][-1][:, int(np.argmax(s4n))]  # [lag][grid]
-        mine["xi_tau_alpha"] = lin_ln_t(slag, xi, tau)
+        gw = int(np.argmax(s4n))
+        xi = o["s4/a0.6/xi_lag/value"][-1][:, gw]  # [lag][grid]
+        x = lin_ln_t(slag, xi, tau)
+        # issue 27, item 4: an OZ xi only where 5 q shells of its box lie below q xi = 1
+        nsh = o["s4/a0.6/n_shells"][()]
+        q = o["s4/a0.6/q"][()][int(np.sum(nsh[:gw])):int(np.sum(nsh[:gw + 1]))]
+        mine["xi_tau_alpha"] = x if np.sum((q > 0) & (q * x <= 1.0)) >= 5 else math.nan
     for k, v in mine.items():
         got = g[k][row, 0]
         same = (math.isnan(v) and math.isnan(got)) or abs(got - v) <= 1e-12 * max(1.0, abs(v))

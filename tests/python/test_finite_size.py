@@ -335,3 +335,23 @@ def test_a_tie_at_one_n_goes_to_the_study_that_runs_the_density_at_every_n():
     assert multi[0.79][4096] is scale[4096] and multi[0.79][1024] is scale[1024]
     quick.runs.append({"seed": 4, "N": 4096, "study": "quick"})     # four seeds against three
     assert points_by_phi_n(A)[0.79][4096] is quick
+
+
+def test_the_reproduction_takes_xi_and_chi0_only_where_five_shells_resolve_them():
+    """Item 4 holds for every xi and chi0 the reproduction uses (its rows and
+    fits), not only for the finite-size table: xi = 2 in a box of side 100 has
+    7 shells below q xi = 1 and is taken; xi = 4 has 3, and neither it nor the
+    chi0 of the same fit is."""
+    from dynhet.analysis.appendix import whole_box
+    from dynhet.analysis.quantities import chi0_at_tau, xi_at_tau
+
+    def run(xi):
+        c = s4_cut(xi, 100.0)
+        c.update(tau_alpha_err=0.5, chi0_t=np.full((3, 1), 5.0), s4_oz_chi0=np.array([5.0]),
+                 s4_oz_chi0_err=np.array([0.5]), s4_chi4=np.array([4.0]), s4_chi4_err=np.array([0.4]))
+        return {"cut": {0.6: c}, "N": 4096}
+    v, e = xi_at_tau(run(2.0))
+    assert math.isclose(v, 2.0) and e > 0
+    assert math.isclose(chi0_at_tau(run(2.0))[0], 5.0) and math.isclose(whole_box(run(2.0), "s4_oz_chi0")[0], 5.0)
+    assert math.isnan(xi_at_tau(run(4.0))[0]) and math.isnan(chi0_at_tau(run(4.0))[0])
+    assert math.isnan(whole_box(run(4.0), "s4_oz_chi0")[0]) and whole_box(run(4.0), "s4_chi4")[0] == 4.0

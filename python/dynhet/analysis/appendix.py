@@ -5,15 +5,19 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .config import A_MAIN
-from .quantities import chi4_at_tau, cut, oz_fit, s4_at_tau, whole_box_s4
+from .quantities import chi4_at_tau, cut, oz_fit, oz_resolved, s4_at_tau, whole_box_s4
 from .plotting import errorbar
 from .verdicts import fmt
 
 
 def whole_box(r, key):
-    """(value, error) of a per-grid S4 result `key` for the run's whole box."""
+    """(value, error) of a per-grid S4 result `key` for the run's whole box;
+    an OZ chi0 only where its fit is resolved (oz_resolved: at least
+    MIN_SHELLS q shells below q xi = 1)."""
     c = cut(r)
     g = whole_box_s4(c)
+    if key != "s4_chi4" and not oz_resolved(c, g, c["s4_oz_xi"][g]):
+        return math.nan, math.nan
     return c[key][g], c[key + "_err"][g]
 
 

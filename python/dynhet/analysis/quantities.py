@@ -45,6 +45,23 @@ def whole_box_s4(c):
 
 
 XI_MIN = 0.3   # below this OZ xi, S4 varies by less than 10% over q <= 1: not determined
+MIN_SHELLS = 5  # an OZ xi (and its chi0) needs this many q shells below q xi = 1 (issue 27, item 4)
+
+
+def shells_below(c, g, xi):
+    """How many q shells of S4 grid g lie below q xi = 1 (0 for xi not finite)."""
+    if not np.isfinite(xi):
+        return 0
+    off = int(np.sum(c["s4_nshells"][:g]))
+    q = np.asarray(c["s4_q"][off:off + int(c["s4_nshells"][g])])
+    return int(np.sum((q > 0) & (q * xi <= 1.0)))
+
+
+def oz_resolved(c, g, xi):
+    """Whether the OZ fit of grid g with this xi rests on at least MIN_SHELLS
+    q shells below q xi = 1: else neither its xi nor its chi0 (the q -> 0
+    extrapolation of the same few shells) is taken ("not resolved at this N")."""
+    return shells_below(c, g, xi) >= MIN_SHELLS
 
 
 def chi4_at_tau(r, a=A_MAIN, g=None, own=False):
@@ -60,8 +77,8 @@ def chi4_at_tau(r, a=A_MAIN, g=None, own=False):
 
 def xi_at_tau(r, a=A_MAIN, own=False):
     """The whole box's OZ xi of cutoff a at tau_alpha (of a = 0.6, or own);
-    NaN where it is below XI_MIN (S4 flat over the q range) or longer than
-    the box."""
+    NaN where it is below XI_MIN (S4 flat over the q range), longer than
+    the box, or not resolved (fewer than MIN_SHELLS q shells below q xi = 1)."""
     c = cut(r, a)
     t = tau(r, a if own else A_MAIN)[0]
     g = whole_box_s4(c)
@@ -71,6 +88,8 @@ def xi_at_tau(r, a=A_MAIN, own=False):
     xi = c["xi_t"][:, g]
     xs = np.where((xi >= XI_MIN) & (xi <= box), xi, np.nan)
     v, ie = sf.interp_ln_t(c["s4_lag"], xs, t)
+    if np.isfinite(v) and not oz_resolved(c, g, v):
+        return math.nan, math.nan
     rel = c["s4_oz_xi_err"][g] / c["s4_oz_xi"][g] if np.isfinite(c["s4_oz_xi"][g]) and c["s4_oz_xi"][g] > 0 else math.nan
     return v, math.hypot(abs(v) * rel if np.isfinite(rel) else math.nan, ie if np.isfinite(ie) else 0.0)
 
@@ -81,6 +100,9 @@ def chi0_at_tau(r, a=A_MAIN, g=None):
     if g is None:
         g = whole_box_s4(c)
     v, ie = sf.interp_ln_t(c["s4_lag"], c["chi0_t"][:, g], t)
+    xi, _ = sf.interp_ln_t(c["s4_lag"], c["xi_t"][:, g], t)
+    if np.isfinite(v) and np.isfinite(xi) and not oz_resolved(c, g, xi):
+        return math.nan, math.nan
     rel = c["s4_oz_chi0_err"][g] / c["s4_oz_chi0"][g] if c["s4_oz_chi0"][g] > 0 else math.nan
     return v, math.hypot(abs(v) * rel if np.isfinite(rel) else math.nan, ie if np.isfinite(ie) else 0.0)
 

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from .config import A_MAIN, EPS_MAIN
-from .quantities import PER_RUN, XI_MIN, chi0_at_tau, kappa_of, whole_box_s4
+from .quantities import MIN_SHELLS, PER_RUN, XI_MIN, chi0_at_tau, kappa_of, shells_below, whole_box_s4
 from .runs import blocks_span
 from ..fits import interp_ln_t
 
@@ -16,7 +16,6 @@ from ..fits import interp_ln_t
 SUBBOX_SIZES = (32, 128, 512, 2048, 8192, 32768)
 
 
-MIN_SHELLS = 5      # xi needs at least this many q shells below q xi = 1 (issue 27, item 4)
 
 
 def cutx(r, cr):
@@ -46,12 +45,10 @@ def xi_shells(r, cr=False):
     c = cutx(r, cr)
     t = c["tau_alpha"]
     g = whole_box_s4(c)
-    off = int(np.sum(c["s4_nshells"][:g]))
-    q = np.asarray(c["s4_q"][off:off + int(c["s4_nshells"][g])])
     xi = np.interp(math.log(t), np.log(c["s4_lag"]), c["xi_t"][:, g]) if np.isfinite(t) else math.nan
     if not np.isfinite(xi):
         return math.nan, math.nan, 0
-    shells = int(np.sum((q > 0) & (q * xi <= 1.0)))
+    shells = shells_below(c, g, xi)
     rel = c["s4_oz_xi_err"][g] / c["s4_oz_xi"][g] if c["s4_oz_xi"][g] > 0 else math.nan
     if shells < MIN_SHELLS or xi < XI_MIN:
         return math.nan, math.nan, shells
@@ -212,8 +209,8 @@ def s4_reason(r, cr, slug):
         xi = np.interp(math.log(t), np.log(c["s4_lag"]), c["xi_t"][:, g])
         if not np.isfinite(xi):
             return "no OZ fit"
-        if slug == "chi0":
-            return None
+        if slug == "chi0":   # the q -> 0 extrapolation of the same fit: as resolved as its xi
+            return None if xi_shells(r, cr)[2] >= MIN_SHELLS or xi < XI_MIN else "not resolved"
         if xi < XI_MIN:
             return f"ξ < {XI_MIN:g}"
         return "not resolved" if xi_shells(r, cr)[2] < MIN_SHELLS else None
