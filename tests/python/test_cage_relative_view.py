@@ -106,10 +106,10 @@ def test_a_real_verdict_reaches_the_note_and_both_measures_stand_side_by_side(tm
     C.row("κ", "3.3", "≈ 1.8", "1.72 ± 0.01", "not judged: χ² improbable", "", C.series())
     cr = A.rows[1]
     assert cr["verdict"] == "—" and cr["note"] == "against the paper's standard measure: differs (9.5 σ)"
-    assert A.rows[2]["note"] == ""                                    # not judged: nothing to say against it
+    assert A.rows[2]["note"] == "not judged: χ² improbable"           # no verdict, but its reason stays in view
     lines = side_by_side(A.rows)
     assert "| τ4 ∝ τ_α^z | 1.19 | 1.06 ± 0.1; agrees (1.3 σ) | 1 ± 0.02; differs (9.5 σ) |" in lines
-    assert "| κ (cage-relative) | ≈ 1.8 | — | 1.72 ± 0.01 |" in lines     # no standard row: it stands alone
+    assert "| κ (cage-relative) | ≈ 1.8 | — | 1.72 ± 0.01; not judged |" in lines     # no standard row: it stands alone
     assert side_by_side(A.rows[:1]) == []                                 # no cage-relative row: no section
 
 

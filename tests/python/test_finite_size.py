@@ -335,6 +335,14 @@ def test_a_tie_at_one_n_goes_to_the_study_that_runs_the_density_at_every_n():
     assert multi[0.79][4096] is scale[4096] and multi[0.79][1024] is scale[1024]
     quick.runs.append({"seed": 4, "N": 4096, "study": "quick"})     # four seeds against three
     assert points_by_phi_n(A)[0.79][4096] is quick
+    # as many seeds and sizes: the study with the cage-relative measures (the tau_alpha^CR protocol)
+    other = {n: point("d_size", n, 3) for n in (1024, 4096, 16384)}
+    A.points = {}
+    A.extra = {(st, p.pairs, p.eps, p.phi, p.N): p for st, d in (("d_size", other), ("scale", scale)) for p in d.values()}
+    for p in scale.values():
+        for r in p.runs:
+            r["cut_cr"] = {0.6: {}}
+    assert all(points_by_phi_n(A)[0.79][n] is scale[n] for n in scale)
 
 
 def test_the_reproduction_takes_xi_and_chi0_only_where_five_shells_resolve_them():

@@ -73,3 +73,17 @@ def test_a_promoted_point_is_one_point_in_the_cutoff_candidates_and_the_cage_rel
     assert sum(1 for p in pop.points if p is copies[0]) == 1
     assert sum(len(p.runs) for p in pop.parent.points) == sum(
         len(p.runs) for p in {id(p): p for p in list(A.points.values()) + list(A.extra.values())}.values())
+
+
+def test_a_row_over_several_box_sizes_says_so():
+    A = analysis()
+    A.rows = []
+    A.row("τ_α(φ) power law: φ_c", "3.2", "0.82", "0.80", "agrees", "", A.series())
+    assert A.rows[-1]["note"] == ""                                   # no --largest-n: one study's sizes
+    A.promote_largest_n()
+    A.row("τ_α(φ) power law: φ_c", "3.2", "0.82", "0.80", "agrees", "", A.series(), "a note")
+    assert A.rows[-1]["note"] == "a note; sizes: 1 φ at N 4096, 1 φ at N 65536 (the largest N per φ)"
+    A.row("θ against N", "3.2", "—", "1.4", "—", "", A.series())
+    assert A.rows[-1]["note"] == ""                                   # a row that sets the sizes side by side
+    A.row("d_f at φ = 0.78", "3.3", "1.9", "1.8", "agrees", "", [p for p in A.series() if p.phi == 0.78])
+    assert A.rows[-1]["note"] == ""

@@ -14,39 +14,10 @@ from .config import A_MAIN
 from .plotting import colours, errorbar
 from .quantities import s4_at_tau
 from .points import MIN_CAL_DOF, ensure_calibrated, spread_ratio as pooled_spread
-from .size import points_by_phi_n
+from .size import Z_CONVERGED, points_by_phi_n, size_verdict, study_of
 from .size_rows import (CHI4P_ROWS, MIN_SHELLS, TAU_ROWS, c_b_times, has_cr, lags_in_tau_cr, missing_cell, quantities,
                         shells_note, tau_b_bound, tau_b_points)
 from .verdicts import fmt
-
-Z_CONVERGED = 2.0   # values within 2 combined standard errors agree
-
-
-def size_verdict(ns, vals, errs):
-    """Converged or drifting, from the numbers: the smallest N0 such that the
-    value at every N >= N0 agrees with the largest N's within Z_CONVERGED
-    combined errors (at least two sizes); otherwise the drift per doubling of N
-    between the two largest sizes. Returns (text, N0 or None, drift, error)."""
-    d = [(n, v, e) for n, v, e in zip(ns, vals, errs) if np.isfinite(v) and np.isfinite(e)]
-    if len(d) < 2:
-        return ("one N only" if d else "no data"), None, math.nan, math.nan
-    d.sort()
-    nmax, vmax, emax = d[-1]
-    n0 = None
-    for k in range(len(d) - 2, -1, -1):
-        n, v, e = d[k]
-        if abs(v - vmax) <= Z_CONVERGED * math.hypot(e, emax):
-            n0 = n
-        else:
-            break
-    if n0 is not None:
-        return f"converged from N = {n0} on (within {Z_CONVERGED:g}σ of N = {nmax})", n0, math.nan, math.nan
-    n1, v1, e1 = d[-2]
-    per = math.log2(nmax / n1)
-    drift, derr = (vmax - v1) / per, math.hypot(emax, e1) / per
-    rel = drift / abs(v1) if v1 else math.nan
-    return (f"drifting: {fmt(drift, derr)} per doubling of N ({100 * rel:+.0f}%) from N = {n1} to {nmax}",
-            None, drift, derr)
 
 
 def spread_ratio(points, fn, cr=False):
@@ -289,10 +260,11 @@ def write_finite_size(A, path, command):
          f"quotes one; \"no error\" where one seed quotes none, and such a "
          f"size takes no part in the verdict); ¹ one seed. Where several studies ran the same φ and N, the cells "
          f"take the one with the most seeds, and among as many the study that runs that φ at the most N (one "
-         f"protocol, run lengths in units of τ_α^CR, across the sizes). A verdict is computed from the "
+         f"protocol, run lengths in units of τ_α^CR, across the sizes), then the one with the cage-relative "
+         f"measures (that protocol); the line under each table names each N's study. A verdict is computed from the "
          f"numbers: **converged** from the smallest N whose value and every larger N's agree with the largest "
-         f"N's within {Z_CONVERGED:g} combined errors; otherwise **drifting**, with the change per doubling of N "
-         f"between the two largest sizes. χ4^P is the peak of χ4(t) of sub-boxes of about that many particles "
+         f"N's within {Z_CONVERGED:g} combined errors; otherwise **drifting**; either way with the change per doubling "
+         f"of N between the two largest sizes and its error, which says how tightly \"converged\" holds. χ4^P is the peak of χ4(t) of sub-boxes of about that many particles "
          f"(interior peaks only); ξ is the whole box's Ornstein-Zernike ξ at τ_α, taken only where at least "
          f"{MIN_SHELLS} q shells lie below q ξ = 1 (else \"not resolved\" at this N; \"no OZ fit\": the S4 node refused the fit at τ_α, for ξ beyond the "
          f"box, below the q range, or with a jackknife error not below ξ); [k q]: the shells below "
@@ -331,7 +303,7 @@ def write_finite_size(A, path, command):
                 if slug == "xi":  # how many q shells its fits had below q xi = 1 (issue 27, item 4)
                     cells = [c + shells_note(dd.get(n), cr) for c, n in zip(cells, qn)]
                 L.append(f"| {label} | " + " | ".join(cells) + f" | {text} |")
-        seeds = ", ".join(f"N {n}: {len(d[n].runs)}" for n in ns)
+        seeds = ", ".join(f"N {n}: {len(d[n].runs)} ({study_of(d[n])})" for n in ns)
         spans = lags_in_tau_cr(d, ns)
         crs = multi_cr.get(phi, {})
         if crs and any(crs.get(n) is not d.get(n) for n in crs):

@@ -12,7 +12,7 @@ from .overlap import tau_fits
 from .plotting import colours, errorbar
 from .points import point_error, series_arrays
 from .quantities import PER_RUN, tau
-from .size import points_by_phi_n
+from .size import points_by_phi_n, size_verdict
 from .verdicts import fmt
 
 TAU_CR, TAU_B = PER_RUN["tau_alpha_cr"], PER_RUN["tau_b"]
@@ -78,11 +78,7 @@ def local_n_results(A):
             # each N: the mean over seeds, the error the runs quote and the seeds' own spread
             cells = ", ".join(f"N {ns[i]}: {fmt(ms[i][0], point_error(ms[i]))} (seeds {ms[i][3]}, spread ± "
                               f"{ms[i][2]:.2g})" for i in ok)
-            lo, hi = ms[ok[0]], ms[ok[-1]]
-            z = abs(hi[0] - lo[0]) / math.hypot(point_error(lo), point_error(hi))
-            drift = f"{(hi[0] / lo[0]) ** (1 / math.log2(ns[ok[-1]] / ns[ok[0]])) - 1:+.1%} per doubling of N"
-            verdict = (f"depends on N ({z:.1f} σ from N {ns[ok[0]]} to {ns[ok[-1]]}, {drift})" if z > 2 else
-                       f"no N dependence resolved ({z:.1f} σ from N {ns[ok[0]]} to {ns[ok[-1]]})")
+            verdict = size_verdict([ns[i] for i in ok], [ms[i][0] for i in ok], [point_error(ms[i]) for i in ok])[0]
             A.row(f"{label.split(' ')[0]} against N at φ = {phi:g}", "issue 26, item 8 (not in the paper)",
                   "not measured", cells, verdict, "", used)
         ax.set_xscale("log")

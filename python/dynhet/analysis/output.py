@@ -123,9 +123,11 @@ def side_by_side(rows):
     def cr_cell(c, std_item):
         against = re.search(r"against the paper's standard measure: ((?:agrees|differs)(?: \([0-9.]+ σ\))?)",
                             c["note"] or "")
+        # a fit that carries no verdict says so, as the standard column does
+        unjudged = re.match(r"(not judged|not determined|not comparable)", c["note"] or "")
         own = c["item"][:-len(CR_SUFFIX)]
         return ((f"[{own}] " if own != std_item else "") + c["ours"]
-                + (f"; {against.group(1)}" if against else ""))
+                + (f"; {against.group(1)}" if against else f"; {unjudged.group(1)}" if unjudged else ""))
     for r in rows:
         if r["item"].endswith(CR_SUFFIX):
             continue

@@ -5,7 +5,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .. import fits as sf
-from .config import EPS_MAIN
+from .config import A_MAIN, EPS_MAIN
 from .points import fit_series, point_error
 from .quantities import tau
 from .verdicts import fmt
@@ -17,13 +17,16 @@ def points_by_phi_n(A, has=lambda p: True):
     studies, the point with most runs where several have the same phi and N,
     and among those with as many, the one whose study runs that phi at the
     most N: one protocol (run lengths in units of tau_alpha^CR) across the
-    sizes, not a single-N study's; only densities run at more than one N."""
+    sizes, not a single-N study's; then the one with the cage-relative
+    measures (that protocol's); only densities run at more than one N."""
     allp = [p for p in list(A.points.values()) + list(A.extra.values())
             if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p)]
     sizes = {}
     for p in allp:
         sizes.setdefault((study_of(p), p.phi), set()).add(p.N)
-    rank = lambda p: (len(p.runs), len(sizes[(study_of(p), p.phi)]))
+    # then the protocol that measures tau_alpha^CR (run lengths in its units, studies/scale.toml)
+    rank = lambda p: (len(p.runs), len(sizes[(study_of(p), p.phi)]),
+                      any(A_MAIN in (r.get("cut_cr") or {}) for r in p.runs))
     by_phi = {}
     for p in allp:
         by_phi.setdefault(p.phi, {})
@@ -49,15 +52,44 @@ def common_densities(multi):
     return per_n, (sorted(per_n[max(wide)]) if wide else [])
 
 
+Z_CONVERGED = 2.0   # values within 2 combined standard errors agree
+
+
+def size_verdict(ns, vals, errs):
+    """Converged or drifting, from the numbers (the one rule of every
+    against-N verdict: the finite-size tables and the reproduction's rows):
+    the smallest N0 such that the value at every N >= N0 agrees with the
+    largest N's within Z_CONVERGED combined errors (at least two sizes);
+    otherwise drifting. Either way the change per doubling of N between the
+    two largest sizes with its error, which bounds what "converged" means.
+    Returns (text, N0 or None, drift, error)."""
+    d = [(n, v, e) for n, v, e in zip(ns, vals, errs) if np.isfinite(v) and np.isfinite(e)]
+    if len(d) < 2:
+        return ("one N only" if d else "no data"), None, math.nan, math.nan
+    d.sort()
+    nmax, vmax, emax = d[-1]
+    n1, v1, e1 = d[-2]
+    per = math.log2(nmax / n1)
+    drift, derr = (vmax - v1) / per, math.hypot(emax, e1) / per
+    rel = drift / abs(v1) if v1 else math.nan
+    change = f"{fmt(drift, derr)} per doubling of N ({100 * rel:+.0f}%) from N = {n1} to {nmax}"
+    n0 = None
+    for k in range(len(d) - 2, -1, -1):
+        n, v, e = d[k]
+        if abs(v - vmax) <= Z_CONVERGED * math.hypot(e, emax):
+            n0 = n
+        else:
+            break
+    if n0 is not None:
+        return (f"converged from N = {n0} on (within {Z_CONVERGED:g}σ of N = {nmax}; {change})",
+                n0, drift, derr)
+    return f"drifting: {change}", None, drift, derr
+
+
 def n_verdict(vals):
-    """Whether a value {N: (value, error)} moves from the smallest N to the largest (2 combined errors)."""
+    """size_verdict of a value {N: (value, error)} (an exponent fitted at each N)."""
     ns = sorted(vals)
-    lo, hi = vals[ns[0]], vals[ns[-1]]
-    e = math.hypot(lo[1], hi[1])
-    if not np.isfinite(e) or e == 0:
-        return "not determined"
-    z = abs(hi[0] - lo[0]) / e
-    return ("moves with N" if z > 2 else "no change with N resolved") + f" ({z:.1f} σ from N {ns[0]} to {ns[-1]})"
+    return size_verdict(ns, [vals[n][0] for n in ns], [vals[n][1] for n in ns])[0]
 
 
 def d_n_results(A):

@@ -161,8 +161,23 @@ class Analysis:
         return os.path.relpath(path, self.dir)
 
     def row(self, item, section, paper, ours, verdict, figure, pts, note=""):
+        mixed = self.sizes_note(item, pts)
         self.rows.append(dict(item=item, section=section, paper=paper, ours=ours, verdict=verdict, figure=figure,
-                              cpu=self.cpu_of(pts), note=note))
+                              cpu=self.cpu_of(pts), note="; ".join(x for x in (note, mixed) if x)))
+
+    def sizes_note(self, item, pts):
+        """With --largest-n, a row over densities of several box sizes says so
+        (its fit mixes N where tau_alpha still depends on N): "sizes: 8 φ at N
+        4096, 4 at N 16384"; "" for one size, without --largest-n, or for the
+        rows that set the sizes against each other."""
+        if not getattr(self, "promoted", None) or "against N" in item:
+            return ""
+        per_n = {}
+        for p in pts:
+            per_n.setdefault(p.N, set()).add(p.phi)
+        if len(per_n) < 2:
+            return ""
+        return "sizes: " + ", ".join(f"{len(per_n[n])} φ at N {n}" for n in sorted(per_n)) + " (the largest N per φ)"
 
     def fit(self, name, f):
         self.fits[name] = f
@@ -217,8 +232,10 @@ class CageRelativeView(Analysis):
 
     def row(self, item, section, paper, ours, verdict, figure, pts, note=""):
         # (a verdict reads "differs (3.2 σ)", "agrees (0.4 σ); ...": its kind starts it)
+        # (and a verdict that is no judgement, "not judged: ...", keeps its reason)
         against = (f"against the paper's standard measure: {verdict}"
-                   if verdict.split(" (")[0].split(";")[0] in ("agrees", "differs") else "")
+                   if verdict.split(" (")[0].split(";")[0] in ("agrees", "differs")
+                   else verdict if verdict.startswith(("not judged", "not determined", "not comparable")) else "")
         self.base.row(f"{item} (cage-relative)", section, paper, ours, "—", figure, pts,
                       "; ".join(x for x in (against, note) if x))
 
