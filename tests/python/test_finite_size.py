@@ -363,3 +363,33 @@ def test_the_reproduction_takes_xi_and_chi0_only_where_five_shells_resolve_them(
     assert math.isclose(chi0_at_tau(run(2.0))[0], 5.0) and math.isclose(whole_box(run(2.0), "s4_oz_chi0")[0], 5.0)
     assert math.isnan(xi_at_tau(run(4.0))[0]) and math.isnan(chi0_at_tau(run(4.0))[0])
     assert math.isnan(whole_box(run(4.0), "s4_oz_chi0")[0]) and whole_box(run(4.0), "s4_chi4")[0] == 4.0
+
+
+def test_a_size_where_only_some_seeds_have_a_value_says_so_and_stays_out_of_the_verdict():
+    from dynhet.analysis.finite_size import cell, quantity_rows
+
+    def pt(n, vals):
+        p = Point(("neighbours", 0.9, 0.78, n))
+        p.runs = [{"seed": s, "N": n, "v": v} for s, v in enumerate(vals, 1)]
+        return p
+    fn = lambda r, cr: (r["v"], 0.1)
+    d = {1024: pt(1024, [5.0, 5.1, 4.9]), 4096: pt(4096, [3.0, math.nan, math.nan]), 16384: pt(16384, [5.0, 5.05])}
+    ns, ms, (text, n0, _, _) = quantity_rows(d, fn, False)
+    assert cell(ms[1], 3).endswith("¹ (1 of 3 seeds)") and "seeds" not in cell(ms[0], 3)
+    assert n0 == 1024, text            # 4096's lone seed (3.0, far off) does not break convergence: it is not judged
+
+
+def test_the_seed_spread_of_tau_b_is_taken_over_the_points_its_cells_show():
+    from dynhet.analysis.finite_size import spread_section
+
+    def pt(n, tb):
+        p = Point(("neighbours", 0.9, 0.79, n))
+        p.runs = [{"seed": s, "N": n, "cut": {0.6: {"tau_alpha": 10.0 + s, "tau_alpha_err": 1.0}},
+                   "tau_b": v, "tau_b_err": 10.0 if np.isfinite(v) else math.nan} for s, v in enumerate(tb, 1)]
+        return p
+    main = {0.79: {1024: pt(1024, [math.nan] * 3), 4096: pt(4096, [math.nan] * 3)}}     # lags short of tau_B
+    longer = {0.79: {1024: pt(1024, [1900.0, 1920.0, 1910.0]), 4096: pt(4096, [1930.0, 1950.0, 1940.0])}}
+    lines = spread_section(main, {}, longer)
+    row = [x for x in lines if x.startswith("| τ_B")]
+    assert row and "(2)" in row[0], lines       # 2 dof per N from the longer study's three seeds
+    assert not [x for x in spread_section(main, {}) if x.startswith("| τ_B")]

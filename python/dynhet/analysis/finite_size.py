@@ -27,14 +27,15 @@ def spread_ratio(points, fn, cr=False):
     return pooled_spread(points, lambda r: fn(r, cr))
 
 
-def spread_section(multi, multi_cr):
+def spread_section(multi, multi_cr, multi_tb=None):
     """Issue 27, item 5: per N, the pooled seed-spread ratio of tau_alpha,
-    tau_alpha^CR, tau_B and chi4^P over the densities run there."""
+    tau_alpha^CR, tau_B and chi4^P over the densities run there (tau_B over
+    the points its cells take: multi_tb)."""
     ns = sorted({n for d in multi.values() for n in d})
     rows = []
-    for name, _, fn, has_cr_version, _ in TAU_ROWS + CHI4P_ROWS:
+    for name, slug, fn, has_cr_version, _ in TAU_ROWS + CHI4P_ROWS:
         for cr in ((False, True) if has_cr_version else (False,)):
-            src = multi_cr if cr else multi
+            src = multi_cr if cr else (multi_tb if slug == "tau_b" and multi_tb is not None else multi)
             cells, any_data = [], False
             for n in ns:
                 r, u, dof, unq = spread_ratio([d[n] for d in src.values() if n in d], fn, cr)
@@ -67,12 +68,18 @@ def measured_error(m):
     return e if np.isfinite(e) and e > 0 else (sem if np.isfinite(sem) and sem > 0 else math.nan)
 
 
-def cell(m):
+def cell(m, seeds=0):
+    """A size's cell: mean ± error, ¹ for one seed; where only n of its
+    `seeds` runs have a value (the others not resolved or not reached), the
+    mean of those, marked "(n of seeds seeds)": it takes no part in the
+    verdict (the seeds that lack it are not a random subset: a xi resolved
+    only by the seeds where it came out smaller)."""
     v, _, _, n = m
     if not np.isfinite(v):
         return "—"
     e = measured_error(m)
-    return (fmt(v, e) if np.isfinite(e) else f"{v:.4g} (no error)") + ("" if n > 1 else " ¹")
+    part = f" ({n} of {seeds} seeds)" if n < seeds else ""
+    return (fmt(v, e) if np.isfinite(e) else f"{v:.4g} (no error)") + ("" if n > 1 else " ¹") + part
 
 
 def quantity_rows(d, fn, cr, ns=None, slug=None):
@@ -85,7 +92,8 @@ def quantity_rows(d, fn, cr, ns=None, slug=None):
     nan = (math.nan, math.nan, math.nan, 0)
     ms = [d[n].mean(lambda r: fn(r, cr)) if n in d and not (slug == "tau_b" and tau_b_bound(d[n]) is not None)
           else nan for n in ns]
-    verdict = size_verdict(ns, [m[0] for m in ms], [measured_error(m) for m in ms])
+    whole = [n in d and m[3] == len(d[n].runs) for n, m in zip(ns, ms)]   # every seed has it (cell)
+    verdict = size_verdict(ns, [m[0] for m in ms], [measured_error(m) if w else math.nan for m, w in zip(ms, whole)])
     return ns, ms, verdict
 
 
@@ -258,7 +266,8 @@ def write_finite_size(A, path, command):
          f"Each cell: the mean over seeds with its error (the runs' own errors, jackknife over origin blocks, "
          f"combined, times the study's factor below where its seeds scatter more; the seeds' spread where no run "
          f"quotes one; \"no error\" where one seed quotes none, and such a "
-         f"size takes no part in the verdict); ¹ one seed. Where several studies ran the same φ and N, the cells "
+         f"size takes no part in the verdict); ¹ one seed; \"(k of m seeds)\": only k of the size's m runs have a "
+         f"value (the others not resolved or not reached), and it takes no part in the verdict either. Where several studies ran the same φ and N, the cells "
          f"take the one with the most seeds, and among as many the study that runs that φ at the most N (one "
          f"protocol, run lengths in units of τ_α^CR, across the sizes), then the one with the cage-relative "
          f"measures (that protocol); the line under each table names each N's study. A verdict is computed from the "
@@ -299,7 +308,7 @@ def write_finite_size(A, path, command):
                 label = name + (" — cage-relative" if cr else "")
                 if slug == "c_b":
                     label = f"C_B at t = {dict(cb_at).get(round(float(phi), 6), math.nan):.4g} (bond breaking)"
-                cells = [w or cell(m) for m, w in zip(ms, why)]
+                cells = [w or cell(m, len(dd[n].runs) if n in dd else 0) for m, w, n in zip(ms, why, qn)]
                 if slug == "xi":  # how many q shells its fits had below q xi = 1 (issue 27, item 4)
                     cells = [c + shells_note(dd.get(n), cr) for c, n in zip(cells, qn)]
                 L.append(f"| {label} | " + " | ".join(cells) + f" | {text} |")
@@ -316,7 +325,7 @@ def write_finite_size(A, path, command):
                                                       f"τ_α^CR (the same at every N where the protocol is): {spans}."
                                                       if spans else ""), ""]
     if multi:
-        L += spread_section(multi, multi_cr)
+        L += spread_section(multi, multi_cr, multi_tb)
         L += ["## Plots", ""]
         for name, slug, fn, has_cr_version, log_y in rows:
             f = plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi_tb if slug == "tau_b" else multi,
