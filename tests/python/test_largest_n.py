@@ -87,3 +87,17 @@ def test_a_row_over_several_box_sizes_says_so():
     assert A.rows[-1]["note"] == ""                                   # a row that sets the sizes side by side
     A.row("d_f at φ = 0.78", "3.3", "1.9", "1.8", "agrees", "", [p for p in A.series() if p.phi == 0.78])
     assert A.rows[-1]["note"] == ""
+
+
+def test_a_larger_n_with_runs_unfinished_is_held_back_and_the_next_stands_in():
+    from dynhet.analysis.output import largest_n_notes
+    A = analysis()
+    A.unfinished = {("scale2", "neighbours", 0.9, 0.78, 65536): 1}   # a third seed of it still running
+    promoted = A.promote_largest_n()
+    assert [(p.phi, p.N, p.study) for p in promoted] == [(0.78, 65536, "scale")]     # the complete one of that N
+    A = analysis()
+    A.unfinished = {("scale2", "neighbours", 0.9, 0.78, 65536): 1, ("scale", "neighbours", 0.9, 0.78, 65536): 2}
+    assert [(p.phi, p.N, p.study) for p in A.promote_largest_n()] == [(0.78, 16384, "fs")]
+    notes = largest_n_notes(A)
+    assert "Held back" in notes and "N = 65536 of study scale2 (1 run not complete)" in notes
+    assert "N = 65536 of study scale (2 runs not complete)" in notes

@@ -74,3 +74,18 @@ def test_restate_via_takes_label_equals_table_and_names_what_is_wrong(tmp_path, 
     with pytest.raises(SystemExit) as e:
         main([study, "--restate", str(old), "--restate-via", "errors fixed (N = 4096)=" + str(old)])
     assert "does not exist" in str(e.value) and "no-study" in str(e.value)
+
+
+def test_how_far_each_step_moved_the_value_in_errors(tmp_path):
+    from dynhet.analysis.restate import shifts, value_of
+    assert value_of("1.3 ± 0.2 (orthogonal distance regression)") == (1.3, 0.2)
+    assert value_of("median 1.37") is None and value_of("-2.27 ± 1.6") == (-2.27, 1.6)
+    assert value_of("0.0268 ± 0.0029") == (0.0268, 0.0029) and value_of("1.48e+03 ± 1.3e+02") == (1480.0, 130.0)
+    # d_f': 0.95 ± 0.09 -> 0.84 ± 0.52 -> 0.7 ± 0.2 -> 1.3 ± 0.2
+    assert shifts(["0.95 ± 0.09", "0.84 ± 0.52", "0.7 ± 0.2", "1.3 ± 0.2"]) == "0.2 / 0.3 / 2.1"
+    assert shifts(["1.66 ± 0.005", "median 1.2", "1.72 ± 0.006"]) == "— / —"
+    old = tmp_path / "old.md"
+    old.write_text(OLD, encoding="utf-8")
+    rows = [dict(item="d_f'", ours="1.3 ± 0.2", verdict="agrees (1.2 σ)")]
+    text = "\n".join(restate(str(old), rows))
+    assert "| d_f' | 0.95 ± 0.09; differs (7.4 σ) | 1.3 ± 0.2; agrees (1.2 σ) | now agrees | 1.6 |" in text

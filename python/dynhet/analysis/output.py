@@ -161,7 +161,7 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=()):
               "largest N over the studies, not this study's own: "
               + "; ".join(f"φ = {p.phi:g} ({p.pairs}, ε = {p.eps:g}): N = {p.N}, study {p.study}, "
                           f"{len(p.runs)} seed{'s' if len(p.runs) > 1 else ''}" for p in A.promoted)
-              + ". The other densities are this study's.", ""]
+              + ". The other densities are this study's." + largest_n_notes(A), ""]
     if A.skipped:
         L += [f"Left out: {len(A.skipped)} runs not complete ({', '.join(sorted({s for _, s in A.skipped}))}).", ""]
     L += ["| result | paper (section, figure) | paper | ours | verdict | figure | CPU |", "|---|---|---|---|---|---|---|"]
@@ -197,3 +197,31 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=()):
             with open(discussion) as d:
                 fh.write("\n" + d.read())
     os.replace(path + ".tmp", path)
+
+
+def largest_n_notes(A):
+    """After the list of promoted points: whether each is a converged N for
+    tau_alpha (size_verdict over the sizes of that density: "largest
+    converged", else "largest available"), and the larger sizes held back
+    because runs of them are unfinished."""
+    from .size import points_by_phi_n, size_verdict
+    from .size_rows import tau_of
+    from .finite_size import measured_error
+    multi = points_by_phi_n(A)
+    out = []
+    for p in A.promoted:
+        d = multi.get(p.phi, {})
+        ns = sorted(n for n in d if n <= p.N)
+        if len(ns) < 2:
+            continue
+        ms = [d[n].mean(lambda r: tau_of(r)) for n in ns]
+        text, n0, _, _ = size_verdict(ns, [m[0] for m in ms], [measured_error(m) for m in ms])
+        out.append(f"φ = {p.phi:g}: N = {p.N} is the largest " + ("converged" if n0 is not None else "available")
+                   + f" N for τ_α ({text})")
+    if out:
+        out = [" Whether that N is converged: " + "; ".join(out) + "."]
+    if getattr(A, "held_back", None):
+        out.append(" Held back, runs of them unfinished (no conclusion from a size whose runs did not finish): "
+                   + "; ".join(f"φ = {p.phi:g}: N = {p.N} of study {p.study} ({n} run{'s' if n > 1 else ''} not "
+                               f"complete)" for p, n in A.held_back) + ".")
+    return "".join(out)

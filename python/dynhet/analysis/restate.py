@@ -55,6 +55,27 @@ def short(ours, verdict):
     return f"{ours.split(' (')[0]}; {kind(verdict)}" + (f" ({sig.group(1)})" if sig else "")
 
 
+NUM = r"[-+]?[0-9]*\.?[0-9]+(?:e[-+]?[0-9]+)?"
+
+
+def value_of(ours):
+    """(value, error) of a cell's first "x ± e"; None without one."""
+    m = re.search(rf"({NUM}) ± ({NUM})", ours or "")
+    return (float(m.group(1)), float(m.group(2))) if m else None
+
+
+def shifts(cells):
+    """Between consecutive cells with a value and an error, how far the value
+    moved in combined errors: "0.3", or "—" where either has none. A verdict
+    that flips on a shift under one error is the threshold's, not the step's."""
+    out = []
+    for a, b in zip(cells, cells[1:]):
+        va, vb = value_of(a), value_of(b)
+        e = (va[1] ** 2 + vb[1] ** 2) ** 0.5 if va and vb else 0.0
+        out.append(f"{abs(vb[0] - va[0]) / e:.1f}" if e > 0 else "—")
+    return " / ".join(out)
+
+
 def restate(old_path, rows, via=()):
     """Markdown lines: each row the old table had as "differs", against the
     row of the same result now (matched by name: `find`). `via`: [(label,
@@ -70,7 +91,11 @@ def restate(old_path, rows, via=()):
            "Every row the earlier table judged \"differs\", and what this table says of the same result"
            + (" (and, between them, " + ", ".join(f"`{path}` ({label})" for label, path in via) + ")"
               if via else "") + ".", "",
-           head + "now: ours, verdict | change |", "|---|---|" + "---|" * len(steps) + "---|---|"]
+           "The last column: how far the value moved at each step (earlier → " + " → ".join(
+               [label for label, _ in via] + ["now"]) + "), in combined errors of the two (— where a step "
+           "quotes no error): a verdict that moves on a shift under one error sits on its threshold.", "",
+           head + "now: ours, verdict | change | moved (σ per step) |",
+           "|---|---|" + "---|" * len(steps) + "---|---|---|"]
     n = {"same": 0, "new": 0, "gone": 0}
     for item, (ours, verdict) in old.items():
         if kind(verdict) != "differs":
@@ -79,7 +104,7 @@ def restate(old_path, rows, via=()):
         match = find(item, now)
         cells = [short(*m) if m else "—" for m in mids]
         if match is None:
-            out.append(f"| {item} | {ours}; {verdict} | " + "".join(c + " | " for c in cells) + "— | no such row now |")
+            out.append(f"| {item} | {ours}; {verdict} | " + "".join(c + " | " for c in cells) + "— | no such row now | — |")
             n["gone"] += 1
             continue
         change = "same verdict" if kind(match[1]) == "differs" else f"now {kind(match[1])}"
@@ -93,8 +118,9 @@ def restate(old_path, rows, via=()):
             if moves:
                 change += " (" + ", ".join(moves) + ")"
         n["same" if kind(match[1]) == "differs" else "new"] += 1
+        moved = shifts([ours] + [m[0] if m else "" for m in mids] + [match[0]])
         out.append(f"| {item} | {ours}; {verdict} | " + "".join(c + " | " for c in cells)
-                   + f"{match[0]}; {match[1]} | {change} |")
+                   + f"{match[0]}; {match[1]} | {change} | {moved} |")
     out += ["", f"{n['same'] + n['new'] + n['gone']} rows differed; {n['same']} still differ, {n['new']} have another "
             f"verdict now, {n['gone']} have no row now."]
     return out

@@ -39,6 +39,8 @@ class Analysis:
         self.points = {}      # the study's own points: (pairs, eps, phi, N) -> Point
         self.extra = {}       # the other studies' points: (study, pairs, eps, phi, N) -> Point
         self.skipped = []
+        self.unfinished = {}  # (study, pairs, eps, phi, N) -> runs of that point not complete (promote_largest_n)
+        self.held_back = []   # [(point, unfinished runs)]: larger N not taken, runs of it unfinished
         self.cpu = {}
         self.pilot_cpu = 0.0
         self.also = [os.path.abspath(x) for x in also]
@@ -60,8 +62,15 @@ class Analysis:
         study = os.path.basename(sdir.rstrip("/"))
         for name, m in sorted(runs.items()):
             path = os.path.join(sdir, m["path"], "run.h5")
+            try:
+                ukey = (study, m.get("pairs", "neighbours"), float(m["restitution"]), float(m["packing_fraction"]),
+                        int(m["n_particles"]))
+            except (KeyError, TypeError, ValueError):
+                ukey = None
             if m.get("state") != "complete" or not os.path.exists(path):
                 self.skipped.append((name, m.get("state", "?")))
+                if ukey:
+                    self.unfinished[ukey] = self.unfinished.get(ukey, 0) + 1
                 continue
             try:
                 r = read_run(path, m)
@@ -91,13 +100,15 @@ class Analysis:
     def promote_largest_n(self):
         """Issue 27, item 3: at each (pairs, eps, phi) of this study, the point
         of the largest N over this study and the --also studies whose runs
-        measured everything this study's point measured joins this study's
-        points, so that every series (and so every row and fit) takes it in
-        place of this study's own; other studies' densities are not added.
-        Returns the promoted points (also in self.promoted)."""
+        measured everything this study's point measured, and all of whose
+        study's runs at that point are complete (else it is held back:
+        self.held_back), joins this study's points, so that every series (and
+        so every row and fit) takes it in place of this study's own; other
+        studies' densities are not added. Returns the promoted points (also
+        in self.promoted)."""
         def measured(p):
             return set.intersection(*[set(r["cut"].get(A_MAIN, {})) | set(r) for r in p.runs]) if p.runs else set()
-        best = {}
+        best, self.held_back = {}, []
         for k, p in self.extra.items():
             key = k[1:4]
             own = [q for pk, q in self.points.items() if pk[:3] == key]
@@ -105,6 +116,10 @@ class Analysis:
                 continue
             top = max(own, key=lambda q: q.N)
             if p.N <= top.N or not measured(top) <= measured(p):
+                continue
+            left = getattr(self, "unfinished", {}).get(k)
+            if left:   # no conclusion from a size whose runs did not all finish
+                self.held_back.append((p, left))
                 continue
             q = best.get(key)
             if q is None or p.N > q.N or (p.N == q.N and len(p.runs) > len(q.runs)):
