@@ -188,7 +188,7 @@ def test_tau_b_beyond_the_lags_is_a_bound_and_c_b_is_compared_at_a_common_time(t
         assert abs(float(c.split("±")[0]) - v) < 2e-3     # interpolated in ln t between lags
     assert "converged from N = 1024" in row
     # the run lengths in units of each run's own tau_alpha^CR, per N (seed range)
-    assert "own measured τ_α^CR (the scale study sets every N's lags from its pilot's τ_α^CR; a run's own τ_α^CR scatters about that, and so does this ratio): N 1024: 5-10, N 4096: 5-10." in text
+    assert "own measured τ_α^CR (a study in units of τ_α^CR sets every N's lags from its pilot's; a run's own τ_α^CR scatters about that, and so does this ratio): N 1024: 5-10, N 4096: 5-10." in text
 
 
 def test_a_tau_b_error_whose_blocks_cannot_span_it_is_dropped_on_reading(tmp_path):

@@ -322,7 +322,7 @@ def write_finite_size(A, path, command):
             seeds += "; τ_B row: " + ", ".join(f"N {n}: {len(p.runs)} of study {getattr(p, 'study', '?')}"
                                                for n, p in tbs)
         L += ["", f"Runs (seeds) per N: {seeds}." + (f" Longest lag in units of each run's own measured "
-                                                      f"τ_α^CR (the scale study sets every N's lags from its pilot's τ_α^CR; a run's own τ_α^CR scatters about that, and so does this ratio): {spans}."
+                                                      f"τ_α^CR (a study in units of τ_α^CR sets every N's lags from its pilot's; a run's own τ_α^CR scatters about that, and so does this ratio): {spans}."
                                                       if spans else ""), ""]
     if multi:
         L += spread_section(multi, multi_cr, multi_tb)
