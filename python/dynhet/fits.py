@@ -80,17 +80,20 @@ class Fit:
         if len(reps) >= 2 and np.all(np.isfinite(reps)):
             n = len(reps)
             jk = float(math.sqrt((n - 1) / n * ((reps - reps.mean()) ** 2).sum()))
+        def slope(nm):
+            h = 1e-6 * max(abs(self.p[nm]), 1.0)
+            up, dn = dict(self.p), dict(self.p)
+            up[nm] += h
+            dn[nm] -= h
+            return (fn(up) - fn(dn)) / (2 * h)
         own = math.nan
-        if self.cov is not None and np.all(np.isfinite(self.cov)):
-            g = np.zeros(len(self.cov_names))
-            for i, nm in enumerate(self.cov_names):
-                if nm not in self.p:   # a parameter the fit reports transformed (lnA as A): fn does not see it
-                    continue
-                h = 1e-6 * max(abs(self.p[nm]), 1.0)
-                up, dn = dict(self.p), dict(self.p)
-                up[nm] += h
-                dn[nm] -= h
-                g[i] = (fn(up) - fn(dn)) / (2 * h)
+        # the covariance's parameters: those of p it names (lnA, kept as A in p, is not one of them); a
+        # quantity that moves with a parameter outside it (an amplitude) has no propagated error
+        inside = [nm for nm in self.cov_names if nm in self.p]
+        outside = [nm for nm in self.p if nm not in inside and np.isfinite(self.p[nm])]
+        if (self.cov is not None and np.all(np.isfinite(self.cov))
+                and not any(slope(nm) != 0 for nm in outside)):
+            g = np.array([slope(nm) if nm in self.p else 0.0 for nm in self.cov_names])
             var = float(g @ self.cov @ g)
             own = math.sqrt(var) if var >= 0 else math.nan
         return v, self._quoted(jk, own)

@@ -393,3 +393,15 @@ def test_the_seed_spread_of_tau_b_is_taken_over_the_points_its_cells_show():
     row = [x for x in lines if x.startswith("| τ_B")]
     assert row and "(2)" in row[0], lines       # 2 dof per N from the longer study's three seeds
     assert not [x for x in spread_section(main, {}) if x.startswith("| τ_B")]
+
+
+def test_a_verdict_that_cannot_take_the_sizes_shown_says_why():
+    from dynhet.analysis.finite_size import quantity_rows
+
+    def pt(n, vals):
+        p = Point(("neighbours", 0.9, 0.78, n))
+        p.runs = [{"seed": s, "N": n, "v": v} for s, v in enumerate(vals, 1)]
+        return p
+    d = {1024: pt(1024, [5.0, math.nan]), 4096: pt(4096, [3.0, math.nan]), 16384: pt(16384, [5.0, 5.05])}
+    _, _, (text, n0, _, _) = quantity_rows(d, lambda r, cr: (r["v"], 0.1), False)
+    assert n0 is None and text == "no verdict: 1 of the 3 sizes shown has every seed's value with an error"

@@ -93,3 +93,15 @@ def test_a_value_falls_with_eps_only_where_the_fall_exceeds_its_errors():
     assert falls_verdict([(0.7, 0.810, 0.02), (0.9, 0.800, 0.02), (1.0, 0.782, 0.02)]).startswith("not resolved")
     assert falls_verdict([(0.7, 0.780, 0.002), (0.9, 0.800, 0.002)]).startswith("differs (ε 0.7 → 0.9 rises")
     assert falls_verdict([(0.7, 0.80, math.nan), (1.0, 0.78, math.nan)]).startswith("not resolved")
+
+
+def test_a_derived_quantity_of_a_parameter_outside_the_covariance_claims_no_propagated_error():
+    f = sf.Fit("critical_joint", ["xc", "g_a", "g_b", "A_a"])
+    f.p = {"xc": 0.8, "g_a": 2.0, "g_b": 1.0, "A_a": 3.0}
+    f.err = {"xc": 0.01, "g_a": 0.1, "g_b": 0.05, "A_a": 0.3}
+    f.cov, f.cov_names = np.array([[1e-4, 0, 0], [0, 0.01, 0.004], [0, 0.004, 0.0025]]), ["xc", "g_a", "g_b"]
+    f.chi2, f.dof = 1.0, 5
+    v, e = f.derived(lambda q: q["g_a"] / q["g_b"])
+    # r = a/b: var = r^2 (var_a/a^2 + var_b/b^2 - 2 cov_ab/(a b)) = 4 (0.0025 + 0.0025 - 0.004) = 0.004
+    assert v == 2.0 and math.isclose(e, math.sqrt(0.004), rel_tol=1e-5)
+    assert math.isnan(f.derived(lambda q: q["A_a"] * q["g_a"])[1])

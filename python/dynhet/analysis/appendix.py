@@ -115,11 +115,12 @@ def ratios(num, den):
 
 def median_error(v, e, draws=4000, seed=1):
     """(median of v, its error): the spread of the median when each value is
-    redrawn within its own error (values without an error held). The
-    measurement error of the median, not the spread of the values (the
-    range says that)."""
+    redrawn within its own error. The measurement error of the median, not
+    the spread of the values (the range says that); NaN where a value has no
+    error (holding it fixed would make the median's error too small)."""
     v, e = np.asarray(v, float), np.asarray(e, float)
-    e = np.where(np.isfinite(e), e, 0.0)
+    if not np.all(np.isfinite(e)):
+        return float(np.median(v)), math.nan
     rng = np.random.default_rng(seed)
     meds = np.median(v[None, :] + e[None, :] * rng.standard_normal((draws, len(v))), axis=1)
     return float(np.median(v)), float(np.std(meds))

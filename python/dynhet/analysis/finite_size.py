@@ -13,7 +13,7 @@ import numpy as np
 from .config import A_MAIN
 from .plotting import colours, errorbar
 from .quantities import s4_at_tau
-from .points import MIN_CAL_DOF, ensure_calibrated, spread_ratio as pooled_spread
+from .points import MIN_CAL_DOF, ensure_calibrated, measured_error, spread_ratio as pooled_spread
 from .size import Z_CONVERGED, points_by_phi_n, size_verdict, study_of
 from .size_rows import (CHI4P_ROWS, MIN_SHELLS, TAU_ROWS, c_b_times, has_cr, lags_in_tau_cr, missing_cell, quantities,
                         shells_note, tau_b_bound, tau_b_points)
@@ -59,15 +59,6 @@ def spread_section(multi, multi_cr, multi_tb=None):
             "|---|" + "---|" * len(ns)] + rows + [""]
 
 
-def measured_error(m):
-    """The error of a per-point mean that was measured: the runs' quoted
-    error, else the seeds' standard error; NaN where there is neither (one
-    seed quoting none: tau_B where its blocks cannot span it). Not
-    point_error's 10% stand-in, which the fits use as a weight."""
-    _, e, sem, _ = m
-    return e if np.isfinite(e) and e > 0 else (sem if np.isfinite(sem) and sem > 0 else math.nan)
-
-
 def cell(m, seeds=0):
     """A size's cell: mean ± error, ¹ for one seed; where only n of its
     `seeds` runs have a value (the others not resolved or not reached), the
@@ -94,6 +85,11 @@ def quantity_rows(d, fn, cr, ns=None, slug=None):
           else nan for n in ns]
     whole = [n in d and m[3] == len(d[n].runs) for n, m in zip(ns, ms)]   # every seed has it (cell)
     verdict = size_verdict(ns, [m[0] for m in ms], [measured_error(m) if w else math.nan for m, w in zip(ms, whole)])
+    shown = sum(np.isfinite(m[0]) for m in ms)
+    judged = sum(np.isfinite(m[0]) and w and np.isfinite(measured_error(m)) for m, w in zip(ms, whole))
+    if verdict[1] is None and judged < 2 <= shown:   # the cells show sizes the verdict cannot take
+        verdict = (f"no verdict: {judged} of the {shown} sizes shown has every seed's value with an error",
+                   None, math.nan, math.nan)
     return ns, ms, verdict
 
 

@@ -10,7 +10,7 @@ import numpy as np
 from .config import say
 from .overlap import tau_fits
 from .plotting import colours, errorbar
-from .points import point_error, series_arrays
+from .points import measured_error, point_error, series_arrays
 from .quantities import PER_RUN, tau
 from .size import points_by_phi_n, size_verdict
 from .verdicts import fmt
@@ -76,9 +76,13 @@ def local_n_results(A):
             if len(ok) < 2:
                 continue
             # each N: the mean over seeds, the error the runs quote and the seeds' own spread
-            cells = ", ".join(f"N {ns[i]}: {fmt(ms[i][0], point_error(ms[i]))} (seeds {ms[i][3]}, spread ± "
-                              f"{ms[i][2]:.2g})" for i in ok)
-            verdict = size_verdict([ns[i] for i in ok], [ms[i][0] for i in ok], [point_error(ms[i]) for i in ok])[0]
+            cells = ", ".join(f"N {ns[i]}: {fmt(ms[i][0], measured_error(ms[i]))} (seeds {ms[i][3]}"
+                              + (f" of {len(d[ns[i]].runs)}" if ms[i][3] < len(d[ns[i]].runs) else "")
+                              + f", spread ± {ms[i][2]:.2g})" for i in ok)
+            # the finite-size table's rule and inputs: measured errors only, sizes where every seed has a value
+            verdict = size_verdict([ns[i] for i in ok], [ms[i][0] for i in ok],
+                                   [measured_error(ms[i]) if ms[i][3] == len(d[ns[i]].runs) else math.nan
+                                    for i in ok])[0]
             A.row(f"{label.split(' ')[0]} against N at φ = {phi:g}", "issue 26, item 8 (not in the paper)",
                   "not measured", cells, verdict, "", used)
         ax.set_xscale("log")

@@ -7,10 +7,10 @@ import time
 import h5py
 import numpy as np
 
-from .points import MIN_CAL_DOF
+from .points import MIN_CAL_DOF, measured_error
 from .quantities import PER_RUN, chi4_at_tau, cut, tau, xi_at_tau
 from .verdicts import fmt
-from .config import CONVENTIONS
+from .config import CONVENTIONS, EPS_MAIN
 from .restate import restate
 
 
@@ -162,6 +162,8 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=()):
               + "; ".join(f"φ = {p.phi:g} ({p.pairs}, ε = {p.eps:g}): N = {p.N}, study {p.study}, "
                           f"{len(p.runs)} seed{'s' if len(p.runs) > 1 else ''}" for p in A.promoted)
               + ". The other densities are this study's." + largest_n_notes(A), ""]
+    elif getattr(A, "held_back", None):
+        L += ["**At the largest N** (`--largest-n`): no larger N taken." + largest_n_notes(A), ""]
     if A.skipped:
         L += [f"Left out: {len(A.skipped)} runs not complete ({', '.join(sorted({s for _, s in A.skipped}))}).", ""]
     L += ["| result | paper (section, figure) | paper | ours | verdict | figure | CPU |", "|---|---|---|---|---|---|---|"]
@@ -206,13 +208,12 @@ def largest_n_notes(A):
     because runs of them are unfinished."""
     from .size import points_by_phi_n, size_verdict
     from .size_rows import tau_of
-    from .finite_size import measured_error
-    multi = points_by_phi_n(A)
+    multi = points_by_phi_n(A)   # the main series (neighbours, eps = 0.9): the others have no sizes of their own here
     out = []
     for p in A.promoted:
-        d = multi.get(p.phi, {})
+        d = multi.get(p.phi, {}) if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 else {}
         ns = sorted(n for n in d if n <= p.N)
-        if len(ns) < 2:
+        if len(ns) < 2 or p.N not in d:
             continue
         ms = [d[n].mean(lambda r: tau_of(r)) for n in ns]
         text, n0, _, _ = size_verdict(ns, [m[0] for m in ms], [measured_error(m) for m in ms])

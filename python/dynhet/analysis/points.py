@@ -158,6 +158,15 @@ def point_error(m):
     return e if np.isfinite(e) and e > 0 else (sem if np.isfinite(sem) and sem > 0 else abs(v) * 0.1)
 
 
+def measured_error(m):
+    """The error of a per-point mean that was measured: the runs' quoted
+    error, else the seeds' standard error; NaN where there is neither (one
+    seed quoting none: tau_B where its blocks cannot span it). Not
+    point_error's 10% stand-in, which the fits use as a weight."""
+    _, e, sem, _ = m
+    return e if np.isfinite(e) and e > 0 else (sem if np.isfinite(sem) and sem > 0 else math.nan)
+
+
 def paired_arrays(points, fn, xrun=None, drop=None, xpoint=lambda p: p.phi):
     """Per-point means of fn against x: a per-point function (xpoint) or the
     per-point mean of a per-run quantity (xrun, e.g. tau_alpha). With xrun,

@@ -62,14 +62,20 @@ def restitution_results(A):
               f"φ_c {fmt(fp.p['xc'], fp.error('xc'), 4)}, φ_0 {fmt(fv.p['x0'], fv.error('x0'), 4)}",
               "figure", f, pts, "; ".join(n for n in (fp.note, fv.note) if n))
     for nm, key, which in (("φ_c", "xc", 1), ("φ_0", "x0", 2)):
-        vals = [(e, f[which].p[key], f[which].error(key)) for e, *f in [(e, None, fp, fv) for e, fp, fv, _ in pc] if f[which].ok]
-        vals.sort()
+        fits = sorted((e, (fp, fv)[which - 1]) for e, fp, fv, _ in pc)
+        # only fits that can carry a verdict: a phi_c on the edge of the data or an improbable chi2 has no error to compare
+        why = {e: ("not determined" if not f_.ok else sf.cannot_judge(f_, key) or
+                   ("no divergence resolved" if not f_.determined else None)) for e, f_ in fits}
+        vals = [(e, f_.p[key], f_.error(key)) for e, f_ in fits if why[e] is None]
+        left = "; ".join(f"ε = {e:g} left out: {w}" for e, w in why.items() if w)
+        shown = ", ".join(f"{e:g}: {fmt(f_.p[key], f_.error(key), 4)}" for e, f_ in fits if f_.ok)
         if len(vals) < 2:
-            A.row(f"{nm}(ε) decreases as ε grows", "3.4, fig. tau inset", "yes", "not determined", "not determined", f, [])
+            A.row(f"{nm}(ε) decreases as ε grows ({rng})", "3.4, fig. tau inset", "yes", shown or "not determined",
+                  f"not judged: {len(vals)} of {len(fits)} fits can carry a verdict", f,
+                  [p for *_, ps in pc for p in ps], left)
             continue
-        A.row(f"{nm}(ε) decreases as ε grows ({rng})", "3.4, fig. tau inset", "yes",
-              ", ".join(f"{e:g}: {fmt(v, err, 4)}" for e, v, err in vals), falls_verdict(vals),
-              f, [p for *_, ps in pc for p in ps])
+        A.row(f"{nm}(ε) decreases as ε grows ({rng})", "3.4, fig. tau inset", "yes", shown, falls_verdict(vals),
+              f, [p for *_, ps in pc for p in ps], left)
     # d_f' over every eps: chi4(tau_alpha) against xi(tau_alpha), all points of the neighbour series
     allp = [p for eps in eps_list for p in A.series(eps=eps)]
     # The paper's 1.58 is the exponent of a finite-size collapse of chi4^P over

@@ -71,8 +71,8 @@ def size_verdict(ns, vals, errs):
     n1, v1, e1 = d[-2]
     per = math.log2(nmax / n1)
     drift, derr = (vmax - v1) / per, math.hypot(emax, e1) / per
-    rel = drift / abs(v1) if v1 else math.nan
-    change = f"{fmt(drift, derr)} per doubling of N ({100 * rel:+.0f}%) from N = {n1} to {nmax}"
+    rel = f" ({100 * drift / abs(v1):+.0f}%)" if v1 else ""
+    change = f"{fmt(drift, derr)} per doubling of N{rel} from N = {n1} to {nmax}"
     n0 = None
     for k in range(len(d) - 2, -1, -1):
         n, v, e = d[k]

@@ -67,18 +67,23 @@ class Analysis:
                         int(m["n_particles"]))
             except (KeyError, TypeError, ValueError):
                 ukey = None
-            if m.get("state") != "complete" or not os.path.exists(path):
-                self.skipped.append((name, m.get("state", "?")))
+            def unfinished(why):
+                self.skipped.append((name, why))
                 if ukey:
                     self.unfinished[ukey] = self.unfinished.get(ukey, 0) + 1
+            if m.get("state") != "complete" or not os.path.exists(path):
+                unfinished(m.get("state", "?"))
                 continue
             try:
                 r = read_run(path, m)
             except (OSError, KeyError, ValueError) as e:
-                self.skipped.append((name, f"unreadable: {e}"))
+                unfinished(f"unreadable: {e}")
                 continue
-            if r["complete"] != 1 or A_MAIN not in r["cut"]:
-                self.skipped.append((name, "run.h5 not complete" if r["complete"] != 1 else f"no cutoff a = {A_MAIN}"))
+            if r["complete"] != 1:
+                unfinished("run.h5 not complete")
+                continue
+            if A_MAIN not in r["cut"]:
+                self.skipped.append((name, f"no cutoff a = {A_MAIN}"))
                 continue
             r["name"], r["path"], r["study"] = name, path, study
             key = (m.get("pairs", "neighbours"), float(m["restitution"]), float(m["packing_fraction"]), int(m["n_particles"]))
@@ -124,6 +129,9 @@ class Analysis:
             q = best.get(key)
             if q is None or p.N > q.N or (p.N == q.N and len(p.runs) > len(q.runs)):
                 best[key] = p
+        # only the sizes above the one taken were held back in its place
+        self.held_back = [(p, n) for p, n in self.held_back
+                          if p.N > getattr(best.get((p.pairs, p.eps, p.phi)), "N", 0)]
         self.promoted = []
         for key, p in sorted(best.items()):
             self.points[key + (p.N,)] = p
