@@ -405,3 +405,19 @@ def test_a_verdict_that_cannot_take_the_sizes_shown_says_why():
     d = {1024: pt(1024, [5.0, math.nan]), 4096: pt(4096, [3.0, math.nan]), 16384: pt(16384, [5.0, 5.05])}
     _, _, (text, n0, _, _) = quantity_rows(d, lambda r, cr: (r["v"], 0.1), False)
     assert n0 is None and text == "no verdict: 1 of the 3 sizes shown has every seed's value with an error"
+
+
+def test_a_size_whose_runs_did_not_all_finish_is_held_back_and_named():
+    from dynhet.analysis.size import held_back, points_by_phi_n
+
+    def point(study, n, seeds):
+        p = Point(("neighbours", 0.9, 0.8, n))
+        p.runs = [{"seed": s, "N": n, "study": study} for s in range(1, seeds + 1)]
+        p.study = study
+        return p
+    A = Analysis.__new__(Analysis)
+    A.points = {}
+    A.extra = {("scale", "neighbours", 0.9, 0.8, n): point("scale", n, k) for n, k in ((1024, 3), (4096, 3), (16384, 2))}
+    A.unfinished = {("scale", "neighbours", 0.9, 0.8, 16384): 1}
+    assert sorted(points_by_phi_n(A)[0.8]) == [1024, 4096]
+    assert held_back(A, 0.8) == [(16384, "scale", 1)] and held_back(A, 0.79) == []

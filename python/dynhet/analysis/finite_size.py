@@ -14,7 +14,7 @@ from .config import A_MAIN
 from .plotting import colours, errorbar
 from .quantities import s4_at_tau
 from .points import MIN_CAL_DOF, ensure_calibrated, measured_error, spread_ratio as pooled_spread
-from .size import Z_CONVERGED, points_by_phi_n, size_verdict, study_of
+from .size import Z_CONVERGED, held_back, points_by_phi_n, size_verdict, study_of
 from .size_rows import (CHI4P_ROWS, MIN_SHELLS, TAU_ROWS, c_b_times, has_cr, lags_in_tau_cr, missing_cell, quantities,
                         shells_note, tau_b_bound, tau_b_points)
 from .verdicts import fmt
@@ -144,9 +144,13 @@ def panels_per_phi(A, multi, multi_cr, curve, title, xlabel, ylabel, name, ms):
     and cage-relative (open, dashed): curve(point, cr) -> (x, y) or None.
     The saved figure's path, "" where no curve has data."""
     phis = list(multi)
-    fig, axes = plt.subplots(1, len(phis), figsize=(4.0 * len(phis), 3.7), squeeze=False)
+    cols = min(3, len(phis))                      # three panels a row: readable at six densities
+    rows = -(-len(phis) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(5.0 * cols, 4.2 * rows), squeeze=False)
+    for ax in axes.flat[len(phis):]:
+        ax.set_visible(False)
     drawn = False
-    for ax, phi in zip(axes[0], phis):
+    for ax, phi in zip(axes.flat, phis):
         ns = sorted(multi[phi])
         for n, col in zip(ns, colours(len(ns))):
             for cr, ls in ((False, "o-"), (True, "s--")):
@@ -164,7 +168,9 @@ def panels_per_phi(A, multi, multi_cr, curve, title, xlabel, ylabel, name, ms):
     if not drawn:
         plt.close(fig)
         return ""
-    axes[0][0].set_ylabel(ylabel)
+    for row in axes:
+        row[0].set_ylabel(ylabel)
+    fig.tight_layout()
     return A.save(fig, name)
 
 
@@ -309,6 +315,9 @@ def write_finite_size(A, path, command):
                     cells = [c + shells_note(dd.get(n), cr) for c, n in zip(cells, qn)]
                 L.append(f"| {label} | " + " | ".join(cells) + f" | {text} |")
         seeds = ", ".join(f"N {n}: {len(d[n].runs)} ({study_of(d[n])})" for n in ns)
+        held = [f"N {n} of {st} ({k} run{'s' if k > 1 else ''} unfinished)" for n, st, k in held_back(A, phi)]
+        if held:
+            seeds += "; held back, no conclusion from a size whose runs did not all finish: " + ", ".join(held)
         spans = lags_in_tau_cr(d, ns)
         crs = multi_cr.get(phi, {})
         if crs and any(crs.get(n) is not d.get(n) for n in crs):

@@ -20,7 +20,8 @@ def points_by_phi_n(A, has=lambda p: True):
     sizes, not a single-N study's; then the one with the cage-relative
     measures (that protocol's); only densities run at more than one N."""
     allp = [p for p in list(A.points.values()) + list(A.extra.values())
-            if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p)]
+            if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p)
+            and not unfinished_runs(A, p)]   # no conclusion from a size whose runs did not all finish
     sizes = {}
     for p in allp:
         sizes.setdefault((study_of(p), p.phi), set()).add(p.N)
@@ -34,6 +35,22 @@ def points_by_phi_n(A, has=lambda p: True):
         if q is None or rank(p) > rank(q):
             by_phi[p.phi][p.N] = p
     return {phi: d for phi, d in sorted(by_phi.items()) if len(d) > 1}
+
+
+def unfinished_runs(A, p):
+    """How many runs of point p's study at its (pairs, eps, phi, N) are not
+    complete (Analysis.unfinished; 0 for an Analysis without that record)."""
+    return getattr(A, "unfinished", {}).get((study_of(p), p.pairs, p.eps, p.phi, p.N), 0)
+
+
+def held_back(A, phi):
+    """The sizes of the main series at phi left out because runs of them are
+    unfinished: [(N, study, runs unfinished)]."""
+    out = []
+    for (st, pairs, eps, ph, n), k in sorted(getattr(A, "unfinished", {}).items()):
+        if pairs == "neighbours" and abs(eps - EPS_MAIN) < 1e-9 and abs(ph - phi) < 1e-9 and k:
+            out.append((n, st, k))
+    return out
 
 
 def study_of(p):
