@@ -405,6 +405,9 @@ def test_a_verdict_that_cannot_take_the_sizes_shown_says_why():
     d = {1024: pt(1024, [5.0, math.nan]), 4096: pt(4096, [3.0, math.nan]), 16384: pt(16384, [5.0, 5.05])}
     _, _, (text, n0, _, _) = quantity_rows(d, lambda r, cr: (r["v"], 0.1), False)
     assert n0 is None and text == "no verdict: 1 of the 3 sizes shown has every seed's value with an error"
+    d = {4096: pt(4096, [3.0, math.nan]), 16384: pt(16384, [math.nan, math.nan])}
+    _, _, (text, _, _, _) = quantity_rows(d, lambda r, cr: (r["v"], 0.1), False)
+    assert text == "no verdict: 0 of the 1 size shown have every seed's value with an error"
 
 
 def test_a_size_whose_runs_did_not_all_finish_is_held_back_and_named():

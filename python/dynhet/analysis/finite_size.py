@@ -87,9 +87,9 @@ def quantity_rows(d, fn, cr, ns=None, slug=None):
     verdict = size_verdict(ns, [m[0] for m in ms], [measured_error(m) if w else math.nan for m, w in zip(ms, whole)])
     shown = sum(np.isfinite(m[0]) for m in ms)
     judged = sum(np.isfinite(m[0]) and w and np.isfinite(measured_error(m)) for m, w in zip(ms, whole))
-    if verdict[1] is None and judged < 2 <= shown:   # the cells show sizes the verdict cannot take
-        verdict = (f"no verdict: {judged} of the {shown} sizes shown has every seed's value with an error",
-                   None, math.nan, math.nan)
+    if verdict[1] is None and judged < 2 and shown > judged:   # the cells show sizes the verdict cannot take
+        verdict = (f"no verdict: {judged} of the {shown} size{'s' if shown > 1 else ''} shown "
+                   f"{'has' if judged == 1 else 'have'} every seed's value with an error", None, math.nan, math.nan)
     return ns, ms, verdict
 
 
