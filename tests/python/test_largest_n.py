@@ -101,3 +101,26 @@ def test_a_larger_n_with_runs_unfinished_is_held_back_and_the_next_stands_in():
     notes = largest_n_notes(A)
     assert "Held back" in notes and "N = 65536 of study scale2 (1 run not complete)" in notes
     assert "N = 65536 of study scale (2 runs not complete)" in notes
+
+
+def test_the_two_driving_rules_are_set_side_by_side_at_one_box_size(tmp_path):
+    from dynhet.analysis.driving import driving_results
+
+    def pt(pairs, phi, n, tau):
+        p = Point((pairs, 0.9, phi, n))
+        p.runs = [{"seed": s, "N": n, "cut": {0.6: {"tau_alpha": tau * (1 + 0.01 * s), "tau_alpha_err": 0.1,
+                                                    "cl_slow_d_f": 1.8, "cl_slow_d_f_err": 0.05}}} for s in (1, 2, 3)]
+        return p
+    A = Analysis.__new__(Analysis)
+    A.points, A.extra, A.cpu, A.fits = {}, {}, {}, {}
+    A.figdir, A.dir = str(tmp_path), str(tmp_path)
+    for pairs in ("neighbours", "any"):
+        for phi, tau in ((0.7, 3.0), (0.76, 6.0), (0.8, 300.0 if pairs == "neighbours" else 7.0)):
+            p = pt(pairs, phi, 4096, tau)
+            A.points[p.pairs, p.eps, p.phi, p.N] = p
+    big = pt("neighbours", 0.8, 16384, 200.0)         # as --largest-n promotes it
+    A.points[big.pairs, big.eps, big.phi, big.N] = big
+    driving_results(A)
+    out, _ = A.driving
+    assert A.driving_n == 4096
+    assert [p.N for p in out["neighbours"]["pts"]] == [4096, 4096, 4096]   # not the promoted N = 16384

@@ -176,7 +176,9 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=()):
         L += ["", "## The two driving rules side by side (ε = 0.9)", "",
               "`driving.pairs = \"neighbours\"` (a kick's partner within reach of the first particle) against `\"any\"` "
               "(two particles from the whole system); the paper does not say which it used (docs/engine.md, \"The "
-              "driving model\").", "",
+              "driving model\")." + (f" Both at N = {A.driving_n}, the largest box both rules ran (not the "
+                                      f"largest N of the neighbour series alone)." if getattr(A, "driving_n", None)
+                                      else ""), "",
               "| quantity | paper | neighbours | any |", "|---|---|---|---|"]
         for lab, paper, a, b in A.driving_table:
             L.append(f"| {lab} | {paper} | {a} | {b} |")
