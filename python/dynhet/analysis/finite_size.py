@@ -315,7 +315,7 @@ def write_finite_size(A, path, command):
                     cells = [c + shells_note(dd.get(n), cr) for c, n in zip(cells, qn)]
                 L.append(f"| {label} | " + " | ".join(cells) + f" | {text} |")
         seeds = ", ".join(f"N {n}: {len(d[n].runs)} ({study_of(d[n])})" for n in ns)
-        held = [f"N {n} of {st} ({k} run{'s' if k > 1 else ''} unfinished)" for n, st, k in held_back(A, phi)]
+        held = [f"N {n} of {st} ({k} run{'s' if k > 1 else ''} not complete)" for n, st, k in held_back(A, phi)]
         if held:
             seeds += "; held back, no conclusion from a size whose runs did not all finish: " + ", ".join(held)
         spans = lags_in_tau_cr(d, ns)
