@@ -7,7 +7,7 @@ import time
 import h5py
 import numpy as np
 
-from .points import MIN_CAL_DOF, measured_error
+from .points import MIN_CAL_DOF
 from .quantities import PER_RUN, chi4_at_tau, cut, tau, xi_at_tau
 from .verdicts import fmt
 from .config import CONVENTIONS, EPS_MAIN
@@ -208,7 +208,8 @@ def largest_n_notes(A):
     tau_alpha (size_verdict over the sizes of that density: "largest
     converged", else "largest available"), and the larger sizes held back
     because runs of them are unfinished."""
-    from .size import points_by_phi_n, size_verdict
+    from .finite_size import quantity_rows   # the finite-size table's own verdict on tau_alpha
+    from .size import points_by_phi_n
     from .size_rows import tau_of
     multi = points_by_phi_n(A)   # the main series (neighbours, eps = 0.9): the others have no sizes of their own here
     out = []
@@ -217,8 +218,7 @@ def largest_n_notes(A):
         ns = sorted(n for n in d if n <= p.N)
         if len(ns) < 2 or p.N not in d:
             continue
-        ms = [d[n].mean(lambda r: tau_of(r)) for n in ns]
-        text, n0, _, _ = size_verdict(ns, [m[0] for m in ms], [measured_error(m) for m in ms])
+        _, _, (text, n0, _, _) = quantity_rows({n: d[n] for n in ns}, tau_of, False)
         out.append(f"φ = {p.phi:g}: N = {p.N} is the largest " + ("converged" if n0 is not None else "available")
                    + f" N for τ_α ({text})")
     if out:

@@ -63,14 +63,14 @@ class Analysis:
         for name, m in sorted(runs.items()):
             path = os.path.join(sdir, m["path"], "run.h5")
             try:
-                ukey = (study, m.get("pairs", "neighbours"), float(m["restitution"]), float(m["packing_fraction"]),
-                        int(m["n_particles"]))
+                key = (m.get("pairs", "neighbours"), float(m["restitution"]), float(m["packing_fraction"]),
+                       int(m["n_particles"]))
             except (KeyError, TypeError, ValueError):
-                ukey = None
+                key = None
             def unfinished(why):
                 self.skipped.append((name, why))
-                if ukey:
-                    self.unfinished[ukey] = self.unfinished.get(ukey, 0) + 1
+                if key:
+                    self.unfinished[(study,) + key] = self.unfinished.get((study,) + key, 0) + 1
             if m.get("state") != "complete" or not os.path.exists(path):
                 unfinished(m.get("state", "?"))
                 continue
@@ -85,8 +85,10 @@ class Analysis:
             if A_MAIN not in r["cut"]:
                 self.skipped.append((name, f"no cutoff a = {A_MAIN}"))
                 continue
+            if key is None:
+                self.skipped.append((name, "its index entry lacks restitution, packing_fraction or n_particles"))
+                continue
             r["name"], r["path"], r["study"] = name, path, study
-            key = (m.get("pairs", "neighbours"), float(m["restitution"]), float(m["packing_fraction"]), int(m["n_particles"]))
             if primary:
                 self.points.setdefault(key, Point(key)).runs.append(r)
                 self.cpu[key] = self.cpu.get(key, 0.0) + float(m.get("cpu_s", 0.0))
