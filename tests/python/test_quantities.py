@@ -45,3 +45,19 @@ def test_near_one_claims_a_difference_only_beyond_the_tolerance_and_the_errors()
     assert near_one(1.32, 0.24) == "agrees"                 # 0.32 off, but 1.3 errors: not told apart
     assert near_one(1.32, 0.10) == "differs (3.2 σ)"
     assert near_one(1.32, math.nan) == "differs"
+
+
+def test_one_seeds_ageing_slope_error_matches_the_spread_of_independent_runs():
+    """tau_alpha(t0) of one run: its slope's error from the scatter about the
+    line is what 2000 independent realisations of the same line scatter by;
+    none where origins lie closer than tau_alpha (correlated) or too few."""
+    from dynhet.analysis.overlap import slope_with_error
+    rng = np.random.default_rng(7)
+    x = 68.0 + 6.8 * np.arange(8)                 # 8 origins 6.8 tau_alpha apart (the scale study at phi 0.78)
+    fits = [slope_with_error(x, 1.0 - 0.001 * x + rng.normal(0, 0.01, 8)) for _ in range(2000)]
+    b, e = np.array([f[0] for f in fits]), np.array([f[1] for f in fits])
+    assert all(f[2] == 8 for f in fits)
+    assert abs(b.mean() + 0.001) < 3 * b.std() / math.sqrt(len(b))
+    assert abs(np.sqrt((e ** 2).mean()) / b.std() - 1) < 0.06     # 2000 draws: the ratio to within ~3%
+    assert math.isnan(slope_with_error(x[:3], x[:3])[1])
+    assert math.isnan(slope_with_error(np.arange(8) * 0.5, np.ones(8))[1])

@@ -78,7 +78,7 @@ def local_n_results(A):
             # each N: the mean over seeds, the error the runs quote and the seeds' own spread
             cells = ", ".join(f"N {ns[i]}: {fmt(ms[i][0], measured_error(ms[i]))} (seeds {ms[i][3]}"
                               + (f" of {len(d[ns[i]].runs)}" if ms[i][3] < len(d[ns[i]].runs) else "")
-                              + f", spread ± {ms[i][2]:.2g})" for i in ok)
+                              + (f", spread ± {ms[i][2]:.2g})" if ms[i][3] > 1 else ")") for i in ok)
             # the finite-size table's rule and inputs: measured errors only, sizes where every seed has a value
             verdict = size_verdict([ns[i] for i in ok], [ms[i][0] for i in ok],
                                    [measured_error(ms[i]) if ms[i][3] == len(d[ns[i]].runs) else math.nan
