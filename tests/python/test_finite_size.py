@@ -424,3 +424,18 @@ def test_a_size_whose_runs_did_not_all_finish_is_held_back_and_named():
     A.unfinished = {("scale", "neighbours", 0.9, 0.8, 16384): 1}
     assert sorted(points_by_phi_n(A)[0.8]) == [1024, 4096]
     assert held_back(A, 0.8) == [(16384, "scale", 1)] and held_back(A, 0.79) == []
+
+
+def test_the_sub_box_caption_names_a_box_its_sub_boxes_stop_short_of():
+    """fig. chi4P(a): a curve's last point is the whole box only where the
+    study's sub-box sizes reach it (studies/scale.toml's end at 32768, below
+    N = 262144): the caption names that size and its largest sub-box."""
+    from dynhet.analysis.finite_size import short_of_box
+    def pt(n, sizes):
+        p = Point(("neighbours", 0.9, 0.78, n))
+        p.runs.append({"seed": 1, "N": n, "cut": {0.6: {"chi4_N": np.array(sizes)}}})
+        return p
+    reach = {0.78: {16384: pt(16384, [28.4, 113.8, 455.1, 1820.4, 16384.0])}}
+    assert short_of_box(reach) == ""
+    reach[0.78][262144] = pt(262144, [28.4, 113.8, 455.1, 1820.4, 7281.8, 29127.1])
+    assert short_of_box(reach) == "; at N = 262144 it is the largest sub-box its study asks for, 29127 particles, short of the box"

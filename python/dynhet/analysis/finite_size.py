@@ -200,7 +200,8 @@ def plot_s4_q(A, multi, multi_cr):
 def plot_chi4p_subbox(A, multi, multi_cr):
     """The paper's fig. chi4P(a) at every box size: chi4^P against the
     sub-box's particles, one panel per density, a curve per N (the mean over
-    seeds; interior peaks only; the last point of a curve is the whole box),
+    seeds; interior peaks only; the last point of a curve is the whole box,
+    where the study's sub-box sizes reach it: short_of_box),
     standard (filled) and cage-relative (open): where a sub-box's chi4^P
     does not depend on the box around it, and how far the larger boxes
     extend the curve."""
@@ -219,6 +220,21 @@ def plot_chi4p_subbox(A, multi, multi_cr):
         return x, [np.mean(by_size[k]) for k in x]
     return panels_per_phi(A, multi, multi_cr, curve, "χ4^P against the sub-box", "particles in the sub-box",
                           "χ4^P (mean over seeds)", "fs_chi4p_subbox.png", 3)
+
+
+def short_of_box(multi):
+    """The caption's exception: the sizes whose sub-boxes stop short of the
+    whole box (the study's list of sub-box sizes ends below N), each with its
+    largest sub-box; "" where every curve reaches its box."""
+    short = {}
+    for d in multi.values():
+        for n, p in d.items():
+            for r in p.runs:
+                sizes = r.get("cut", {}).get(A_MAIN, {}).get("chi4_N")
+                if sizes is not None and len(sizes) and max(sizes) < 0.99 * n:
+                    short[n] = max(short.get(n, 0), round(float(max(sizes))))
+    return "".join(f"; at N = {n} it is the largest sub-box its study asks for, {m} particles, short of the box"
+                   for n, m in sorted(short.items()))
 
 
 def calibration_note(A, multi, multi_cr, multi_tb=None):
@@ -340,7 +356,8 @@ def write_finite_size(A, path, command):
                 L.append(f"- {name}: ![{name}](finite_size/{os.path.basename(f)})")
         for plot, caption, alt in (
                 (plot_chi4p_subbox, "χ4^P against the sub-box's particles at every N (the paper's fig. chi4P(a), with "
-                 "the sub-box sizes the larger boxes allow; a curve's last point is its whole box), standard (filled) "
+                 "the sub-box sizes the larger boxes allow; a curve's last point is its whole box"
+                 + short_of_box(multi) + "), standard (filled) "
                  "and cage-relative (open)", "χ4^P against the sub-box"),
                 (plot_s4_q, "S4(q, τ_α) of the whole box at every N, standard (filled, solid) and cage-relative (open, "
                  "dashed): where it levels off below q = 1/ξ (an Ornstein-Zernike ξ the box resolves) and where it "
