@@ -215,3 +215,20 @@ def test_the_study_ends_when_its_last_slot_does():
     # the queue alone on two free slots: 4 | 2 + 2 -> 4 h
     assert study_eta([], [4 * h, 2 * h, 2 * h], 2) == 4 * h
     assert study_eta([], [], 2) == 0.0
+
+
+def test_a_resumed_run_keeps_the_cpu_of_earlier_attempts_and_counts_a_killed_one():
+    """The status a new attempt writes at its start carries the CPU of the
+    earlier attempts; one left "running" (killed before it could record its
+    own: the whole machine stopped) loses only its own, and is counted."""
+    from dynhet.study.runner import carried_cpu, running_status
+    # what the new attempt writes at its start, before anything can kill it
+    st = running_status({"state": "running", "attempts": 2, "cpu_s": 5118.6}, "cut", "pilot x 1.2")
+    assert st["state"] == "running" and st["attempts"] == 3 and st["cpu_s"] == 5118.6 and st["cpu_unrecorded"] == 1
+    # stopped by a signal: recorded its CPU, nothing lost
+    assert carried_cpu({"state": "interrupted", "cpu_s": 5118.6}, "cut") == (5118.6, 0)
+    # killed while running: its status still carries the attempts before it (written at its start)
+    assert carried_cpu({"state": "running", "cpu_s": 5118.6}, "cut") == (5118.6, 1)
+    assert carried_cpu({"state": "running", "cpu_s": 10.0, "cpu_unrecorded": 1}, "cut") == (10.0, 2)
+    # starting over: the result costs only what the new attempt costs
+    assert carried_cpu({"state": "failed", "cpu_s": 99.0}, None) == (0.0, 0)

@@ -43,6 +43,9 @@ class Analysis:
         self.held_back = []   # [(point, unfinished runs)]: larger N not taken, runs of it unfinished
         self.cpu = {}
         self.pilot_cpu = 0.0
+        self.cpu_runs = 0       # the runs (of every study read) whose CPU self.cpu sums
+        self.cpu_resumed = 0    # of those, resumed after an interruption (attempts > 1)
+        self.cpu_unrecorded = 0 # attempts killed before they recorded their CPU (not in self.cpu)
         self.also = [os.path.abspath(x) for x in also]
         for k, sd in enumerate([d] + list(also)):
             self.read_study(sd, primary=(k == 0))
@@ -89,6 +92,9 @@ class Analysis:
                 self.skipped.append((name, "its index entry lacks restitution, packing_fraction or n_particles"))
                 continue
             r["name"], r["path"], r["study"] = name, path, study
+            self.cpu_runs += 1
+            self.cpu_resumed += int(m.get("attempts", 1)) > 1
+            self.cpu_unrecorded += int(m.get("cpu_unrecorded", 0))
             if primary:
                 self.points.setdefault(key, Point(key)).runs.append(r)
                 self.cpu[key] = self.cpu.get(key, 0.0) + float(m.get("cpu_s", 0.0))

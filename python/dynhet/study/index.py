@@ -14,7 +14,8 @@ def write_index(sd):
         row = {a: p[a] for a in AXES}
         row["path"] = os.path.relpath(sd.run_dir(p), sd.dir)
         row["state"] = st.get("state", "pending")
-        for k in ("tau_estimate", "tau_source", "tau_alpha", "wall_s", "cpu_s", "attempts", "requeues", "message"):
+        for k in ("tau_estimate", "tau_source", "tau_alpha", "wall_s", "cpu_s", "cpu_unrecorded", "attempts", "requeues",
+                  "message"):
             if k in st:
                 row[k] = st[k]
         rows[sd.study.run_name(p)] = row

@@ -12,6 +12,28 @@ from .progress import sim_progress
 from .states import equilibrated_state, pid_alive, pilot, prepared_state
 
 
+def carried_cpu(old, resume):
+    """(CPU seconds, attempts whose CPU was lost) that a new attempt carries
+    from its run's previous status: a resumed run's earlier attempts; an
+    earlier attempt left "running" was killed before it could record its own
+    (its process is gone: do_run returns before this for a live one). A run
+    that starts over carries nothing."""
+    if resume is None:
+        return 0.0, 0
+    return float(old.get("cpu_s", 0.0)), int(old.get("cpu_unrecorded", 0)) + int(old.get("state") == "running")
+
+
+def running_status(old, resume, source):
+    """The status an attempt writes at its start (over old, the previous one)."""
+    carried, unrecorded = carried_cpu(old, resume)
+    status = {"state": "running", "host": socket.gethostname(), "pid": os.getpid(),
+              "started": time.strftime("%Y-%m-%dT%H:%M:%S"), "attempts": int(old.get("attempts", 0)) + 1,
+              "tau_source": source or "scene", "cpu_s": carried}
+    if unrecorded:
+        status["cpu_unrecorded"] = unrecorded
+    return status
+
+
 def do_run(sd, p, log=print):
     """Runs (or resumes) one run to the end; returns its final status."""
     st = sd.study
@@ -21,7 +43,6 @@ def do_run(sd, p, log=print):
     if old.get("state") == "complete":
         return old
     rl = st.run_length
-    attempts = int(old.get("attempts", 0))
     resume = None
     tau_est, source = old.get("tau_estimate"), old.get("tau_source")
     if old.get("state") == "running" and old.get("host") == socket.gethostname() and pid_alive(old.get("pid")):
@@ -72,9 +93,14 @@ def do_run(sd, p, log=print):
         write_atomic(os.path.join(d, "scene.toml"),
                      toml_dump(sc, f"# {st.name}: {st.run_name(p)}; tau_alpha estimate {tau_est} ({source})"))
     sc = read_toml(os.path.join(d, "scene.toml"))
-    status = {"state": "running", "host": socket.gethostname(), "pid": os.getpid(),
-              "started": time.strftime("%Y-%m-%dT%H:%M:%S"), "attempts": attempts + 1,
-              "tau_source": source or "scene"}
+    # A resumed run's CPU includes its earlier attempts' (what the result
+    # cost: the study's CPU figures and --dry-run's measured scale use it),
+    # recorded from the start: an attempt killed before it can write its own
+    # (SIGKILL, a machine that goes down) leaves the status "running", and
+    # must not take the earlier attempts' record with it; its own CPU is lost,
+    # and counted as lost (cpu_unrecorded, which the study analysis states).
+    status = running_status(old, resume, source)
+    carried = status["cpu_s"]
     if tau_est is not None:
         status["tau_estimate"] = tau_est
     for a in AXES:
@@ -84,9 +110,6 @@ def do_run(sd, p, log=print):
         status["requeues"] = int(os.environ["SLURM_RESTART_COUNT"])
     scene_path = os.path.join(d, "scene.toml")
     cut0 = newest_whole_cut(d)
-    # A resumed run's CPU includes its earlier attempts' (what the result
-    # cost: the study's CPU figures and --dry-run's measured scale use it).
-    carried = float(old.get("cpu_s", 0.0)) if resume is not None else 0.0
     # A run that failed (or was too short) starts over: resuming it from its
     # last cut would repeat what failed (a recorder part that lost frames
     # can never make the run complete).
