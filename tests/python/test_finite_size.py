@@ -439,3 +439,21 @@ def test_the_sub_box_caption_names_a_box_its_sub_boxes_stop_short_of():
     assert short_of_box(reach) == ""
     reach[0.78][262144] = pt(262144, [28.4, 113.8, 455.1, 1820.4, 7281.8, 29127.1])
     assert short_of_box(reach) == "; at N = 262144 it is the largest sub-box its study asks for, 29127 particles, short of the box"
+
+
+def test_the_spread_table_says_a_size_of_one_seed_cannot_check_its_errors():
+    """Item 5 at the largest N: one seed has no spread, so the check cannot be
+    made there; the table says so instead of a bare dash."""
+    from dynhet.analysis.finite_size import spread_section
+    multi = {}
+    for phi in (0.76, 0.78):
+        multi[phi] = {}
+        for n, seeds in ((4096, (1, 2, 3)), (262144, (1,))):
+            p = Point(("neighbours", 0.9, phi, n))
+            for s in seeds:
+                p.runs.append({"seed": s, "N": n, "cut": {0.6: {"tau_alpha": 10.0 + s, "tau_alpha_err": 1.0}}})
+            multi[phi][n] = p
+    row = next(l for l in spread_section(multi, {}) if l.startswith("| τ_α |"))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[1] == "1.00 ± 0.35 (4)"          # seeds 1 apart (std 1), errors 1: 2 points of 2 dof, ± 1/sqrt(8)
+    assert cells[2] == "one seed: not checkable"

@@ -124,3 +124,16 @@ def test_the_two_driving_rules_are_set_side_by_side_at_one_box_size(tmp_path):
     out, _ = A.driving
     assert A.driving_n == 4096
     assert [p.N for p in out["neighbours"]["pts"]] == [4096, 4096, 4096]   # not the promoted N = 16384
+
+
+def test_a_driving_table_parameter_whose_error_exceeds_it_is_not_determined():
+    """The side-by-side table printed "γξ 10.7 ± 2.4e+02" as a result."""
+    from dynhet import fits as sf
+    from dynhet.analysis.driving import param_cell
+    f = sf.Fit("power", ["g", "xc"])
+    f.p.update(g=10.7, xc=0.8)
+    f.err.update(g=240.0, xc=0.001)
+    assert param_cell(f, "g") == "not determined (10.7 ± 2.4e+02)"
+    assert param_cell(f, "xc", 4) == "0.8 ± 0.001"
+    f.p["g"] = float("nan")
+    assert param_cell(f, "g") == "not determined"

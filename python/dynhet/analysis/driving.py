@@ -46,27 +46,36 @@ def driving_results(A):
     A.driving_n = n_common
 
 
+def param_cell(f_, k, digits=3):
+    """A fit parameter's cell: a parameter whose error exceeds its value (or
+    that has none) says nothing (docs/analysis.md) and is so marked."""
+    v, e = f_.p[k], f_.error(k)
+    if not math.isfinite(v):
+        return "not determined"
+    return fmt(v, e, digits) if abs(e) <= abs(v) else f"not determined ({fmt(v, e, digits)})"
+
+
 def driving_rows(A):
     out, f = A.driving
     if len(out) < 2:
         A.row("both kick-pair rules side by side (ε = 0.9)", "2 (driving)", "—",
               f"only pairs = {', '.join(out) or 'none'} in this study", "not run", f, [])
         return
+    param = param_cell
     def cell(res, what):
         if what == "phi_c":
-            return fmt(res["fp"].p["xc"], res["fp"].error("xc"), 4)
+            return param(res["fp"], "xc", 4)
         if what == "gamma":
-            return fmt(res["fp"].p["g"], res["fp"].error("g"))
+            return param(res["fp"], "g")
         if what == "phi_0":
-            return fmt(res["fv"].p["x0"], res["fv"].error("x0"), 4)
+            return param(res["fv"], "x0", 4)
         if what == "B":
-            return fmt(res["fv"].p["B"], res["fv"].error("B"))
+            return param(res["fv"], "B")
         if what == "better":
             return better(res["fp"], res["fv"]).split(" (")[0]
         if what in ("fc", "fx", "fd"):
             f_ = res.get(what)
-            k = "s" if what == "fd" else "g"
-            return fmt(f_.p[k], f_.error(k)) if f_ is not None else "not determined"
+            return param(f_, "s" if what == "fd" else "g") if f_ is not None else "not determined"
         if what == "tau_range":
             t = [p.mean(tau)[0] for p in res["pts"]]
             return f"{min(t):.3g} to {max(t):.3g} (φ {res['pts'][0].phi:g}-{res['pts'][-1].phi:g})" if t else "—"

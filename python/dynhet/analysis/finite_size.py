@@ -38,10 +38,13 @@ def spread_section(multi, multi_cr, multi_tb=None):
             src = multi_cr if cr else (multi_tb if slug == "tau_b" and multi_tb is not None else multi)
             cells, any_data = [], False
             for n in ns:
-                r, u, dof, unq = spread_ratio([d[n] for d in src.values() if n in d], fn, cr)
+                pts = [d[n] for d in src.values() if n in d]
+                r, u, dof, unq = spread_ratio(pts, fn, cr)
                 if dof:
                     any_data = True
                     cells.append(f"{r:.2f} ± {u:.2f} ({dof})")
+                elif pts and all(len(p.runs) == 1 for p in pts):
+                    cells.append("one seed: not checkable")
                 else:
                     cells.append("no error quoted" if unq else "—")
                     any_data = any_data or unq > 0
@@ -284,7 +287,7 @@ def write_finite_size(A, path, command):
          f"Each cell: the mean over seeds with its error (the runs' own errors, jackknife over origin blocks, "
          f"combined, times the study's factor below where its seeds scatter more; the seeds' spread where no run "
          f"quotes one; \"no error\" where one seed quotes none, and such a "
-         f"size takes no part in the verdict); ¹ one seed; \"(k of m seeds)\": only k of the size's m runs have a "
+         f"size takes no part in the verdict); ¹ one seed: its error is the run's own (jackknife over origin blocks, times the study's factor below where it has one for that quantity), which no spread of seeds checks at that N; \"(k of m seeds)\": only k of the size's m runs have a "
          f"value (the others not resolved or not reached), and it takes no part in the verdict either. Where several studies ran the same φ and N, the cells "
          f"take the one with the most seeds, and among as many the study that runs that φ at the most N (one "
          f"protocol, run lengths in units of τ_α^CR, across the sizes), then the one with the cage-relative "
