@@ -457,3 +457,24 @@ def test_the_spread_table_says_a_size_of_one_seed_cannot_check_its_errors():
     cells = [c.strip() for c in row.strip("|").split("|")]
     assert cells[1] == "1.00 ± 0.35 (4)"          # seeds 1 apart (std 1), errors 1: 2 points of 2 dof, ± 1/sqrt(8)
     assert cells[2] == "one seed: not checkable"
+
+
+def test_c_b_is_compared_at_the_longest_lag_whose_origin_blocks_give_every_size_an_error():
+    """8 origins 100 apart: blocks of 2 origins span lags up to 200, so C_B is
+    compared at the longest lag <= 200 (one seed at N = 262144 then has its
+    own error), not at the last common lag 400, where no run quotes one."""
+    from dynhet.analysis.size_rows import c_b_at, c_b_times
+    lag = np.geomspace(1.0, 400.0, 30)
+    d = {}
+    for n, seeds in ((4096, (1, 2)), (262144, (1,))):
+        p = Point(("neighbours", 0.9, 0.78, n))
+        for s in seeds:
+            p.runs.append({"seed": s, "N": n, "packing_fraction": 0.78, "schedule": (8, 100.0),
+                           "c_b_lag": lag, "c_b": np.exp(-lag / 1000.0), "c_b_err": np.full(30, 0.002)})
+        d[n] = p
+    ((phi, t),) = c_b_times({0.78: d})
+    assert phi == 0.78 and t == lag[lag <= 200.0][-1]
+    v, e = c_b_at(((phi, t),))(d[262144].runs[0])
+    assert abs(v - math.exp(-t / 1000.0)) < 1e-9 and abs(e - 0.002) < 1e-9
+    # a lag beyond what the blocks span: no error (the seeds' spread stands in)
+    assert math.isnan(c_b_at(((phi, 400.0),))(d[262144].runs[0])[1])
