@@ -137,3 +137,20 @@ def test_a_driving_table_parameter_whose_error_exceeds_it_is_not_determined():
     assert param_cell(f, "xc", 4) == "0.8 ± 0.001"
     f.p["g"] = float("nan")
     assert param_cell(f, "g") == "not determined"
+
+
+def test_the_header_names_what_still_drifts_at_the_n_taken():
+    """A referee's point: "largest converged N" was judged on tau_alpha alone.
+    tau_alpha^CR drifts here (250 -> 300 -> 360, errors 1) while tau_alpha is
+    converged: the note names the cage-relative one with its drift per doubling."""
+    from dynhet.analysis.output import still_drifting
+    d = {}
+    for n, t, tcr in ((1024, 27.0, 250.0), (4096, 27.5, 300.0), (16384, 27.2, 360.0)):
+        p = Point(("neighbours", 0.9, 0.79, n))
+        for seed, e in ((1, -1.0), (2, 1.0)):
+            p.runs.append({"seed": seed, "N": n, "cut": {0.6: {"tau_alpha": t + e, "tau_alpha_err": 1.0}},
+                           "cut_cr": {0.6: {"tau_alpha": tcr + e, "tau_alpha_err": 1.0}}})
+        d[n] = p
+    out = still_drifting({0.79: d}, d, d, 16384)
+    assert out == ["τ_α — cage-relative: 30 ± 0.5 per doubling of N (+10%) from N = 4096 to 16384"]
+    assert still_drifting({0.79: d}, d, d, 4096) == ["τ_α — cage-relative: 25 ± 0.5 per doubling of N (+10%) from N = 1024 to 4096"]

@@ -215,24 +215,50 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=()):
     os.replace(path + ".tmp", path)
 
 
+def still_drifting(multi, d, d_cr, n_top):
+    """The quantities of the finite-size table (standard and cage-relative)
+    whose verdict over the sizes up to n_top at one density says "drifting":
+    the rows taken at that N carry them, not only tau_alpha ("name: the drift
+    per doubling")."""
+    from .finite_size import quantity_rows
+    from .size_rows import quantities
+    out = []
+    for name, slug, fn, has_cr_version, _ in quantities(multi):
+        if slug == "tau_b":    # its points are another study's (tau_b_points); its own row says
+            continue
+        for cr in ((False, True) if has_cr_version else (False,)):
+            src = d_cr if cr else d
+            sub = {n: q for n, q in src.items() if n <= n_top}
+            if len(sub) < 2 or n_top not in sub:
+                continue
+            text = quantity_rows(sub, fn, cr, slug=slug)[2][0]
+            if text.startswith("drifting"):
+                out.append(f"{name}{' — cage-relative' if cr else ''}{text[len('drifting'):]}")
+    return out
+
+
 def largest_n_notes(A):
     """After the list of promoted points: whether each is a converged N for
     tau_alpha (size_verdict over the sizes of that density: "largest
     converged", else "largest available"), and the larger sizes held back
     because runs of them are unfinished."""
-    from .finite_size import quantity_rows   # the finite-size table's own verdict on tau_alpha
+    from .finite_size import quantity_rows   # the finite-size table's own verdicts
     from .size import points_by_phi_n
-    from .size_rows import tau_of
+    from .size_rows import has_cr, tau_of
     multi = points_by_phi_n(A)   # the main series (neighbours, eps = 0.9): the others have no sizes of their own here
+    multi_cr = {phi: {n: q for n, q in d.items() if has_cr(q)} for phi, d in points_by_phi_n(A, has_cr).items()}
     out = []
     for p in A.promoted:
-        d = multi.get(p.phi, {}) if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 else {}
+        main = p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9
+        d = multi.get(p.phi, {}) if main else {}
         ns = sorted(n for n in d if n <= p.N)
         if len(ns) < 2 or p.N not in d:
             continue
         _, _, (text, n0, _, _) = quantity_rows({n: d[n] for n in ns}, tau_of, False)
+        drifting = still_drifting(multi, d, multi_cr.get(p.phi, {}), p.N)
         out.append(f"φ = {p.phi:g}: N = {p.N} is the largest " + ("converged" if n0 is not None else "available")
-                   + f" N for τ_α ({text})")
+                   + f" N for τ_α ({text})" + (f"; at that N still drifting (finite_size.md): {'; '.join(drifting)}"
+                                              if drifting else ""))
     if out:
         out = [" Whether that N is converged: " + "; ".join(out) + "."]
     if getattr(A, "held_back", None):
