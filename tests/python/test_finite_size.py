@@ -457,6 +457,11 @@ def test_the_spread_table_says_a_size_of_one_seed_cannot_check_its_errors():
     cells = [c.strip() for c in row.strip("|").split("|")]
     assert cells[1] == "1.00 ± 0.35 (4)"          # seeds 1 apart (std 1), errors 1: 2 points of 2 dof, ± 1/sqrt(8)
     assert cells[2] == "one seed: not checkable"
+    # a one-seed size that lacks the quantity (another study's run, which did not measure it): a dash
+    for phi in (0.76, 0.78):
+        multi[phi][262144].runs[0]["cut"][0.6]["tau_alpha"] = float("nan")
+    row = next(l for l in spread_section(multi, {}) if l.startswith("| τ_α |"))
+    assert [c.strip() for c in row.strip("|").split("|")][2] == "—"
 
 
 def test_c_b_is_compared_at_the_longest_lag_whose_origin_blocks_give_every_size_an_error():

@@ -43,7 +43,8 @@ def spread_section(multi, multi_cr, multi_tb=None):
                 if dof:
                     any_data = True
                     cells.append(f"{r:.2f} ± {u:.2f} ({dof})")
-                elif pts and all(len(p.runs) == 1 for p in pts):
+                elif any(np.isfinite(v) for p in pts for _, v, _ in p.values(lambda r: fn(r, cr))) \
+                        and all(len(p.runs) == 1 for p in pts):
                     cells.append("one seed: not checkable")
                 else:
                     cells.append("no error quoted" if unq else "—")
