@@ -154,3 +154,23 @@ def test_the_header_names_what_still_drifts_at_the_n_taken():
     out = still_drifting({0.79: d}, d, d, 16384)
     assert out == ["τ_α — cage-relative: 30 ± 0.5 per doubling of N (+10%) from N = 4096 to 16384"]
     assert still_drifting({0.79: d}, d, d, 4096) == ["τ_α — cage-relative: 25 ± 0.5 per doubling of N (+10%) from N = 1024 to 4096"]
+
+
+def test_a_size_the_leading_protocol_has_not_finished_is_not_filled_from_another_study():
+    """A referee's point: at phi 0.76 the scale study's N = 65536 was still
+    running, and d_size's one-seed run (other run lengths) filled the
+    column. The study that runs phi at the most N (its unfinished sizes
+    counted) holds that size back; a size it never runs may come from another."""
+    from dynhet.analysis.size import points_by_phi_n
+    A = Analysis.__new__(Analysis)
+    A.points, A.extra, A.cpu = {}, {}, {}
+    for n in (1024, 4096, 16384):
+        p = point(0.76, n, (1, 2, 3), "scale")
+        A.extra[("scale",) + (p.pairs, p.eps, p.phi, p.N)] = p
+    for n in (65536, 1000000):
+        p = point(0.76, n, (1,), "d_size")
+        A.extra[("d_size",) + (p.pairs, p.eps, p.phi, p.N)] = p
+    A.unfinished = {("scale", "neighbours", 0.9, 0.76, 65536): 2}
+    assert sorted(points_by_phi_n(A)[0.76]) == [1024, 4096, 16384, 1000000]
+    A.unfinished = {}
+    assert sorted(points_by_phi_n(A)[0.76]) == [1024, 4096, 16384, 65536, 1000000]

@@ -22,6 +22,11 @@ def points_by_phi_n(A, has=lambda p: True):
     allp = [p for p in list(A.points.values()) + list(A.extra.values())
             if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p)
             and not unfinished_runs(A, p)]   # no conclusion from a size whose runs did not all finish
+    # nor another protocol's run in its place: a size that the study running
+    # that phi at the most N (its unfinished sizes counted) has not finished
+    # is held back at that phi, not filled from a study of other run lengths
+    waiting = protocol_waiting(A, allp)
+    allp = [p for p in allp if (p.phi, p.N) not in waiting]
     sizes = {}
     for p in allp:
         sizes.setdefault((study_of(p), p.phi), set()).add(p.N)
@@ -35,6 +40,27 @@ def points_by_phi_n(A, has=lambda p: True):
         if q is None or rank(p) > rank(q):
             by_phi[p.phi][p.N] = p
     return {phi: d for phi, d in sorted(by_phi.items()) if len(d) > 1}
+
+
+def protocol_waiting(A, allp):
+    """{(phi, N)} of the main series where the study (or studies, tied) that
+    runs phi at the most N, counting its unfinished sizes, has runs of that
+    N unfinished."""
+    planned = {}
+    for p in allp:
+        planned.setdefault(p.phi, {}).setdefault(study_of(p), set()).add(p.N)
+    main = [(st, ph, n) for (st, pairs, eps, ph, n), k in getattr(A, "unfinished", {}).items()
+            if k and pairs == "neighbours" and abs(eps - EPS_MAIN) < 1e-9]
+    for st, ph, n in main:
+        phi = next((f for f in planned if abs(f - ph) < 1e-9), ph)
+        planned.setdefault(phi, {}).setdefault(st, set()).add(n)
+    out = set()
+    for st, ph, n in main:
+        phi = next((f for f in planned if abs(f - ph) < 1e-9), ph)
+        most = max(len(v) for v in planned[phi].values())
+        if len(planned[phi][st]) == most:
+            out.add((phi, n))
+    return out
 
 
 def unfinished_runs(A, p):
