@@ -174,3 +174,18 @@ def test_a_size_the_leading_protocol_has_not_finished_is_not_filled_from_another
     assert sorted(points_by_phi_n(A)[0.76]) == [1024, 4096, 16384, 1000000]
     A.unfinished = {}
     assert sorted(points_by_phi_n(A)[0.76]) == [1024, 4096, 16384, 65536, 1000000]
+
+
+def test_the_per_point_table_says_which_study_and_which_point_the_rows_take():
+    """A referee's point: phi 0.8 at N 4096 read 256 in the per-point table
+    (quick_cr) and 327 in finite_size.md (scale), with no word of which is which."""
+    from dynhet.analysis.output import study_cell
+    A = analysis()
+    A.study_name = "quick_cr"
+    A.unfinished = {}
+    promoted = A.promote_largest_n()
+    top = next(p for p in promoted if p.phi == 0.78)
+    own = A.points[("neighbours", 0.9, 0.78, 4096)]
+    assert study_cell(A, top) == f"{top.study} (the rows take it)"
+    assert study_cell(A, own) == "quick_cr (not in the rows)"
+    assert study_cell(A, A.points[("neighbours", 0.9, 0.70, 4096)]) == "quick_cr"

@@ -195,14 +195,19 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=()):
         for lab, paper, a, b in A.driving_table:
             L.append(f"| {lab} | {paper} | {a} | {b} |")
     L += ["", "## Per point (ε, φ): the means over seeds", "",
-          "| pairs | ε | φ | N | seeds | τ_α | β | τ0 | D | χ4(τ_α) | ξ(τ_α) | d_f slow |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+          "Each point's study; where a larger N of another study stands in for this study's point (`--largest-n`), "
+          "the rows take that one and this study's point is listed for comparison only (another protocol: the two "
+          "may differ by more than their errors at the densities where τ_α depends on the run lengths).", "",
+          "| pairs | ε | φ | N | study | seeds | τ_α | β | τ0 | D | χ4(τ_α) | ξ(τ_α) | d_f slow |",
+          "|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
     for key, p in sorted(A.points.items()):
         cells = []
         for fn in (tau, lambda r: (cut(r)["beta"], cut(r)["beta_err"]), lambda r: (cut(r)["tau0"], cut(r)["tau0_err"]),
                    lambda r: (r["D"], r["D_err"]), chi4_at_tau, xi_at_tau, lambda r: (cut(r)["cl_slow_d_f"], cut(r)["cl_slow_d_f_err"])):
             m, e, _, _ = p.mean(fn)
             cells.append(fmt(m, e))
-        L.append(f"| {p.pairs} | {p.eps:g} | {p.phi:g} | {p.N} | {len(p.runs)} | " + " | ".join(cells) + " |")
+        L.append(f"| {p.pairs} | {p.eps:g} | {p.phi:g} | {p.N} | {study_cell(A, p)} | {len(p.runs)} | "
+                 + " | ".join(cells) + " |")
     if restate_from:
         L += restate(restate_from, A.rows, via)
     L.append("")
@@ -213,6 +218,18 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=()):
             with open(discussion) as d:
                 fh.write("\n" + d.read())
     os.replace(path + ".tmp", path)
+
+
+def study_cell(A, p):
+    """The per-point table's study of a point, and whether the rows take it:
+    a larger N of another study stands in for the study's own (--largest-n)."""
+    promoted = getattr(A, "promoted", None) or []
+    name = getattr(p, "study", None) or getattr(A, "study_name", "")
+    if any(p is q for q in promoted):
+        return f"{name} (the rows take it)"
+    if any(q.pairs == p.pairs and q.eps == p.eps and q.phi == p.phi for q in promoted):
+        return f"{name} (not in the rows)"
+    return name
 
 
 def still_drifting(multi, d, d_cr, n_top):
