@@ -483,3 +483,26 @@ def test_c_b_is_compared_at_the_longest_lag_whose_origin_blocks_give_every_size_
     assert abs(v - math.exp(-t / 1000.0)) < 1e-9 and abs(e - 0.002) < 1e-9
     # a lag beyond what the blocks span: no error (the seeds' spread stands in)
     assert math.isnan(c_b_at(((phi, 400.0),))(d[262144].runs[0])[1])
+
+
+def test_d_has_its_row_against_n(tmp_path):
+    """D grows with the box in two dimensions (phi 0.78: 0.0085 at N 1024,
+    0.0129 at 262144): finite_size.md judges it like every other quantity,
+    standard and cage-relative."""
+    A = Analysis.__new__(Analysis)
+    A.dir, A.figdir, A.also = str(tmp_path / "study"), str(tmp_path / "study" / "figures"), []
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    for n, dd in ((1024, 0.0085), (4096, 0.0095), (16384, 0.0107)):
+        p = Point(("neighbours", 0.9, 0.78, n))
+        for seed, e in ((1, -1e-5), (2, 1e-5)):
+            p.runs.append({"seed": seed, "N": n, "cut": {0.6: {"tau_alpha": 14.0 + e, "tau_alpha_err": 0.5}},
+                           "cut_cr": {0.6: {"tau_alpha": 85.0, "tau_alpha_err": 1.0}},
+                           "D": dd + e, "D_err": 1e-4, "D_cr": 0.002 + e, "D_cr_err": 1e-4})
+        A.points[p.pairs, p.eps, p.phi, p.N] = p
+    out = tmp_path / "finite_size.md"
+    write_finite_size(A, str(out), "analyse_study.sh study")
+    lines = out.read_text().splitlines()
+    row = next(l for l in lines if l.startswith("| D (the MSD's long-time slope / 4) |"))
+    assert "drifting: 0.0006 ± 5e-05 per doubling of N" in row
+    row = next(l for l in lines if l.startswith("| D (the MSD's long-time slope / 4) — cage-relative |"))
+    assert "converged from N = 1024 on" in row

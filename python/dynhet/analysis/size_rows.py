@@ -142,7 +142,11 @@ REST_ROWS = [("χ0 of S4 (whole box, at τ_α)", "chi0", with_cr(chi0_at_tau), T
              ("ξ of S4 (whole box, at τ_α)", "xi", lambda r, cr=False: xi_shells(r, cr)[:2], True, True),
              ("κ (slow clusters)", "kappa", with_cr(kappa_of), True, False),
              ("d_f (slow clusters)", "d_f", lambda r, cr=False: (cutx(r, cr)["cl_slow_d_f"], cutx(r, cr)["cl_slow_d_f_err"]),
-              True, False)]
+              True, False),
+             # D grows with L in two dimensions (the long-wavelength motion): the
+             # fits of D against tau_alpha over several box sizes carry it
+             ("D (the MSD's long-time slope / 4)", "diffusion", lambda r, cr=False: (r["D_cr"], r["D_cr_err"]) if cr
+              else (r["D"], r["D_err"]), True, True)]
 
 
 QUANTITIES = TAU_ROWS + CHI4P_ROWS + REST_ROWS
