@@ -189,3 +189,29 @@ def test_the_per_point_table_says_which_study_and_which_point_the_rows_take():
     assert study_cell(A, top) == f"{top.study} (the rows take it)"
     assert study_cell(A, own) == "quick_cr (not in the rows)"
     assert study_cell(A, A.points[("neighbours", 0.9, 0.70, 4096)]) == "quick_cr"
+
+
+def test_an_exponent_at_the_joint_fits_phi_c_is_not_judged_where_the_joint_fit_is_not():
+    """A referee's point: "γξ with φ_c held at the joint fit's 0.8014: differs
+    (5.6 σ)", while the table calls that joint fit "not judged" (χ² p < 1e-3)."""
+    import numpy as np
+    from dynhet import fits as sf
+    from dynhet.analysis.quantities import tau
+    from dynhet.analysis.verdicts import fixed_xc_row
+    A = Analysis.__new__(Analysis)
+    A.fits, A.rows, A.promoted, A.cpu, A.points, A.extra = {}, [], [], {}, {}, {}
+    pts = []
+    for phi in (0.70, 0.74, 0.76, 0.78, 0.79):
+        p = Point(("neighbours", 0.9, phi, 4096))
+        t = 3.0 * (0.82 - phi) ** -1.0   # an exponent 1.0 against the paper's 1.6: "differs" where judged
+        p.runs = [{"seed": s, "cut": {0.6: {"tau_alpha": t * (1 + 0.01 * (s - 2)), "tau_alpha_err": 0.01 * t}}}
+                  for s in (1, 2, 3)]
+        pts.append(p)
+    joint = sf.Fit("critical_joint", ["xc"])
+    joint.p["xc"], joint.err["xc"], joint.chi2, joint.dof, joint.n = 0.82, 0.001, 100.0, 10, 13
+    joint.xs, joint.x_range = np.array([0.78, 0.79]), (0.70, 0.79)
+    fixed_xc_row(A, "k", "γ", "3.4", "1.6", tau, pts, joint, "")
+    assert A.rows[-1]["verdict"].startswith("not judged: its φ_c is the joint fit's, which is not judged (χ²/dof 10")
+    joint.chi2 = 10.0          # a joint fit that can be judged: the exponent is judged
+    fixed_xc_row(A, "k", "γ", "3.4", "1.6", tau, pts, joint, "")
+    assert A.rows[-1]["verdict"].startswith("differs")

@@ -95,7 +95,7 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
           "3.3, fig. dist(a), dist-collapse", "≈ 1.8", fmt(kappa, kappa_e), verdict(kappa, kappa_e, 1.8), f1, dense, knote)
     fc, fc_err, cpts, cnote = kappa_collapse_rows(A, pts)
     # rho: N* = <N_c^2>/<N_c> against (phi_c - phi), phi_c from the tau_alpha power law
-    frho = Fitless = None
+    frho = None
     if np.isfinite(phi_c):
         frho = A.fit("n_star", fit_series([p for p in pts if p.phi < phi_c], n_star, sf.power, xpoint=lambda p: phi_c - p.phi))
     rho = -1 / frho.p["s"] if frho and frho.ok else math.nan

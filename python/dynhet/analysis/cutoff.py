@@ -1,4 +1,6 @@
 """Section 3.4: the cutoff a."""
+import math
+
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -65,7 +67,8 @@ def cutoff_results(A):
         cfn = lambda r, a=a: chi4_at_tau(r, a, own=True)
         x, y, e = series_arrays(pts, xfn)
         errorbar(ax[2], x, y, e, fmt=m + "-", ms=4, label=f"a = {a:g}")
-        fd = A.fit(f"chi4_xi_a{a:g}", fit_series(pts, cfn, sf.power, xrun=xfn))
+        # over xi >= XI_MIN_DF, as the main series' d_f' (the same fit range for every d_f')
+        fd = A.fit(f"chi4_xi_a{a:g}", fit_series(pts, cfn, sf.power, xrun=xfn, x_range=(XI_MIN_DF, math.inf)))
         xs, ys = [p.mean(xfn)[0] for p in pts], [p.mean(cfn)[0] for p in pts]
         ax[3].loglog(xs, ys, m, label=f"a = {a:g}: d_f' = {fd.p['s']:.3g}")
         if fd.ok:
@@ -94,7 +97,8 @@ def cutoff_results(A):
     sizes = sorted({p.N for p in A.series()})
     span = f"{sizes[0]}" + (f"-{sizes[-1]}" if sizes and sizes[-1] != sizes[0] else "") if sizes else "?"
     for a, fd in outs:
-        note = fd.note + (f"; N = {', '.join(str(n) for n in sorted({p.N for p in pts}))} ({', '.join(src)})" if pts else "")
+        note = (fd.note + ("; " if fd.note else "") + f"ξ ≥ {XI_MIN_DF:g}, as the main series"
+                + (f"; N = {', '.join(str(n) for n in sorted({p.N for p in pts}))} ({', '.join(src)})" if pts else ""))
         if abs(a - A_MAIN) < 1e-9 and main is not None and main.ok:
             note += (f"; the main series' d_f' at a = {A_MAIN:g} (ξ ≥ {XI_MIN_DF:g}, N {span}): "
                      f"{fmt(main.p['s'], main.error('s'))}, {fit_verdict(main, 's', 1.6)}")

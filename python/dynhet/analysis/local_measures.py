@@ -9,7 +9,7 @@ import numpy as np
 
 from .config import say
 from .overlap import tau_fits
-from .plotting import colours, errorbar
+from .plotting import errorbar
 from .points import measured_error, point_error, series_arrays
 from .quantities import PER_RUN, tau
 from .size import points_by_phi_n, size_verdict

@@ -2,7 +2,6 @@
 import math
 
 import numpy as np
-from scipy.optimize import least_squares
 
 from .. import fits as sf
 from .config import A_MAIN

@@ -54,8 +54,13 @@ def fixed_xc_row(A, key, item, sec, paper, fn, pts, joint, fig):
     fx = A.fit(key, fit_series(pts, fn, sf.critical_fixed, xc=xc))
     num = paper.lstrip("≈ ")
     judged = num[:1].isdigit()
+    v = fit_verdict(fx, "g", float(num)) if judged else "—"
+    # an exponent at a phi_c that the table itself does not trust is no judgement either
+    why = sf.cannot_judge(joint, "xc") if judged and joint is not None and joint.ok else None
+    if why and not v.startswith(("not judged", "not determined")):
+        v = f"not judged: its φ_c is the joint fit's, which is not judged ({why})"
     A.row(item + (f" (φ_c held at the joint fit's {xc:.4f})" if np.isfinite(xc) else " (φ_c of the joint fit: none)"),
-          sec, paper, fmt(fx.p["g"], fx.error("g")), fit_verdict(fx, "g", float(num)) if judged else "—", fig, pts, fx.note)
+          sec, paper, fmt(fx.p["g"], fx.error("g")), v, fig, pts, fx.note)
     return fx
 
 
