@@ -403,3 +403,17 @@ def interp_ln_t(t, y, at):
         return lin, math.nan
     c = np.polyfit(lt[idx], y[idx], 2)
     return lin, float(abs(np.polyval(c, la) - lin))
+
+
+def slope_with_error(x, y):
+    """(slope, its standard error from the residuals, points) of a straight
+    line through (x, y), x = t0 / tau_alpha; NaN error with fewer than 4
+    points (2 dof) or where neighbouring origins lie less than one tau_alpha
+    apart (their tau_alpha(t0) are correlated: the residuals would understate it)."""
+    n = len(x)
+    b, a = np.polyfit(x, y, 1)
+    if n < 4 or np.min(np.diff(np.sort(x))) < 1.0:
+        return float(b), math.nan, n
+    sxx = float(((x - x.mean()) ** 2).sum())
+    ssr = float(((y - (a + b * x)) ** 2).sum())
+    return float(b), math.sqrt(ssr / (n - 2) / sxx) if sxx > 0 else math.nan, n

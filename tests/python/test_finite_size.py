@@ -506,3 +506,54 @@ def test_d_has_its_row_against_n(tmp_path):
     assert "drifting: 0.0006 ± 5e-05 per doubling of N" in row
     row = next(l for l in lines if l.startswith("| D (the MSD's long-time slope / 4) — cage-relative |"))
     assert "converged from N = 1024 on" in row
+
+
+def test_the_change_of_tau_alpha_over_the_production_is_measured_per_run():
+    """A steady state has tau_alpha(t0) flat: at phi 0.78, N 262144, it fell
+    from 14.0 to 13.3 over 8 origins while the cage-relative one held. A line
+    falling 5% from the first origin to the last reads -5%; a flat one 0 within
+    its error; its error is the slope's (the origins' scatter about the line)."""
+    from dynhet.analysis.size_rows import production_change
+    t0 = 923.5 + 92.35 * np.arange(8)
+    tm = 13.6
+    fall = 1.0 - 0.05 * (t0 - t0[0]) / (t0[-1] - t0[0])
+    noise = np.array([1, -1, 1, -1, -1, 1, -1, 1]) * 0.002
+    r = {"cut": {0.6: {"t0": t0, "tau_t0": tm * (fall + noise), "tau_alpha": tm}},
+         "cut_cr": {0.6: {"t0": t0, "tau_t0": 85.0 * (1.0 + noise), "tau_alpha": 85.0}}}
+    v, e = production_change(r)
+    assert abs(v + 5.0) < 3 * e and 0 < e < 1.0
+    v, e = production_change(r, cr=True)
+    assert abs(v) < 3 * e
+    # origins closer than tau_alpha^CR apart in units of the cage-relative tau_alpha: no error claimed
+    r["cut_cr"][0.6]["tau_alpha"] = 200.0
+    assert math.isnan(production_change(r, cr=True)[1])
+
+
+def test_a_size_whose_tau_alpha_moves_over_its_production_is_not_steady(tmp_path):
+    """The change of tau_alpha(t0) is judged against 0 at each N (not for
+    convergence in N), and the reproduction's header names a largest N that
+    is not steady."""
+    from dynhet.analysis.output import still_drifting
+    t0 = 923.5 + 92.35 * np.arange(8)
+    alt = np.array([1, -1, 1, -1, -1, 1, -1, 1]) * 0.004
+    d = {}
+    for n, fall in ((4096, 0.0), (16384, 0.0), (262144, 0.05)):
+        p = Point(("neighbours", 0.9, 0.78, n))
+        for seed in (1, 2):
+            line = 1.0 - fall * (t0 - t0[0]) / (t0[-1] - t0[0])
+            p.runs.append({"seed": seed, "N": n,
+                           "cut": {0.6: {"t0": t0, "tau_t0": 13.6 * (line + seed * alt), "tau_alpha": 13.6,
+                                         "tau_alpha_err": 0.1}}})
+        d[n] = p
+    A = Analysis.__new__(Analysis)
+    A.dir, A.figdir, A.also = str(tmp_path / "study"), str(tmp_path / "study" / "figures"), []
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    for p in d.values():
+        A.points[p.pairs, p.eps, p.phi, p.N] = p
+    out = tmp_path / "finite_size.md"
+    write_finite_size(A, str(out), "analyse_study.sh study")
+    row = next(l for l in out.read_text().splitlines() if l.startswith("| τ_α(t0): change over the production"))
+    assert "| not steady at N = 262144 (-5" in row and "0 within 3 errors at N = 4096, 16384 |" in row
+    notes = still_drifting({0.78: d}, d, {}, 262144)
+    assert len(notes) == 1 and notes[0].startswith("τ_α(t0) not steady over the production at N = 262144 (-5")
+    assert still_drifting({0.78: d}, d, {}, 16384) == []

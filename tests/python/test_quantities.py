@@ -51,7 +51,7 @@ def test_one_seeds_ageing_slope_error_matches_the_spread_of_independent_runs():
     """tau_alpha(t0) of one run: its slope's error from the scatter about the
     line is what 2000 independent realisations of the same line scatter by;
     none where origins lie closer than tau_alpha (correlated) or too few."""
-    from dynhet.analysis.overlap import slope_with_error
+    from dynhet.fits import slope_with_error
     rng = np.random.default_rng(7)
     x = 68.0 + 6.8 * np.arange(8)                 # 8 origins 6.8 tau_alpha apart (the scale study at phi 0.78)
     fits = [slope_with_error(x, 1.0 - 0.001 * x + rng.normal(0, 0.01, 8)) for _ in range(2000)]

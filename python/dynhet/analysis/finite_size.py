@@ -89,12 +89,35 @@ def quantity_rows(d, fn, cr, ns=None, slug=None):
           else nan for n in ns]
     whole = [n in d and m[3] == len(d[n].runs) for n, m in zip(ns, ms)]   # every seed has it (cell)
     verdict = size_verdict(ns, [m[0] for m in ms], [measured_error(m) if w else math.nan for m, w in zip(ms, whole)])
+    if slug == "tau_t0_change":   # a steady state is 0 at each N, not an N-independent value
+        return ns, ms, (steady_verdict(ns, ms, whole), None, math.nan, math.nan)
     shown = sum(np.isfinite(m[0]) for m in ms)
     judged = sum(np.isfinite(m[0]) and w and np.isfinite(measured_error(m)) for m, w in zip(ms, whole))
     if verdict[1] is None and judged < 2 and shown > judged:   # the cells show sizes the verdict cannot take
         verdict = (f"no verdict: {judged} of the {shown} size{'s' if shown > 1 else ''} shown "
                    f"{'has' if judged == 1 else 'have'} every seed's value with an error", None, math.nan, math.nan)
     return ns, ms, verdict
+
+
+Z_STEADY = 3.0   # a size is "not steady" beyond 3 errors: some 30 cells judged at 2 would flag one or two by chance
+
+
+def steady_verdict(ns, ms, whole):
+    """tau_alpha(t0)'s change over the production against 0 at each size
+    (every seed's value with an error): the sizes where it lies more than
+    Z_STEADY errors from 0 are "not steady"."""
+    off, ok = [], []
+    for n, m, w in zip(ns, ms, whole):
+        e = measured_error(m)
+        if not (w and np.isfinite(m[0]) and np.isfinite(e)):
+            continue
+        (off if abs(m[0]) > Z_STEADY * e else ok).append((n, m[0], e))
+    if not off and not ok:
+        return "no verdict: no size with every seed's value and an error"
+    if not off:
+        return f"steady: 0 within {Z_STEADY:g} errors at every N"
+    return ("not steady at " + ", ".join(f"N = {n} ({fmt(v, e)} %)" for n, v, e in off)
+            + (f"; 0 within {Z_STEADY:g} errors at N = " + ", ".join(str(n) for n, _, _ in ok) if ok else ""))
 
 
 def bound_conflict(ns, ms, bounds):

@@ -249,6 +249,12 @@ def still_drifting(multi, d, d_cr, n_top):
             if len(sub) < 2 or n_top not in sub:
                 continue
             text = quantity_rows(sub, fn, cr, slug=slug)[2][0]
+            if slug == "tau_t0_change":   # not a drift in N: whether the run at that N was steady
+                top = next((x for x in text.split("; ")[0].split(", ") if f"N = {n_top} (" in x), None)
+                if text.startswith("not steady") and top:
+                    out.append(f"{name.split(':')[0]}{' — cage-relative' if cr else ''} not steady over the "
+                               f"production at {top.replace('not steady at ', '')}")
+                continue
             if text.startswith("drifting"):
                 out.append(f"{name}{' — cage-relative' if cr else ''}{text[len('drifting'):]}")
     return out
@@ -274,7 +280,7 @@ def largest_n_notes(A):
         _, _, (text, n0, _, _) = quantity_rows({n: d[n] for n in ns}, tau_of, False)
         drifting = still_drifting(multi, d, multi_cr.get(p.phi, {}), p.N)
         out.append(f"φ = {p.phi:g}: N = {p.N} is the largest " + ("converged" if n0 is not None else "available")
-                   + f" N for τ_α ({text})" + (f"; at that N still drifting (finite_size.md): {'; '.join(drifting)}"
+                   + f" N for τ_α ({text})" + (f"; at that N still drifting, or not steady (finite_size.md): {'; '.join(drifting)}"
                                               if drifting else ""))
     if out:
         out = [" Whether that N is converged: " + "; ".join(out) + "."]

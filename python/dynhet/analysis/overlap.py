@@ -152,12 +152,12 @@ def ageing_results(A):
             ax.plot(t0[m], tt[m], "o-", ms=3, label=f"φ = {p.phi:g}, seed {r['seed']}")
             if m.sum() >= 3:
                 tm = c["tau_alpha"]
-                fits.append(slope_with_error(t0[m] / tm, tt[m] / tm))
+                fits.append(sf.slope_with_error(t0[m] / tm, tt[m] / tm))
         s, se, n = sf.seed_mean([f[0] for f in fits])
         note = f"jackknife over {n} seeds" if n > 1 else ""
         if n == 1 and np.isfinite(fits[0][1]):
             # one seed: the error from its origins' scatter about the line
-            # (slope_with_error takes it only where the origins lie at least
+            # (sf.slope_with_error takes it only where the origins lie at least
             # tau_alpha apart, so their tau_alpha(t0) are independent)
             s, se = fits[0][0], fits[0][1]
             note = f"one seed: error from its {fits[0][2]} origins' scatter about the line"
@@ -171,16 +171,3 @@ def ageing_results(A):
         A.row(f"τ_α(t0) at φ = {p.phi:g}: slope d(τ_α/τ̄_α)/d(t0/τ̄_α)", "3.1, inset of fig. Q-t-t0", "0 (no ageing)",
               fmt(s, se, 2), verdict(s, se, 0.0), f, [p], note)
 
-
-def slope_with_error(x, y):
-    """(slope, its standard error from the residuals, points) of a straight
-    line through (x, y), x = t0 / tau_alpha; NaN error with fewer than 4
-    points (2 dof) or where neighbouring origins lie less than one tau_alpha
-    apart (their tau_alpha(t0) are correlated: the residuals would understate it)."""
-    n = len(x)
-    b, a = np.polyfit(x, y, 1)
-    if n < 4 or np.min(np.diff(np.sort(x))) < 1.0:
-        return float(b), math.nan, n
-    sxx = float(((x - x.mean()) ** 2).sum())
-    ssr = float(((y - (a + b * x)) ** 2).sum())
-    return float(b), math.sqrt(ssr / (n - 2) / sxx) if sxx > 0 else math.nan, n

@@ -9,7 +9,7 @@ import numpy as np
 from .config import A_MAIN, EPS_MAIN
 from .quantities import MIN_SHELLS, PER_RUN, XI_MIN, chi0_at_tau, kappa_of, shells_below, whole_box_s4
 from .runs import blocks_span
-from ..fits import interp_ln_t
+from ..fits import interp_ln_t, slope_with_error
 
 # chi4^P (the peak of chi4(t)) per sub-box size: a run's grid counts for a
 # size when its <N_r> is within a factor 1.6 of it and is not the whole box.
@@ -89,6 +89,23 @@ def tau_of(r, cr=False):
     return c["tau_alpha"], c["tau_alpha_err"]
 
 
+def production_change(r, cr=False):
+    """How far tau_alpha(t0) moves over the run's production, in per cent of
+    tau_alpha: the line through tau_alpha(t0)/tau_alpha against t0/tau_alpha
+    (fits.slope_with_error, the origins' scatter about it) from the first
+    origin to the last; 0 within its error in a steady state. Where the
+    box-scale flows still build up (they relax as L^2, not as tau_alpha^CR)
+    the standard tau_alpha falls with t0 and the cage-relative does not."""
+    c = cutx(r, cr)
+    t0, tt, tm = np.asarray(c["t0"], float), np.asarray(c["tau_t0"], float), float(c["tau_alpha"])
+    m = np.isfinite(tt)
+    if m.sum() < 3 or not tm > 0:
+        return math.nan, math.nan
+    b, e, _ = slope_with_error(t0[m] / tm, tt[m] / tm)
+    span = (t0[m].max() - t0[m].min()) / tm
+    return 100.0 * b * span, 100.0 * e * span
+
+
 def tau_b_of(r, cr=False):
     return PER_RUN["tau_b"](r)
 
@@ -143,6 +160,8 @@ REST_ROWS = [("χ0 of S4 (whole box, at τ_α)", "chi0", with_cr(chi0_at_tau), T
              ("κ (slow clusters)", "kappa", with_cr(kappa_of), True, False),
              ("d_f (slow clusters)", "d_f", lambda r, cr=False: (cutx(r, cr)["cl_slow_d_f"], cutx(r, cr)["cl_slow_d_f_err"]),
               True, False),
+             ("τ_α(t0): change over the production, % (0 when steady)", "tau_t0_change", production_change, True,
+              False),
              # D grows with L in two dimensions (the long-wavelength motion): the
              # fits of D against tau_alpha over several box sizes carry it
              ("D (the MSD's long-time slope / 4)", "diffusion", lambda r, cr=False: (r["D_cr"], r["D_cr_err"]) if cr
