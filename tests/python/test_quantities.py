@@ -61,3 +61,20 @@ def test_one_seeds_ageing_slope_error_matches_the_spread_of_independent_runs():
     assert abs(np.sqrt((e ** 2).mean()) / b.std() - 1) < 0.06     # 2000 draws: the ratio to within ~3%
     assert math.isnan(slope_with_error(x[:3], x[:3])[1])
     assert math.isnan(slope_with_error(np.arange(8) * 0.5, np.ones(8))[1])
+
+
+def test_the_cutoff_studys_d_f_prime_fits_over_the_same_xi_range_as_every_other():
+    """Row 14 of the earlier table (d_f' at a = 0.6 from the cutoff study,
+    0.64 'differs') was a fit over every xi; the main series fits over xi >= 3.
+    Points with chi4 = xi^1.6 above xi = 3 and a flatter branch below it: the
+    fit over xi >= 3 finds 1.6, one over every xi would not."""
+    from dynhet.analysis.cutoff import df_fit
+    from dynhet.analysis.points import Point
+    pts = []
+    for k, xi in enumerate((1.0, 1.5, 2.0, 3.5, 5.0, 7.0, 10.0)):
+        p = Point(("neighbours", 0.9, 0.70 + 0.01 * k, 4096))
+        chi4 = xi ** 1.6 if xi >= 3 else 3.0 ** 1.6 * (xi / 3.0) ** 0.3
+        p.runs = [{"seed": s, "xi": xi * (1 + 0.001 * (s - 2)), "chi4": chi4 * (1 + 0.002 * (s - 2))} for s in (1, 2, 3)]
+        pts.append(p)
+    f = df_fit(pts, lambda r: (r["chi4"], 0.02 * r["chi4"]), lambda r: (r["xi"], 0.01 * r["xi"]))
+    assert f.ok and f.n == 4 and abs(f.p["s"] - 1.6) < 0.02

@@ -12,6 +12,12 @@ from .verdicts import fit_verdict, fmt
 from .plotting import colours, errorbar
 
 
+def df_fit(pts, cfn, xfn):
+    """d_f' of one cutoff: chi4 against xi over xi >= XI_MIN_DF, the range of
+    every d_f' of the analysis (the main series', the driving rules')."""
+    return fit_series(pts, cfn, sf.power, xrun=xfn, x_range=(XI_MIN_DF, math.inf))
+
+
 def cutoff_results(A):
     """The cutoff a. Each a is taken at its own tau_alpha(a) where the run's
     lags reach it (solid), and all at tau_alpha of a = 0.6 (dashed); the
@@ -67,8 +73,7 @@ def cutoff_results(A):
         cfn = lambda r, a=a: chi4_at_tau(r, a, own=True)
         x, y, e = series_arrays(pts, xfn)
         errorbar(ax[2], x, y, e, fmt=m + "-", ms=4, label=f"a = {a:g}")
-        # over xi >= XI_MIN_DF, as the main series' d_f' (the same fit range for every d_f')
-        fd = A.fit(f"chi4_xi_a{a:g}", fit_series(pts, cfn, sf.power, xrun=xfn, x_range=(XI_MIN_DF, math.inf)))
+        fd = A.fit(f"chi4_xi_a{a:g}", df_fit(pts, cfn, xfn))
         xs, ys = [p.mean(xfn)[0] for p in pts], [p.mean(cfn)[0] for p in pts]
         ax[3].loglog(xs, ys, m, label=f"a = {a:g}: d_f' = {fd.p['s']:.3g}")
         if fd.ok:
