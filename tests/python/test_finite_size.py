@@ -557,3 +557,8 @@ def test_a_size_whose_tau_alpha_moves_over_its_production_is_not_steady(tmp_path
     notes = still_drifting({0.78: d}, d, {}, 262144)
     assert len(notes) == 1 and notes[0].startswith("τ_α(t0) not steady over the production at N = 262144 (-5")
     assert still_drifting({0.78: d}, d, {}, 16384) == []
+    # a size whose error cannot be given (origins closer than tau_alpha) is named, not counted as steady
+    from dynhet.analysis.finite_size import steady_verdict
+    nan = float("nan")
+    text = steady_verdict([4096, 262144], [(0.5, 1.0, 1.0, 2), (1.0, nan, nan, 1)], [True, True])
+    assert text == "steady: 0 within 3 errors at N = 4096; not judged (no error) at N = 262144"

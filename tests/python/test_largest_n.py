@@ -215,3 +215,22 @@ def test_an_exponent_at_the_joint_fits_phi_c_is_not_judged_where_the_joint_fit_i
     joint.chi2 = 10.0          # a joint fit that can be judged: the exponent is judged
     fixed_xc_row(A, "k", "γ", "3.4", "1.6", tau, pts, joint, "")
     assert A.rows[-1]["verdict"].startswith("differs")
+    joint.note = "xc at the scan's end"   # a joint fit whose phi_c row reads "not determined"
+    fixed_xc_row(A, "k", "γ", "3.4", "1.6", tau, pts, joint, "")
+    assert A.rows[-1]["verdict"] == ("not judged: its φ_c is the joint fit's, which is not determined "
+                                     "(no divergence resolved)")
+
+
+def test_a_drift_that_ends_below_the_n_taken_is_not_said_of_that_n():
+    """D drifts from 1024 to 16384 but has no value at 262144: the header
+    must not say "at N = 262144 still drifting" of it."""
+    from dynhet.analysis.output import still_drifting
+    d = {}
+    for n, dd in ((1024, 0.0085), (4096, 0.0095), (16384, 0.0107), (262144, float("nan"))):
+        p = Point(("neighbours", 0.9, 0.78, n))
+        for seed, e in ((1, -1e-5), (2, 1e-5)):
+            p.runs.append({"seed": seed, "N": n, "cut": {0.6: {"tau_alpha": 14.0, "tau_alpha_err": 0.5}},
+                           "D": dd + e, "D_err": 1e-4})
+        d[n] = p
+    assert still_drifting({0.78: d}, d, {}, 262144) == []
+    assert [x.split(":")[0] for x in still_drifting({0.78: d}, d, {}, 16384)] == ["D (the MSD's long-time slope / 4)"]

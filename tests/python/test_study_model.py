@@ -232,3 +232,15 @@ def test_a_resumed_run_keeps_the_cpu_of_earlier_attempts_and_counts_a_killed_one
     assert carried_cpu({"state": "running", "cpu_s": 10.0, "cpu_unrecorded": 1}, "cut") == (10.0, 2)
     # starting over: the result costs only what the new attempt costs
     assert carried_cpu({"state": "failed", "cpu_s": 99.0}, None) == (0.0, 0)
+
+
+def test_a_run_queued_again_on_slurm_goes_by_what_it_was_before():
+    """A Slurm submission writes "queued" over the status and keeps the state
+    before in previous_state: a run killed while running counts its lost
+    attempt, a failed one is started over (do_run goes by effective_state)."""
+    from dynhet.study.runner import carried_cpu, effective_state
+    assert effective_state({"state": "queued", "previous_state": "running"}) == "running"
+    assert effective_state({"state": "queued", "previous_state": "failed"}) == "failed"
+    assert effective_state({"state": "queued"}) == "queued"          # never started
+    assert effective_state({"state": "interrupted", "previous_state": "failed"}) == "interrupted"
+    assert carried_cpu({"state": "queued", "previous_state": "running", "cpu_s": 7.0}, "cut") == (7.0, 1)

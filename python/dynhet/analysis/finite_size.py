@@ -106,18 +106,23 @@ def steady_verdict(ns, ms, whole):
     """tau_alpha(t0)'s change over the production against 0 at each size
     (every seed's value with an error): the sizes where it lies more than
     Z_STEADY errors from 0 are "not steady"."""
-    off, ok = [], []
+    off, ok, unjudged = [], [], []
     for n, m, w in zip(ns, ms, whole):
         e = measured_error(m)
-        if not (w and np.isfinite(m[0]) and np.isfinite(e)):
+        if not np.isfinite(m[0]):
+            continue
+        if not (w and np.isfinite(e)):
+            unjudged.append(n)
             continue
         (off if abs(m[0]) > Z_STEADY * e else ok).append((n, m[0], e))
+    tail = f"; not judged (no error) at N = {', '.join(str(n) for n in unjudged)}" if unjudged else ""
     if not off and not ok:
         return "no verdict: no size with every seed's value and an error"
     if not off:
-        return f"steady: 0 within {Z_STEADY:g} errors at every N"
+        return (f"steady: 0 within {Z_STEADY:g} errors at "
+                + ("every N" if not unjudged else "N = " + ", ".join(str(n) for n, _, _ in ok)) + tail)
     return ("not steady at " + ", ".join(f"N = {n} ({fmt(v, e)} %)" for n, v, e in off)
-            + (f"; 0 within {Z_STEADY:g} errors at N = " + ", ".join(str(n) for n, _, _ in ok) if ok else ""))
+            + (f"; 0 within {Z_STEADY:g} errors at N = " + ", ".join(str(n) for n, _, _ in ok) if ok else "") + tail)
 
 
 def bound_conflict(ns, ms, bounds):

@@ -147,8 +147,10 @@ def cpu_caveat(A):
     k, r = getattr(A, "cpu_unrecorded", 0), getattr(A, "cpu_resumed", 0)
     if not (k or r):
         return ""
-    return (f" (at least: {r} of the runs were resumed after interruptions, and an attempt killed before it "
-            f"recorded its CPU is not counted" + (f": {k} such attempts recorded as lost" if k else "") + ")")
+    return (f" ({r} of the runs ran in more than one attempt: a resumed run's figure sums its attempts, but an "
+            f"attempt killed before it recorded its CPU is not counted" + (f" ({k} such attempts recorded as lost)"
+                                                                           if k else "")
+            + ", and a run started over counts its last start only)")
 
 
 def write_table(A, path, command, discussion=None, restate_from=None, via=()):
@@ -255,7 +257,7 @@ def still_drifting(multi, d, d_cr, n_top):
                     out.append(f"{name.split(':')[0]}{' — cage-relative' if cr else ''} not steady over the "
                                f"production at {top.replace('not steady at ', '')}")
                 continue
-            if text.startswith("drifting"):
+            if text.startswith("drifting") and text.endswith(f"to {n_top}"):   # a drift up to that N, not below it
                 out.append(f"{name}{' — cage-relative' if cr else ''}{text[len('drifting'):]}")
     return out
 

@@ -56,9 +56,11 @@ def fixed_xc_row(A, key, item, sec, paper, fn, pts, joint, fig):
     judged = num[:1].isdigit()
     v = fit_verdict(fx, "g", float(num)) if judged else "—"
     # an exponent at a phi_c that the table itself does not trust is no judgement either
-    why = sf.cannot_judge(joint, "xc") if judged and joint is not None and joint.ok else None
-    if why and not v.startswith(("not judged", "not determined")):
-        v = f"not judged: its φ_c is the joint fit's, which is not judged ({why})"
+    # (the joint fit's own verdict on phi_c, as its row gives it: not judged, or not determined)
+    jv = fit_verdict(joint, "xc", 0.82) if judged and joint is not None and joint.ok else ""
+    if jv.startswith("not") and not v.startswith(("not judged", "not determined")):
+        kind, _, why = jv.partition(": ")
+        v = f"not judged: its φ_c is the joint fit's, which is {kind}" + (f" ({why})" if why else "")
     A.row(item + (f" (φ_c held at the joint fit's {xc:.4f})" if np.isfinite(xc) else " (φ_c of the joint fit: none)"),
           sec, paper, fmt(fx.p["g"], fx.error("g")), v, fig, pts, fx.note)
     return fx

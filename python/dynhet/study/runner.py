@@ -12,6 +12,15 @@ from .progress import sim_progress
 from .states import equilibrated_state, pid_alive, pilot, prepared_state
 
 
+def effective_state(old):
+    """A run's state as do_run goes by it: a Slurm submission writes "queued"
+    over what the run was and keeps that in previous_state, so that a run
+    that failed is started over and a run killed while running is resumed
+    (and its lost CPU counted), as on the local executor."""
+    s = old.get("state")
+    return old.get("previous_state", s) if s == "queued" else s
+
+
 def carried_cpu(old, resume):
     """(CPU seconds, attempts whose CPU was lost) that a new attempt carries
     from its run's previous status: a resumed run's earlier attempts; an
@@ -20,7 +29,7 @@ def carried_cpu(old, resume):
     that starts over carries nothing."""
     if resume is None:
         return 0.0, 0
-    return float(old.get("cpu_s", 0.0)), int(old.get("cpu_unrecorded", 0)) + int(old.get("state") == "running")
+    return float(old.get("cpu_s", 0.0)), int(old.get("cpu_unrecorded", 0)) + int(effective_state(old) == "running")
 
 
 def running_status(old, resume, source):
@@ -47,7 +56,8 @@ def do_run(sd, p, log=print):
     tau_est, source = old.get("tau_estimate"), old.get("tau_source")
     if old.get("state") == "running" and old.get("host") == socket.gethostname() and pid_alive(old.get("pid")):
         return dict(old, state="running", message=f"still running in process {old.get('pid')}")
-    if old.get("state") in ("running", "queued", "interrupted"):
+    state = effective_state(old)
+    if state in ("running", "queued", "interrupted"):
         ck = os.path.join(d, "checkpoint_before_frames.h5")
         cut = newest_whole_cut(d)
         if cut is not None and os.path.exists(os.path.join(d, "scene.toml")):
@@ -59,14 +69,14 @@ def do_run(sd, p, log=print):
         elif os.path.exists(ck) and os.path.exists(os.path.join(d, "scene.toml")):
             resume = ck
             log(f"{st.run_name(p)}: was interrupted; resuming from {ck}")
-        elif old.get("state") != "queued" or old.get("started"):
+        elif state != "queued" or old.get("started"):
             log(f"{st.run_name(p)}: was interrupted before its first checkpoint; starting again")
-    elif old.get("state") in ("failed", "too_short", "unknown"):
-        log(f"{st.run_name(p)}: {old.get('state')} before ({old.get('message', '')}); running it again")
+    elif state in ("failed", "too_short", "unknown"):
+        log(f"{st.run_name(p)}: {state} before ({old.get('message', '')}); running it again")
     if resume is None:
         if rl["tau_alpha"] == "scene":
             tau_est, source = None, "scene"
-        elif old.get("state") == "too_short" and old.get("tau_alpha"):
+        elif state == "too_short" and old.get("tau_alpha"):
             tau_est, source = 1.3 * old["tau_alpha"], "1.3 x the tau_alpha of the previous, too short attempt"
         elif rl["tau_alpha"] == "interpolate" and len(sd.finished_taus(p)) >= 2:
             tau_est, source = sd.guess(p)
@@ -113,7 +123,7 @@ def do_run(sd, p, log=print):
     # A run that failed (or was too short) starts over: resuming it from its
     # last cut would repeat what failed (a recorder part that lost frames
     # can never make the run complete).
-    again = old.get("state") in ("failed", "too_short", "unknown")
+    again = state in ("failed", "too_short", "unknown")
     rc, wall, cpu = run_scene(scene_path, d, os.path.join(d, "run_scene.log"), None if resume == "cut" else resume,
                               fresh=again and resume is None)
     # A process of the run died (exit 75: resumable): again from the last

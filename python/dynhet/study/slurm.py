@@ -90,6 +90,8 @@ def run_slurm(sd, a):
         d = sd.run_dir(p)
         os.makedirs(d, exist_ok=True)
         st = read_status(d)
+        if st.get("state") not in (None, "queued"):
+            st["previous_state"] = st["state"]   # what the run was: do_run goes by it (runner.effective_state)
         st.update({"state": "queued", "job": job})
         for k in AXES:
             st[k] = p[k]
