@@ -102,19 +102,29 @@ def quantity_rows(d, fn, cr, ns=None, slug=None):
 Z_STEADY = 3.0   # a size is "not steady" beyond 3 errors: some 30 cells judged at 2 would flag one or two by chance
 
 
+def steady_off(m, whole):
+    """Whether a size's change over the production (m, Point.mean's) lies
+    more than Z_STEADY errors from 0; None where it cannot be judged (no
+    value, no error, or not every seed has one)."""
+    e = measured_error(m)
+    if not (whole and np.isfinite(m[0]) and np.isfinite(e)):
+        return None
+    return abs(m[0]) > Z_STEADY * e
+
+
 def steady_verdict(ns, ms, whole):
     """tau_alpha(t0)'s change over the production against 0 at each size
     (every seed's value with an error): the sizes where it lies more than
     Z_STEADY errors from 0 are "not steady"."""
     off, ok, unjudged = [], [], []
     for n, m, w in zip(ns, ms, whole):
-        e = measured_error(m)
         if not np.isfinite(m[0]):
             continue
-        if not (w and np.isfinite(e)):
+        away = steady_off(m, w)
+        if away is None:
             unjudged.append(n)
             continue
-        (off if abs(m[0]) > Z_STEADY * e else ok).append((n, m[0], e))
+        (off if away else ok).append((n, m[0], measured_error(m)))
     tail = f"; not judged (no error) at N = {', '.join(str(n) for n in unjudged)}" if unjudged else ""
     if not off and not ok:
         return "no verdict: no size with every seed's value and an error"

@@ -239,7 +239,8 @@ def still_drifting(multi, d, d_cr, n_top):
     whose verdict over the sizes up to n_top at one density says "drifting":
     the rows taken at that N carry them, not only tau_alpha ("name: the drift
     per doubling")."""
-    from .finite_size import quantity_rows
+    from .finite_size import quantity_rows, steady_off
+    from .points import measured_error
     from .size_rows import quantities
     out = []
     for name, slug, fn, has_cr_version, _ in quantities(multi):
@@ -250,12 +251,12 @@ def still_drifting(multi, d, d_cr, n_top):
             sub = {n: q for n, q in src.items() if n <= n_top}
             if len(sub) < 2 or n_top not in sub:
                 continue
-            text = quantity_rows(sub, fn, cr, slug=slug)[2][0]
+            ns, ms, (text, *_) = quantity_rows(sub, fn, cr, slug=slug)
             if slug == "tau_t0_change":   # not a drift in N: whether the run at that N was steady
-                top = next((x for x in text.split("; ")[0].split(", ") if f"N = {n_top} (" in x), None)
-                if text.startswith("not steady") and top:
+                m = ms[ns.index(n_top)]
+                if steady_off(m, m[3] == len(sub[n_top].runs)):
                     out.append(f"{name.split(':')[0]}{' — cage-relative' if cr else ''} not steady over the "
-                               f"production at {top.replace('not steady at ', '')}")
+                               f"production at N = {n_top} ({fmt(m[0], measured_error(m))} %)")
                 continue
             if text.startswith("drifting") and text.endswith(f"to {n_top}"):   # a drift up to that N, not below it
                 out.append(f"{name}{' — cage-relative' if cr else ''}{text[len('drifting'):]}")
