@@ -562,3 +562,24 @@ def test_a_size_whose_tau_alpha_moves_over_its_production_is_not_steady(tmp_path
     nan = float("nan")
     text = steady_verdict([4096, 262144], [(0.5, 1.0, 1.0, 2), (1.0, nan, nan, 1)], [True, True])
     assert text == "steady: 0 within 3 errors at N = 4096; not judged (no error) at N = 262144"
+
+
+def test_the_tau_b_row_takes_no_size_whose_runs_did_not_all_finish():
+    """tau_b_points chose its points over every study without the rule of
+    the other rows: the scale study's N = 65536 at phi 0.79, one seed of two
+    finished, appeared in the tau_B row while the size was held back."""
+    from dynhet.analysis.size import points_by_phi_n
+    from dynhet.analysis.size_rows import tau_b_points
+    A = Analysis.__new__(Analysis)
+    A.points, A.extra = {}, {}
+    lag = np.geomspace(1.0, 400.0, 20)
+    for n in (4096, 16384, 65536):
+        p = Point(("neighbours", 0.9, 0.79, n))
+        p.study = "scale"
+        p.runs = [{"seed": 1, "N": n, "cut": {0.6: {"tau_alpha": 30.0, "tau_alpha_err": 1.0}},
+                   "c_b_lag": lag, "c_b": np.exp(-lag / 100.0)}]
+        A.extra[("scale",) + (p.pairs, p.eps, p.phi, p.N)] = p
+    A.unfinished = {("scale", "neighbours", 0.9, 0.79, 65536): 1}
+    multi = points_by_phi_n(A)
+    assert sorted(multi[0.79]) == [4096, 16384]
+    assert sorted(tau_b_points(A, multi)[0.79]) == [4096, 16384]

@@ -19,14 +19,9 @@ def points_by_phi_n(A, has=lambda p: True):
     most N: one protocol (run lengths in units of tau_alpha^CR) across the
     sizes, not a single-N study's; then the one with the cage-relative
     measures (that protocol's); only densities run at more than one N."""
+    held = held_sizes(A, has)
     allp = [p for p in list(A.points.values()) + list(A.extra.values())
-            if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p)
-            and not unfinished_runs(A, p)]   # no conclusion from a size whose runs did not all finish
-    # nor another protocol's run in its place: a size that the study running
-    # that phi at the most N (its unfinished sizes counted) has not finished
-    # is held back at that phi, not filled from a study of other run lengths
-    waiting = protocol_waiting(A, allp)
-    allp = [p for p in allp if (p.phi, p.N) not in waiting]
+            if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p) and not held(p)]
     sizes = {}
     for p in allp:
         sizes.setdefault((study_of(p), p.phi), set()).add(p.N)
@@ -40,6 +35,18 @@ def points_by_phi_n(A, has=lambda p: True):
         if q is None or rank(p) > rank(q):
             by_phi[p.phi][p.N] = p
     return {phi: d for phi, d in sorted(by_phi.items()) if len(d) > 1}
+
+
+def held_sizes(A, has=lambda p: True):
+    """p -> whether point p's size is held back: no conclusion from a size
+    whose runs did not all finish, nor another protocol's run in its place (a
+    size that the study running that phi at the most N, its unfinished sizes
+    counted, has not finished is held back at that phi, not filled from a
+    study of other run lengths)."""
+    done = [p for p in list(A.points.values()) + list(A.extra.values())
+            if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p) and not unfinished_runs(A, p)]
+    waiting = protocol_waiting(A, done)
+    return lambda p: bool(unfinished_runs(A, p)) or (p.phi, p.N) in waiting
 
 
 def protocol_waiting(A, allp):

@@ -263,11 +263,15 @@ def tau_b_points(A, multi):
     (studies/cage_bonds.toml) thus give tau_B where the main runs stop short
     of it; where the chosen point's seeds did not all reach it, its cell is
     the bound."""
+    from .size import held_sizes   # the rule of every finite-size row: no size whose runs did not all finish
+    held = held_sizes(A)
     out = {}
     for phi, d in multi.items():
         dd = dict(d)
         for p in list(A.points.values()) + list(A.extra.values()):
             if p.phi != phi or p.pairs != "neighbours" or abs(p.eps - EPS_MAIN) > 1e-9 or not c_b_reach(p):
+                continue
+            if held(p):
                 continue
             q = dd.get(p.N)
             if q is None or (c_b_reach(p), len(p.runs)) > (c_b_reach(q), len(q.runs)):
