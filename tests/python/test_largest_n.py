@@ -234,3 +234,21 @@ def test_a_drift_that_ends_below_the_n_taken_is_not_said_of_that_n():
         d[n] = p
     assert still_drifting({0.78: d}, d, {}, 262144) == []
     assert [x.split(":")[0] for x in still_drifting({0.78: d}, d, {}, 16384)] == ["D (the MSD's long-time slope / 4)"]
+
+
+def test_a_size_the_leading_protocol_has_not_finished_is_not_filled_from_another_study():
+    """A complete point of another study (d_size: one seed, other run lengths)
+    at a size whose runs in the study that runs the density at the most N
+    (scale) are unfinished is held back, naming scale, not promoted."""
+    from dynhet.analysis.output import largest_n_notes
+    A = analysis()
+    A.extra = {}
+    for n, seeds, study in ((4096, (1, 2, 3), "scale"), (16384, (1, 2, 3), "scale"), (65536, (1,), "d_size")):
+        p = point(0.78, n, seeds, study)
+        A.extra[(study,) + (p.pairs, p.eps, p.phi, p.N)] = p
+    A.unfinished = {("scale", "neighbours", 0.9, 0.78, 65536): 2}   # scale's N = 65536: nothing finished yet
+    assert [(p.phi, p.N, p.study) for p in A.promote_largest_n()] == [(0.78, 16384, "scale")]
+    assert [(p.N, p.study, n) for p, n in A.held_back] == [(65536, "scale", 2)]
+    assert "N = 65536 of study scale (2 runs not complete)" in largest_n_notes(A)
+    A.unfinished = {}                                                 # scale's N = 65536 done (and not measured)
+    assert [(p.phi, p.N, p.study) for p in A.promote_largest_n()] == [(0.78, 65536, "d_size")]

@@ -46,28 +46,37 @@ def held_sizes(A, has=lambda p: True):
     done = [p for p in list(A.points.values()) + list(A.extra.values())
             if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p) and not unfinished_runs(A, p)]
     waiting = protocol_waiting(A, done)
-    return lambda p: bool(unfinished_runs(A, p)) or (p.phi, p.N) in waiting
+    return lambda p: bool(unfinished_runs(A, p)) or waiting_for(waiting, p) is not None
 
 
 def protocol_waiting(A, allp):
-    """{(phi, N)} of the main series where the study (or studies, tied) that
-    runs phi at the most N, counting its unfinished sizes, has runs of that
-    N unfinished."""
+    """{(phi, N): (study, runs unfinished, leaders)} of the main series where
+    a study that runs phi at the most N (leaders: every such study, tied),
+    counting its unfinished sizes, has runs of that N unfinished (study: the
+    first such by name). A point of a leader is one protocol's and is not
+    held back by another leader's unfinished runs (waiting_for)."""
     planned = {}
     for p in allp:
         planned.setdefault(p.phi, {}).setdefault(study_of(p), set()).add(p.N)
-    main = [(st, ph, n) for (st, pairs, eps, ph, n), k in getattr(A, "unfinished", {}).items()
+    main = [(st, ph, n, k) for (st, pairs, eps, ph, n), k in getattr(A, "unfinished", {}).items()
             if k and pairs == "neighbours" and abs(eps - EPS_MAIN) < 1e-9]
-    for st, ph, n in main:
+    for st, ph, n, _ in main:
         phi = next((f for f in planned if abs(f - ph) < 1e-9), ph)
         planned.setdefault(phi, {}).setdefault(st, set()).add(n)
-    out = set()
-    for st, ph, n in main:
+    out = {}
+    for st, ph, n, k in sorted(main):
         phi = next((f for f in planned if abs(f - ph) < 1e-9), ph)
         most = max(len(v) for v in planned[phi].values())
-        if len(planned[phi][st]) == most:
-            out.add((phi, n))
+        if len(planned[phi][st]) == most and (phi, n) not in out:
+            out[(phi, n)] = (st, k, {x for x, v in planned[phi].items() if len(v) == most})
     return out
+
+
+def waiting_for(waiting, p):
+    """(study, runs unfinished) of the leading protocol holding point p's size
+    back (protocol_waiting), or None."""
+    v = next((v for (ph, n), v in waiting.items() if abs(ph - p.phi) < 1e-9 and n == p.N), None)
+    return v[:2] if v and study_of(p) not in v[2] else None
 
 
 def unfinished_runs(A, p):

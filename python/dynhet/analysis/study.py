@@ -114,13 +114,20 @@ class Analysis:
         """Issue 27, item 3: at each (pairs, eps, phi) of this study, the point
         of the largest N over this study and the --also studies whose runs
         measured everything this study's point measured, and all of whose
-        study's runs at that point are complete (else it is held back:
-        self.held_back), joins this study's points, so that every series (and
+        study's runs at that point are complete, and of a size that the study
+        running that phi at the most N has finished (else it is held back:
+        self.held_back; size.protocol_waiting), joins this study's points, so that every series (and
         so every row and fit) takes it in place of this study's own; other
         studies' densities are not added. Returns the promoted points (also
         in self.promoted)."""
+        from .size import protocol_waiting, unfinished_runs, waiting_for
         def measured(p):
             return set.intersection(*[set(r["cut"].get(A_MAIN, {})) | set(r) for r in p.runs]) if p.runs else set()
+        main = lambda p: p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9
+        # a size the leading protocol (the study running phi at the most N) has not finished is
+        # not filled from another study's runs of other lengths (size.protocol_waiting)
+        waiting = protocol_waiting(self, [p for p in list(self.points.values()) + list(self.extra.values())
+                                          if main(p) and not unfinished_runs(self, p)])
         best, self.held_back = {}, []
         for k, p in self.extra.items():
             key = k[1:4]
@@ -134,12 +141,18 @@ class Analysis:
             if left:   # no conclusion from a size whose runs did not all finish
                 self.held_back.append((p, left))
                 continue
+            wait = waiting_for(waiting, p) if main(p) else None
+            if wait:
+                stand_in = Point(k[1:])
+                stand_in.study = wait[0]
+                self.held_back.append((stand_in, wait[1]))
+                continue
             q = best.get(key)
             if q is None or p.N > q.N or (p.N == q.N and len(p.runs) > len(q.runs)):
                 best[key] = p
         # only the sizes above the one taken were held back in its place
-        self.held_back = [(p, n) for p, n in self.held_back
-                          if p.N > getattr(best.get((p.pairs, p.eps, p.phi)), "N", 0)]
+        self.held_back = list({(p.study, p.pairs, p.eps, p.phi, p.N): (p, n) for p, n in self.held_back
+                               if p.N > getattr(best.get((p.pairs, p.eps, p.phi)), "N", 0)}.values())
         self.promoted = []
         for key, p in sorted(best.items()):
             self.points[key + (p.N,)] = p
