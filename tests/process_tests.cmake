@@ -190,3 +190,9 @@ set_tests_properties(tcpq_hub_death_ends_every_process_cleanly PROPERTIES LABELS
 add_test(NAME python_unit
   COMMAND /usr/bin/python3 -m pytest -q -p no:cacheprovider ${CMAKE_CURRENT_SOURCE_DIR}/python)
 set_tests_properties(python_unit PROPERTIES LABELS unit TIMEOUT 120)
+
+# launch_scripts/reproduce.sh, the recipe of the reproduction from nothing:
+# every study it names dry-runs, the sum is theirs, bad input refused.
+add_test(NAME reproduce_dry
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/reproduce_dry.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(reproduce_dry PROPERTIES LABELS process TIMEOUT 120)
