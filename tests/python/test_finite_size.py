@@ -583,3 +583,23 @@ def test_the_tau_b_row_takes_no_size_whose_runs_did_not_all_finish():
     multi = points_by_phi_n(A)
     assert sorted(multi[0.79]) == [4096, 16384]
     assert sorted(tau_b_points(A, multi)[0.79]) == [4096, 16384]
+
+
+def test_tau_against_n_rows_give_a_spread_only_where_seeds_can_have_one(tmp_path):
+    """local_measures.local_n_results: each N's cell gives the seeds' spread
+    where it has several seeds, and none (no "± nan") where one seed."""
+    from dynhet.analysis.local_measures import local_n_results
+    A = Analysis.__new__(Analysis)
+    A.dir, A.figdir, A.also = str(tmp_path / "study"), str(tmp_path / "study" / "figures"), []
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    for n, seeds in ((4096, (1, 2, 3)), (65536, (1,))):
+        p = Point(("neighbours", 0.9, 0.79, n))
+        for seed in seeds:
+            p.runs.append({"seed": seed, "N": n, "cut": {0.6: {"tau_alpha": 27.0 + seed, "tau_alpha_err": 1.0,
+                                                               "tau_cr": 240.0 + seed, "tau_cr_err": 5.0}}})
+        A.points[p.pairs, p.eps, p.phi, p.N] = p
+    local_n_results(A)
+    rows = {r["item"]: r["ours"] for r in A.rows}
+    cell = rows["τ_α against N at φ = 0.79"]
+    assert "N 4096: 29 ± 0.58 (seeds 3, spread ± 0.58)" in cell and "N 65536: 28 ± 1 (seeds 1)" in cell
+    assert "nan" not in " ".join(rows.values())
