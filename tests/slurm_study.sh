@@ -5,7 +5,9 @@
 # directory, all started inside a private network
 # namespace so it cannot meet any real Slurm): studies/tiny.toml submitted
 # with --executor slurm must end with every run complete and equal, bit for
-# bit, to the local executor's runs (same seeds). Bounded waits throughout.
+# bit, to the local executor's runs (same seeds); a run marked failed and
+# submitted again must start over, not resume its failed attempt, and come
+# out equal again. Bounded waits throughout.
 set -euo pipefail
 root=$1 build=$2
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then exec "$root/launch_scripts/netns.sh" bash "$0" "$@"; fi
@@ -35,5 +37,22 @@ check 'ls "$tmp"/s/slurm/task-*_0.out >/dev/null' "each task's log is in the stu
 # Again: nothing left to submit.
 bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --executor slurm --out "$tmp/s" >"$tmp/s2.out" 2>&1
 check 'grep -q "nothing to submit" "$tmp/s2.out"' "submitted again: nothing to submit"
+# A run that failed, submitted again, starts over: the queue keeps what it was
+# (previous_state), it is not resumed from its failed attempt's checkpoints.
+run=$(ls "$tmp/s/runs" | head -1)
+sed -i 's/^state = "complete"/state = "failed"/' "$tmp/s/runs/$run/status.toml"
+bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --executor slurm --out "$tmp/s" \
+  --time=10 >"$tmp/s3.out" 2>&1 || { cat "$tmp/s3.out"; exit 1; }
+check 'grep -q "1 runs submitted as Slurm job array" "$tmp/s3.out"' "the failed run submitted again, alone"
+done_=0
+for _ in $(seq 1800); do
+  if [[ -z $(squeue -h -o %i 2>/dev/null) ]]; then done_=1; break; fi
+  sleep 0.2
+done
+((done_)) || { echo "FAIL the resubmitted job did not finish in 6 min"; squeue; exit 1; }
+check 'grep -q "$run: failed before" "$tmp"/s/slurm/task-*.out' "its task ran it again from the start"
+check '! grep -q "$run: was interrupted" "$tmp"/s/slurm/task-*.out' "its task did not resume its failed attempt"
+check '[[ $(grep -c "state = \"complete\"" "$tmp/s/index.toml") == 4 ]]' "the index: 4 complete runs again"
+/usr/bin/python3 "$root/tests/compare_studies.py" "$tmp/l" "$tmp/s" || fail=1
 ((fail == 0)) || { cat "$tmp"/*.out; tail -n 30 "$d"/*.log; for f in "$tmp"/s/slurm/*.out; do echo "== $f"; tail -n 5 "$f"; done; }
 exit $fail

@@ -82,7 +82,9 @@ def run_slurm(sd, a):
         f"#SBATCH --output={sdir}/index-%j.out", *common,
         "# After every task: the study's index (and what must follow the runs).",
         f"exec /usr/bin/python3 {me} index {sd.dir} --analyse", ""]))
-    r = subprocess.run(["sbatch", "--parsable", array], capture_output=True, text=True)
+    # Held until every run's status says queued: a task that started at once
+    # would have its "running" overwritten by this loop's "queued".
+    r = subprocess.run(["sbatch", "--parsable", "--hold", array], capture_output=True, text=True)
     if r.returncode != 0:
         raise StudyError(f"sbatch refused the job array: {r.stderr.strip()}")
     job = r.stdout.strip().split(";")[0]
@@ -96,6 +98,11 @@ def run_slurm(sd, a):
         for k in AXES:
             st[k] = p[k]
         write_status(d, st)
+    rel = subprocess.run(["scontrol", "release", job], capture_output=True, text=True)
+    if rel.returncode != 0:
+        subprocess.run(["scancel", job], capture_output=True)
+        raise StudyError(f"scontrol could not release job array {job} (cancelled; submit again): "
+                         f"{rel.stderr.strip()}")
     r2 = subprocess.run(["sbatch", "--parsable", f"--dependency=afterany:{job}", after], capture_output=True,
                         text=True)
     if r2.returncode != 0:
