@@ -18,6 +18,13 @@ source "$root/tests/slurm_cluster.sh"
 
 fail=0
 check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
+wait_queue() { # until the queue is empty, at most 6 minutes
+  for _ in $(seq 1800); do
+    [[ -n $(squeue -h -o %i 2>/dev/null) ]] || return 0
+    sleep 0.2
+  done
+  echo "FAIL $1 did not finish in 6 min"; squeue; exit 1
+}
 bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --executor slurm --out "$tmp/s" \
   --time=10 >"$tmp/s.out" 2>&1 || { cat "$tmp/s.out"; tail -20 "$d"/*.log; exit 1; }
 cat "$tmp/s.out"
@@ -25,12 +32,7 @@ check 'grep -q "4 runs submitted as Slurm job array" "$tmp/s.out"' "one job arra
 # Meanwhile the same study on the local executor.
 bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --out "$tmp/l" --jobs 1 >"$tmp/l.out" 2>&1 ||
   { cat "$tmp/l.out"; exit 1; }
-done_=0
-for _ in $(seq 1800); do
-  if [[ -z $(squeue -h -o %i 2>/dev/null) ]]; then done_=1; break; fi
-  sleep 0.2
-done
-((done_)) || { echo "FAIL the Slurm jobs did not finish in 6 min"; squeue; exit 1; }
+wait_queue "the Slurm jobs"
 check '[[ $(grep -c "state = \"complete\"" "$tmp/s/index.toml") == 4 ]]' "the index job wrote an index with 4 complete runs"
 check 'ls "$tmp"/s/slurm/task-*_0.out >/dev/null' "each task's log is in the study directory"
 /usr/bin/python3 "$root/tests/compare_studies.py" "$tmp/l" "$tmp/s" || fail=1
@@ -44,12 +46,7 @@ sed -i 's/^state = "complete"/state = "failed"/' "$tmp/s/runs/$run/status.toml"
 bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --executor slurm --out "$tmp/s" \
   --time=10 >"$tmp/s3.out" 2>&1 || { cat "$tmp/s3.out"; exit 1; }
 check 'grep -q "1 runs submitted as Slurm job array" "$tmp/s3.out"' "the failed run submitted again, alone"
-done_=0
-for _ in $(seq 1800); do
-  if [[ -z $(squeue -h -o %i 2>/dev/null) ]]; then done_=1; break; fi
-  sleep 0.2
-done
-((done_)) || { echo "FAIL the resubmitted job did not finish in 6 min"; squeue; exit 1; }
+wait_queue "the resubmitted job"
 check 'grep -q "$run: failed before" "$tmp"/s/slurm/task-*.out' "its task ran it again from the start"
 check '! grep -q "$run: was interrupted" "$tmp"/s/slurm/task-*.out' "its task did not resume its failed attempt"
 check '[[ $(grep -c "state = \"complete\"" "$tmp/s/index.toml") == 4 ]]' "the index: 4 complete runs again"
