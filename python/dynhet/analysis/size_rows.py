@@ -93,9 +93,9 @@ def production_change(r, cr=False):
     """How far tau_alpha(t0) moves over the run's production, in per cent of
     tau_alpha: the line through tau_alpha(t0)/tau_alpha against t0/tau_alpha
     (fits.slope_with_error, the origins' scatter about it) from the first
-    origin to the last; 0 within its error in a steady state. Where the
-    box-scale flows still build up (they relax as L^2, not as tau_alpha^CR)
-    the standard tau_alpha falls with t0 and the cage-relative does not."""
+    origin to the last; 0 within its error in a steady state (a run that
+    still relaxes after its equilibration moves; docs/analysis.md, "The
+    longest waves", for what the box-scale flows do and do not do)."""
     c = cutx(r, cr)
     t0, tt, tm = np.asarray(c["t0"], float), np.asarray(c["tau_t0"], float), float(c["tau_alpha"])
     m = np.isfinite(tt)
