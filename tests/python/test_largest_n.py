@@ -94,7 +94,9 @@ def test_a_larger_n_with_runs_unfinished_is_held_back_and_the_next_stands_in():
     A = analysis()
     A.unfinished = {("scale2", "neighbours", 0.9, 0.78, 65536): 1}   # a third seed of it still running
     promoted = A.promote_largest_n()
-    assert [(p.phi, p.N, p.study) for p in promoted] == [(0.78, 65536, "scale")]     # the complete one of that N
+    # scale2 ties scale (and fs, and this study) for the most sizes at 0.78: any of them may be the protocol
+    # the rows follow, so the size waits for scale2's run, the complete scale point of it too
+    assert [(p.phi, p.N, p.study) for p in promoted] == [(0.78, 16384, "fs")]
     A = analysis()
     A.unfinished = {("scale2", "neighbours", 0.9, 0.78, 65536): 1, ("scale", "neighbours", 0.9, 0.78, 65536): 2}
     assert [(p.phi, p.N, p.study) for p in A.promote_largest_n()] == [(0.78, 16384, "fs")]
@@ -252,3 +254,24 @@ def test_a_size_the_leading_protocol_has_not_finished_is_not_filled_from_another
     assert "N = 65536 of study scale (2 runs not complete)" in largest_n_notes(A)
     A.unfinished = {}                                                 # scale's N = 65536 done (and not measured)
     assert [(p.phi, p.N, p.study) for p in A.promote_largest_n()] == [(0.78, 65536, "d_size")]
+
+
+def test_a_study_tied_for_the_most_sizes_does_not_fill_a_size_the_other_has_not_finished():
+    """phi 0.76 in the real studies: scale runs N 1024-262144 and d_size (one
+    seed, overlap only, other run lengths) N 4096-10^6, five sizes each. With
+    scale's N = 262144 unfinished, d_size's complete run of that size fills
+    neither the finite-size table nor the largest N (review, session 24)."""
+    from dynhet.analysis.size import held_sizes
+    A = analysis()
+    A.extra = {}
+    for n, seeds, study in [(n, (1, 2, 3), "scale") for n in (1024, 4096, 16384, 65536)] + \
+                           [(n, (1,), "d_size") for n in (4096, 16384, 65536, 262144, 1000000)]:
+        p = point(0.78, n, seeds, study)
+        A.extra[(study,) + (p.pairs, p.eps, p.phi, p.N)] = p
+    A.unfinished = {("scale", "neighbours", 0.9, 0.78, 262144): 1}
+    held = held_sizes(A)
+    assert held(A.extra[("d_size", "neighbours", 0.9, 0.78, 262144)])
+    assert not held(A.extra[("d_size", "neighbours", 0.9, 0.78, 1000000)])   # a size scale does not run
+    del A.extra[("d_size", "neighbours", 0.9, 0.78, 1000000)]
+    assert [(p.N, p.study) for p in A.promote_largest_n()] == [(65536, "scale")]
+    assert [(p.N, p.study, n) for p, n in A.held_back] == [(262144, "scale", 1)]

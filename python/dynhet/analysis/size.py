@@ -50,11 +50,11 @@ def held_sizes(A, has=lambda p: True):
 
 
 def protocol_waiting(A, allp):
-    """{(phi, N): (study, runs unfinished, leaders)} of the main series where
-    a study that runs phi at the most N (leaders: every such study, tied),
-    counting its unfinished sizes, has runs of that N unfinished (study: the
-    first such by name). A point of a leader is one protocol's and is not
-    held back by another leader's unfinished runs (waiting_for)."""
+    """{(phi, N): (study, runs unfinished)} of the main series where a study
+    that runs phi at the most N (counting its unfinished sizes; with a tie,
+    any of them: the studies' sizes say nothing of their protocols, and at
+    phi 0.76 d_size's one-seed overlap-only runs tie scale's five sizes)
+    has runs of that N unfinished (the first such study by name)."""
     planned = {}
     for p in allp:
         planned.setdefault(p.phi, {}).setdefault(study_of(p), set()).add(p.N)
@@ -68,15 +68,14 @@ def protocol_waiting(A, allp):
         phi = next((f for f in planned if abs(f - ph) < 1e-9), ph)
         most = max(len(v) for v in planned[phi].values())
         if len(planned[phi][st]) == most and (phi, n) not in out:
-            out[(phi, n)] = (st, k, {x for x, v in planned[phi].items() if len(v) == most})
+            out[(phi, n)] = (st, k)
     return out
 
 
 def waiting_for(waiting, p):
     """(study, runs unfinished) of the leading protocol holding point p's size
     back (protocol_waiting), or None."""
-    v = next((v for (ph, n), v in waiting.items() if abs(ph - p.phi) < 1e-9 and n == p.N), None)
-    return v[:2] if v and study_of(p) not in v[2] else None
+    return next((v for (ph, n), v in waiting.items() if abs(ph - p.phi) < 1e-9 and n == p.N), None)
 
 
 def unfinished_runs(A, p):
