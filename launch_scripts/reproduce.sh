@@ -6,13 +6,17 @@
 # command goes on where it stopped; complete studies are skipped.
 #
 # Usage: launch_scripts/reproduce.sh [--runs DIR] [--jobs K] [--only S1,S2] [--dry-run]
-#          [--analyse-only] [--no-build] [--executor slurm [run_study.sh's Slurm flags]]
+#          [--analyse-only [--partial]] [--no-build] [--executor slurm [run_study.sh's Slurm flags]]
 #   --runs DIR       where the studies go, DIR/<study> (default: runs/ beside the
 #                    checkout, ../runs, as the documents' headers name them)
 #   --jobs K         runs at once (run_study.sh --jobs)
 #   --only S1,S2     these studies only (names below), e.g. --only quick,scale
 #   --dry-run        each study's runs and estimated CPU time, and their sum; starts nothing
-#   --analyse-only   the analysis alone: every study must be complete
+#   --analyse-only   the analysis alone; refused while a study has runs not complete
+#                    (their names are printed), unless --partial (unfinished sizes are
+#                    then held back and named in the documents)
+# The analysis rewrites the tracked documents, so it runs only once all seven
+# studies are complete (after --only too, if the others are).
 #   --executor slurm submits each study's job array and returns; run this again
 #                    with --analyse-only once every array has ended
 # Studies, in this order: quick (N = 4096: every row of the paper, the leading
@@ -27,13 +31,14 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; }
 studies=(quick finite_size cutoff cage cage_bonds d_size scale)
 before_commit=556a0f6
-runs=$(cd "$root/.." && pwd)/runs only="" dry=0 analyse_only=0 build=1 pass=()
+runs=$root/../runs only="" dry=0 analyse_only=0 partial=0 build=1 pass=()
 while (($#)); do
   case "$1" in
   --runs) runs=${2:?--runs needs a directory}; shift ;;
   --only) only=${2:?--only needs study names}; shift ;;
   --dry-run) dry=1 ;;
   --analyse-only) analyse_only=1 ;;
+  --partial) partial=1 ;;
   --no-build) build=0 ;;
   -h | --help) usage; exit 0 ;;
   *) pass+=("$1") ;;
@@ -48,7 +53,8 @@ if [[ -n $only ]]; then
   studies=("${want[@]}")
 fi
 if ((build)); then BUILD_DIR=${BUILD_DIR:-$root/build} "$root/launch_scripts/setup.sh"; fi
-mkdir -p "$runs"
+((dry)) || mkdir -p "$runs"
+runs=$(realpath -m "$runs") # the studies run from here, the analysis from $root
 
 if ((!analyse_only)); then
   total=0
@@ -74,19 +80,42 @@ if ((!analyse_only)); then
   }
 fi
 
-also=() missing=()
-for s in finite_size cutoff cage cage_bonds d_size scale; do
-  if [[ -f $runs/$s/index.toml ]]; then also+=(--also "$runs/$s"); else missing+=("$s"); fi
-done
 [[ -f $runs/quick/index.toml ]] || { echo "reproduce: $runs/quick/index.toml does not exist: run the studies first" >&2; exit 1; }
-((${#missing[@]} == 0)) || echo "reproduce: not run, left out of the analysis: ${missing[*]}" >&2
+# Every run of every study complete? (each index.toml: [runs.<name>] tables with a state)
+unfinished=$(/usr/bin/python3 - "$runs" <<'PY'
+import os, sys, tomllib
+for s in ("quick", "finite_size", "cutoff", "cage", "cage_bonds", "d_size", "scale"):
+    idx = os.path.join(sys.argv[1], s, "index.toml")
+    if not os.path.exists(idx):
+        print(f"{s} (not run)")
+        continue
+    with open(idx, "rb") as fh:
+        runs = tomllib.load(fh).get("runs", {})
+    left = sum(1 for m in runs.values() if m.get("state") != "complete")
+    if left:
+        print(f"{s} ({left} of {len(runs)} runs not complete)")
+PY
+)
+if [[ -n $unfinished ]]; then
+  echo "reproduce: not complete: $(paste -sd ';' <<<"$unfinished" | sed 's/;/; /g')" >&2
+  if ((!analyse_only)); then
+    echo "reproduce: the documents are left as they are; --analyse-only --partial writes them from what is complete" >&2
+    exit 0
+  fi
+  ((partial)) || { echo "reproduce: refused: --partial to write the documents from what is complete" >&2; exit 1; }
+fi
+rel=$(realpath -m --relative-to="$root" "$runs") # the documents' headers name the studies relative to the checkout
+also=()
+for s in finite_size cutoff cage cage_bonds d_size scale; do
+  [[ -f $runs/$s/index.toml ]] && also+=(--also "$rel/$s")
+done
 restate=()
 if git -C "$root" cat-file -e "$before_commit:docs/reproduction.md" 2>/dev/null; then
   git -C "$root" show "$before_commit:docs/reproduction.md" >"$runs/reproduction_before.md"
-  restate=(--restate "$runs/reproduction_before.md")
+  restate=(--restate "$rel/reproduction_before.md")
 else
   echo "reproduce: not a git checkout with commit $before_commit: no row-by-row restatement" >&2
 fi
 cd "$root"
-exec bash launch_scripts/analyse_study.sh "$runs/quick" "${also[@]}" --largest-n --table docs/reproduction.md \
+exec bash launch_scripts/analyse_study.sh "$rel/quick" "${also[@]}" --largest-n --table docs/reproduction.md \
   --finite-size docs/finite_size.md --discussion docs/reproduction_findings.md "${restate[@]}"
