@@ -7,7 +7,8 @@
 # with --executor slurm must end with every run complete and equal, bit for
 # bit, to the local executor's runs (same seeds); a run marked failed and
 # submitted again must start over, not resume its failed attempt, and come
-# out equal again. Bounded waits throughout.
+# out equal again; a submission that fails halfway leaves no held array
+# behind. Bounded waits throughout.
 set -euo pipefail
 root=$1 build=$2
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then exec "$root/launch_scripts/netns.sh" bash "$0" "$@"; fi
@@ -51,5 +52,17 @@ check 'grep -q "$run: failed before" "$tmp"/s/slurm/task-*.out' "its task ran it
 check '! grep -q "$run: was interrupted" "$tmp"/s/slurm/task-*.out' "its task did not resume its failed attempt"
 check '[[ $(grep -c "state = \"complete\"" "$tmp/s/index.toml") == 4 ]]' "the index: 4 complete runs again"
 /usr/bin/python3 "$root/tests/compare_studies.py" "$tmp/l" "$tmp/s" || fail=1
+# A submission that fails after sbatch (here a run directory that cannot be
+# made: a file in its place) leaves no held array behind and puts back what
+# the runs were.
+runs=($(ls "$tmp/s/runs"))
+sed -i 's/^state = "complete"/state = "failed"/' "$tmp/s/runs/${runs[0]}/status.toml"
+rm -rf "$tmp/s/runs/${runs[1]}" && touch "$tmp/s/runs/${runs[1]}"
+rc=0; bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --executor slurm --out "$tmp/s" \
+  --time=10 >"$tmp/s4.out" 2>&1 || rc=$?
+check '[[ $rc != 0 ]]' "a submission that cannot write its runs' statuses fails (exit $rc)"
+check '[[ -z $(squeue -h -o %i 2>/dev/null) ]]' "and leaves no job in the queue (its held array cancelled)"
+check 'grep -q "^state = \"failed\"" "$tmp/s/runs/${runs[0]}/status.toml" && ! grep -q "queued" "$tmp/s/runs/${runs[0]}/status.toml"' \
+  "the failed run's status is as it was"
 ((fail == 0)) || { cat "$tmp"/*.out; tail -n 30 "$d"/*.log; for f in "$tmp"/s/slurm/*.out; do echo "== $f"; tail -n 5 "$f"; done; }
 exit $fail

@@ -88,21 +88,35 @@ def run_slurm(sd, a):
     if r.returncode != 0:
         raise StudyError(f"sbatch refused the job array: {r.stderr.strip()}")
     job = r.stdout.strip().split(";")[0]
-    for p in todo:
-        d = sd.run_dir(p)
-        os.makedirs(d, exist_ok=True)
-        st = read_status(d)
-        if st.get("state") not in (None, "queued"):
-            st["previous_state"] = st["state"]   # what the run was: do_run goes by it (runner.effective_state)
-        st.update({"state": "queued", "job": job})
-        for k in AXES:
-            st[k] = p[k]
-        write_status(d, st)
-    rel = subprocess.run(["scontrol", "release", job], capture_output=True, text=True)
-    if rel.returncode != 0:
-        subprocess.run(["scancel", job], capture_output=True)
-        raise StudyError(f"scontrol could not release job array {job} (cancelled; submit again): "
-                         f"{rel.stderr.strip()}")
+    before = {}   # each run's status as it was: put back if the array cannot be released
+    try:
+        for p in todo:
+            d = sd.run_dir(p)
+            os.makedirs(d, exist_ok=True)
+            st = read_status(d)
+            before[d] = dict(st)
+            if st.get("state") not in (None, "queued"):
+                st["previous_state"] = st["state"]   # what the run was: do_run goes by it (runner.effective_state)
+            st.update({"state": "queued", "job": job})
+            for k in AXES:
+                st[k] = p[k]
+            write_status(d, st)
+        rel = subprocess.run(["scontrol", "release", job], capture_output=True, text=True)
+        if rel.returncode != 0:
+            raise StudyError(f"scontrol could not release job array {job}: {rel.stderr.strip()}")
+    except BaseException as e:   # a held array left behind would keep its runs "queued" for ever
+        c = subprocess.run(["scancel", job], capture_output=True, text=True)
+        for d, st in before.items():
+            path = os.path.join(d, "status.toml")
+            if st:
+                write_status(d, st)
+            elif os.path.exists(path):
+                os.remove(path)
+        if isinstance(e, StudyError):
+            raise StudyError(f"{e}; the array " + ("cancelled" if c.returncode == 0 else
+                             f"could not be cancelled either ({c.stderr.strip()}): scancel {job}")
+                             + ", the runs' states put back: submit again") from None
+        raise
     r2 = subprocess.run(["sbatch", "--parsable", f"--dependency=afterany:{job}", after], capture_output=True,
                         text=True)
     if r2.returncode != 0:
