@@ -29,7 +29,8 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; }
-studies=(quick finite_size cutoff cage cage_bonds d_size scale)
+all=(quick finite_size cutoff cage cage_bonds d_size scale) # quick leads the analysis; the rest are --also
+studies=("${all[@]}")
 before_commit=556a0f6
 runs=$root/../runs only="" dry=0 analyse_only=0 partial=0 build=1 pass=()
 while (($#)); do
@@ -48,7 +49,7 @@ done
 if [[ -n $only ]]; then
   IFS=, read -ra want <<<"$only"
   for s in "${want[@]}"; do
-    [[ " ${studies[*]} " == *" $s "* ]] || { echo "reproduce: no study '$s'; the studies: ${studies[*]}" >&2; exit 2; }
+    [[ " ${all[*]} " == *" $s "* ]] || { echo "reproduce: no study '$s'; the studies: ${all[*]}" >&2; exit 2; }
   done
   studies=("${want[@]}")
 fi
@@ -82,9 +83,9 @@ fi
 
 [[ -f $runs/quick/index.toml ]] || { echo "reproduce: $runs/quick/index.toml does not exist: run the studies first" >&2; exit 1; }
 # Every run of every study complete? (each index.toml: [runs.<name>] tables with a state)
-unfinished=$(/usr/bin/python3 - "$runs" <<'PY'
+unfinished=$(/usr/bin/python3 - "$runs" "${all[@]}" <<'PY'
 import os, sys, tomllib
-for s in ("quick", "finite_size", "cutoff", "cage", "cage_bonds", "d_size", "scale"):
+for s in sys.argv[2:]:
     idx = os.path.join(sys.argv[1], s, "index.toml")
     if not os.path.exists(idx):
         print(f"{s} (not run)")
@@ -106,7 +107,7 @@ if [[ -n $unfinished ]]; then
 fi
 rel=$(realpath -m --relative-to="$root" "$runs") # the documents' headers name the studies relative to the checkout
 also=()
-for s in finite_size cutoff cage cage_bonds d_size scale; do
+for s in "${all[@]:1}"; do
   [[ -f $runs/$s/index.toml ]] && also+=(--also "$rel/$s")
 done
 restate=()

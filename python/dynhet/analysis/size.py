@@ -43,10 +43,16 @@ def held_sizes(A, has=lambda p: True):
     size that the study running that phi at the most N, its unfinished sizes
     counted, has not finished is held back at that phi, not filled from a
     study of other run lengths)."""
+    waiting = waiting_sizes(A, has)
+    return lambda p: bool(unfinished_runs(A, p)) or waiting_for(waiting, p) is not None
+
+
+def waiting_sizes(A, has=lambda p: True):
+    """protocol_waiting over the main series' points whose runs all finished
+    (held_sizes, and Analysis.promote_largest_n)."""
     done = [p for p in list(A.points.values()) + list(A.extra.values())
             if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p) and not unfinished_runs(A, p)]
-    waiting = protocol_waiting(A, done)
-    return lambda p: bool(unfinished_runs(A, p)) or waiting_for(waiting, p) is not None
+    return protocol_waiting(A, done)
 
 
 def protocol_waiting(A, allp):

@@ -120,14 +120,13 @@ class Analysis:
         so every row and fit) takes it in place of this study's own; other
         studies' densities are not added. Returns the promoted points (also
         in self.promoted)."""
-        from .size import protocol_waiting, unfinished_runs, waiting_for
+        from .size import waiting_for, waiting_sizes
         def measured(p):
             return set.intersection(*[set(r["cut"].get(A_MAIN, {})) | set(r) for r in p.runs]) if p.runs else set()
         main = lambda p: p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9
         # a size the leading protocol (the study running phi at the most N) has not finished is
         # not filled from another study's runs of other lengths (size.protocol_waiting)
-        waiting = protocol_waiting(self, [p for p in list(self.points.values()) + list(self.extra.values())
-                                          if main(p) and not unfinished_runs(self, p)])
+        waiting = waiting_sizes(self)
         best, self.held_back = {}, []
         for k, p in self.extra.items():
             key = k[1:4]
