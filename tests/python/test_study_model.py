@@ -158,6 +158,48 @@ def test_a_size_not_yet_piloted_is_estimated_from_the_pilots_of_the_same_system(
     assert math.isclose(row[2], 8.0 * 1.2) and row[3].startswith("guess: interpolated from finished points x 1.2")
 
 
+def test_beyond_the_finished_points_the_guess_follows_the_tau_guess_table(tmp_path):
+    # scale.toml's case: pilots at 0.78 and 0.80 only. A line in ln tau
+    # through them, extrapolated down to 0.76, gave 3.6 where the table
+    # puts a third of 0.78's; the table's shape through the nearest
+    # finished point gives 77 x 30 / 90.
+    from dynhet.study.rundir import StudyDir, write_status
+    text = GOOD.replace("packing_fraction = [0.60, 0.70]", "packing_fraction = [0.76, 0.78, 0.79, 0.80, 0.81]") \
+               .replace("lag_max_tau = 30.0", "lag_max_tau = 30.0\ntau_guess = [[0.76, 30.0], [0.78, 90.0], "
+                                                "[0.79, 230.0], [0.80, 900.0]]")
+    sd = StudyDir(study(tmp_path, text), str(tmp_path / "out"))
+    sd.claim()
+    pts = {q["packing_fraction"]: q for q in sd.study.points() if q["restitution"] == 0.9 and q["seed"] == 1}
+    for name, phi, tau in (("a", 0.78, 77.0), ("b", 0.80, 1657.0)):
+        d = tmp_path / "out" / "pilots" / name
+        d.mkdir(parents=True)
+        write_status(str(d), {"state": "complete", "tau_alpha": tau, "packing_fraction": phi,
+                              "series": [0.9, "neighbours", 300]})
+    tau, src = sd.guess(pts[0.76])
+    assert math.isclose(tau, 77.0 * 30.0 / 90.0) and src.endswith("finished point at phi = 0.78")
+    tau, src = sd.guess(pts[0.79])                      # between them: ln tau linear in phi
+    assert math.isclose(tau, math.sqrt(77.0 * 1657.0)) and src == "interpolated from finished points"
+    tau, src = sd.guess(pts[0.81])                      # above: the table's own end, extrapolated
+    assert math.isclose(tau, 1657.0 * (900.0 * (900.0 / 230.0)) / 900.0)
+    assert src.endswith("finished point at phi = 0.8")
+    assert sd.guess(pts[0.76], finished=False) == (30.0, "the study's tau_guess")
+
+
+def test_the_dry_runs_time_left_counts_only_what_a_running_run_has_not_simulated(tmp_path):
+    from dynhet.study.index import share_done
+    d = tmp_path / "run"
+    d.mkdir()
+    scene = {"run": {"equilibration_time": 19890.0}}
+    assert share_done(str(d), "running", scene, 21880.0) == 0.0        # no progress line yet
+    (d / "sim_node.log").write_text(
+        "[equilibrate] t=7830      /1.989e+04  phi=0.8000  coll/s=1.36e+06  T=0.86  Z=29.6  frames 0/212  ETA 4:57:36\n")
+    # equilibration's line names the end of equilibration; the share is of both phases (one clock)
+    assert math.isclose(share_done(str(d), "running", scene, 21880.0), 7830.0 / 41770.0)
+    assert math.isclose(share_done(str(d), "interrupted", scene, 21880.0), 7830.0 / 41770.0)
+    for state in ("failed", "pending", "too_short", "complete"):   # these start over, or are not left
+        assert share_done(str(d), state, scene, 21880.0) == 0.0
+
+
 def test_a_running_run_is_described_from_its_sims_last_progress_line(tmp_path):
     from dynhet.study.progress import describe, sim_progress
     d = tmp_path / "run"

@@ -90,6 +90,9 @@ def main():
 
 def check_scenes(sd):
     """Every point's scene through sim_node --check, before anything runs."""
+    if not os.access(SIM, os.X_OK):
+        raise StudyError(f"no sim_node at {SIM}: build it first (launch_scripts/setup.sh, or run_study.sh "
+                         "without --no-build), or point BUILD_DIR at a build that has it")
     problems = []
     tmp = os.path.join("/tmp", f"dynhet-study-check-{os.getpid()}.toml")
     try:

@@ -4,6 +4,7 @@ import os
 from .toml_io import toml_value, write_atomic
 from .model import AXES
 from .estimates import estimate, fmt_time
+from .progress import sim_progress
 from .rundir import read_status
 
 
@@ -86,6 +87,17 @@ def measured_ratio(done):
     return ratios, (g_all / e_all if e_all > 0 else None)
 
 
+def share_done(run_dir, state, scene, prod):
+    """The share of a running or interrupted run's simulated time (equilibration
+    and production, one clock from 0) that its sim's last progress line has
+    passed; 0 for any other state (a failed run starts over)."""
+    if state not in ("running", "interrupted"):
+        return 0.0
+    p = sim_progress(run_dir)
+    total = float(scene.get("run", {}).get("equilibration_time", 100)) + prod
+    return min(1.0, max(0.0, p["t"] / total)) if p and total > 0 else 0.0
+
+
 def dry_run(sd):
     rows = plan(sd)
     costs = [(p, sc, tau, src, state, *estimate(sc, nodes_of(sc)), read_status(sd.run_dir(p)).get("cpu_s"))
@@ -111,7 +123,7 @@ def dry_run(sd):
         sch = sc.get("schedule", {})
         prod = (int(sch.get("origins", 10)) - 1) * float(sch.get("origin_spacing", 10)) + float(sch.get("lag_max", 100))
         tot_cpu += cpu
-        left_cpu += 0 if state == "complete" else cpu
+        left_cpu += 0 if state == "complete" else cpu * (1 - share_done(sd.run_dir(p), state, sc, prod))
         peak = max(peak, mem)
         print(f"{sd.study.run_name(p):44s} {state:9s} {n:8d} "
               f"{(f'{tau:.4g}' if tau else '-'):>9s} {sc.get('run', {}).get('equilibration_time', 100):9.4g} "
@@ -119,6 +131,7 @@ def dry_run(sd):
     if overall:
         print("# measured CPU over the engine's estimate, complete runs: "
               + ", ".join(f"N {n}: {r:.2f}" for n, r in sorted(ratios.items())) + f"; all: {overall:.2f}")
-    print(f"# total CPU {fmt_time(tot_cpu)} ({tot_cpu / 3600:.2f} CPU-hours), left {fmt_time(left_cpu)}; "
+    print(f"# total CPU {fmt_time(tot_cpu)} ({tot_cpu / 3600:.2f} CPU-hours), left {fmt_time(left_cpu)} "
+          "(a running or interrupted run less the share of its simulated time its sim has passed); "
           + (f"the engine's estimate alone {engine_cpu / 3600:.2f} CPU-hours; " if overall else "")
           + f"largest run {peak / 2**20:.0f} MiB (pilots not counted)")
