@@ -36,6 +36,25 @@ def test_drift_per_doubling_between_the_two_largest_sizes():
     assert "per doubling of N" in text and "(-18%)" in text
 
 
+def test_a_steady_drift_in_steps_within_the_errors_is_a_drift():
+    # each of 27, 24 agrees with 21 ± 3 within 2 sigma, but the three fall by
+    # 1.5 ± 0.58 per doubling (weighted line in log2 N), 2.6 sigma from flat
+    text, n0, _, _ = size_verdict([1024, 4096, 16384, 65536], [30.0, 27.0, 24.0, 21.0], [1.0, 1.0, 1.0, 3.0])
+    assert n0 == 16384    # two sizes: agreement within the errors is all that can be asked
+    text, n0, _, _ = size_verdict([1024, 4096, 16384, 65536, 262144], [30.0, 27.0, 24.0, 21.0, 20.0],
+                                  [1.0, 1.0, 1.0, 1.0, 3.0])
+    # 65536 and 262144 agree within 262144's error; 16384 on agree with 20 ± 3 but fall, and it says so
+    assert n0 == 65536 and "over N = 16384 to 262144 the line in log2 N changes by -1.29 ± 0.58" in text
+    text, n0, _, _ = size_verdict([1024, 4096, 16384, 65536, 262144], [30.0, 27.0, 24.0, 21.0, 18.0], [1.0] * 5)
+    assert n0 is None and text.startswith("drifting")
+    from dynhet.analysis.size import flat_slope
+    b, e = flat_slope([(4096, 27.0, 1.0), (16384, 24.0, 1.0), (65536, 21.0, 3.0)])
+    assert math.isclose(b, -1.5, rel_tol=1e-9) and abs(e - 0.582) < 0.001
+    # flat within the errors: the line does not hold it back
+    text, n0, _, _ = size_verdict([1024, 4096, 16384, 65536], [12.3, 11.9, 12.2, 12.0], [0.2] * 4)
+    assert n0 == 1024
+
+
 def test_one_or_no_size():
     assert size_verdict([1024], [1.0], [0.1])[0] == "one N only"
     assert size_verdict([1024, 4096], [math.nan, math.nan], [0.1, 0.1])[0] == "no data"
@@ -56,6 +75,25 @@ def test_xi_needs_five_shells_below_q_xi_1():
     assert n == 7 >= MIN_SHELLS and math.isclose(v, 2.0) and math.isclose(e, 0.2)
     v, e, n = xi_shells({"cut": {0.6: s4_cut(4.0, L)}})
     assert n == 3 and math.isnan(v)
+
+
+def test_the_finite_size_xi_is_the_reproductions_xi():
+    # One function (quantities.xi_of_cut) for both documents: beyond the
+    # lags no xi (np.interp once took the last lag's), and the error is the
+    # OZ fit's and the interpolation's in quadrature.
+    from dynhet.analysis.quantities import xi_at_tau
+    L = 100.0
+    c = s4_cut(2.0, L)
+    c["xi_t"] = np.array([[1.6], [2.0], [3.0]])
+    run = {"N": 4096, "cut": {0.6: dict(c, tau_alpha=10.0, tau_alpha_err=0.1)}}
+    v, e, n = xi_shells(run)
+    assert (v, e) == xi_at_tau(run) and math.isclose(v, 2.0) and n == 7
+    run["cut"][0.6]["tau_alpha"] = 31.6   # between 10 and 100: the parabola through 3 lags is the interpolation error
+    v, e, n = xi_shells(run)
+    assert (v, e) == xi_at_tau(run) and 2.0 < v < 3.0 and e > 0.1 * 2.0
+    run["cut"][0.6]["tau_alpha"] = 150.0  # beyond the longest lag
+    v, e, n = xi_shells(run)
+    assert math.isnan(v) and n == 0 and math.isnan(xi_at_tau(run)[0])
 
 
 def test_the_report_on_three_sizes(tmp_path):

@@ -258,7 +258,9 @@ def still_drifting(multi, d, d_cr, n_top):
                     out.append(f"{name.split(':')[0]}{' — cage-relative' if cr else ''} not steady over the "
                                f"production at N = {n_top} ({fmt(m[0], measured_error(m))} %)")
                 continue
-            if text.startswith("drifting") and text.endswith(f"to {n_top}"):   # a drift up to that N, not below it
+            # a drift up to that N, not below it (the change between the two largest sizes ends the
+            # verdict's first part; a note on a longer range's line may follow it)
+            if text.startswith("drifting") and text.split("; over N = ")[0].endswith(f"to {n_top}"):
                 out.append(f"{name}{' — cage-relative' if cr else ''}{text[len('drifting'):]}")
     return out
 

@@ -78,8 +78,17 @@ def xi_at_tau(r, a=A_MAIN, own=False):
     """The whole box's OZ xi of cutoff a at tau_alpha (of a = 0.6, or own);
     NaN where it is below XI_MIN (S4 flat over the q range), longer than
     the box, or not resolved (fewer than MIN_SHELLS q shells below q xi = 1)."""
-    c = cut(r, a)
-    t = tau(r, a if own else A_MAIN)[0]
+    return xi_of_cut(cut(r, a), tau(r, a if own else A_MAIN)[0])[:2]
+
+
+def xi_of_cut(c, t):
+    """(xi, error, shells) of a cut's whole-box S4 at time t (a tau_alpha):
+    xi(t) interpolated in ln t between the lags around t (NaN outside the
+    lags), its error the OZ fit's relative error at tau_alpha and the
+    interpolation's in quadrature; NaN below XI_MIN or beyond the box, and
+    with fewer than MIN_SHELLS shells below q xi = 1 (their count is
+    returned either way: the finite-size table states it). The one xi of
+    the reproduction's rows and of the finite-size table."""
     g = whole_box_s4(c)
     off = int(np.sum(c["s4_nshells"][:g]))
     q = c["s4_q"][off:off + int(c["s4_nshells"][g])]
@@ -87,10 +96,11 @@ def xi_at_tau(r, a=A_MAIN, own=False):
     xi = c["xi_t"][:, g]
     xs = np.where((xi >= XI_MIN) & (xi <= box), xi, np.nan)
     v, ie = sf.interp_ln_t(c["s4_lag"], xs, t)
-    if np.isfinite(v) and not oz_resolved(c, g, v):
-        return math.nan, math.nan
+    shells = shells_below(c, g, v)
+    if np.isfinite(v) and shells < MIN_SHELLS:
+        return math.nan, math.nan, shells
     rel = c["s4_oz_xi_err"][g] / c["s4_oz_xi"][g] if np.isfinite(c["s4_oz_xi"][g]) and c["s4_oz_xi"][g] > 0 else math.nan
-    return v, math.hypot(abs(v) * rel if np.isfinite(rel) else math.nan, ie if np.isfinite(ie) else 0.0)
+    return v, math.hypot(abs(v) * rel if np.isfinite(rel) else math.nan, ie if np.isfinite(ie) else 0.0), shells
 
 
 def chi0_at_tau(r, a=A_MAIN, g=None):

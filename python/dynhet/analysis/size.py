@@ -119,14 +119,30 @@ def common_densities(multi):
 Z_CONVERGED = 2.0   # values within 2 combined standard errors agree
 
 
+def flat_slope(d):
+    """(slope per doubling of N, its error) of the weighted straight line
+    through d = [(N, value, error)] against log2 N (weights 1/error^2; the
+    error from the weights, not the residuals: the values' own errors)."""
+    x = np.log2([n for n, _, _ in d])
+    y = np.array([v for _, v, _ in d])
+    w = 1.0 / np.array([e for _, _, e in d]) ** 2
+    xm, ym = (w * x).sum() / w.sum(), (w * y).sum() / w.sum()
+    sxx = (w * (x - xm) ** 2).sum()
+    return float((w * (x - xm) * (y - ym)).sum() / sxx), float(1.0 / math.sqrt(sxx))
+
+
 def size_verdict(ns, vals, errs):
     """Converged or drifting, from the numbers (the one rule of every
     against-N verdict: the finite-size tables and the reproduction's rows):
     the smallest N0 such that the value at every N >= N0 agrees with the
-    largest N's within Z_CONVERGED combined errors (at least two sizes);
-    otherwise drifting. Either way the change per doubling of N between the
-    two largest sizes with its error, which bounds what "converged" means.
-    Returns (text, N0 or None, drift, error)."""
+    largest N's within Z_CONVERGED combined errors (at least two sizes) and,
+    where N >= N0 holds three sizes or more, the weighted line through them
+    against log2 N is flat within Z_CONVERGED of its error (a steady drift
+    whose every step is within the errors is a drift: 30, 27, 24, 21 with
+    errors 1, 1, 1, 3 each agree with 21 from 4096 on, and fall by 1.5 ± 0.6
+    per doubling); otherwise drifting. Either way the change per doubling
+    of N between the two largest sizes with its error, which bounds what
+    "converged" means. Returns (text, N0 or None, drift, error)."""
     d = [(n, v, e) for n, v, e in zip(ns, vals, errs) if np.isfinite(v) and np.isfinite(e)]
     if len(d) < 2:
         return ("one N only" if d else "no data"), None, math.nan, math.nan
@@ -137,17 +153,24 @@ def size_verdict(ns, vals, errs):
     drift, derr = (vmax - v1) / per, math.hypot(emax, e1) / per
     rel = f" ({100 * drift / abs(v1):+.0f}%)" if v1 else ""
     change = f"{fmt(drift, derr)} per doubling of N{rel} from N = {n1} to {nmax}"
-    n0 = None
-    for k in range(len(d) - 2, -1, -1):
-        n, v, e = d[k]
-        if abs(v - vmax) <= Z_CONVERGED * math.hypot(e, emax):
-            n0 = n
-        else:
-            break
+    n0, sloped = None, None
+    for k in range(len(d) - 1):
+        if not all(abs(v - vmax) <= Z_CONVERGED * math.hypot(e, emax) for _, v, e in d[k:-1]):
+            continue
+        if len(d) - k >= 3:
+            b, be = flat_slope(d[k:])
+            if abs(b) > Z_CONVERGED * be:
+                sloped = sloped or (d[k][0], b, be)
+                continue
+        n0 = d[k][0]
+        break
+    # a longer range that drifts says so beside any verdict of its tail
+    steady = (f"; over N = {sloped[0]} to {nmax} the line in log2 N changes by {fmt(sloped[1], sloped[2])} per "
+              f"doubling, {abs(sloped[1]) / sloped[2]:.1f}σ from flat" if sloped else "")
     if n0 is not None:
-        return (f"converged from N = {n0} on (within {Z_CONVERGED:g}σ of N = {nmax}; {change})",
+        return (f"converged from N = {n0} on (within {Z_CONVERGED:g}σ of N = {nmax}; {change}{steady})",
                 n0, drift, derr)
-    return f"drifting: {change}", None, drift, derr
+    return f"drifting: {change}{steady}", None, drift, derr
 
 
 def n_verdict(vals):

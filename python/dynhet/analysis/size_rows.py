@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from .config import A_MAIN, EPS_MAIN
-from .quantities import MIN_SHELLS, PER_RUN, XI_MIN, chi0_at_tau, kappa_of, shells_below, whole_box_s4
+from .quantities import MIN_SHELLS, PER_RUN, XI_MIN, chi0_at_tau, kappa_of, whole_box_s4, xi_of_cut
 from .runs import blocks_span
 from ..fits import interp_ln_t, slope_with_error
 
@@ -39,20 +39,12 @@ def chi4p_of(size):
 
 
 def xi_shells(r, cr=False):
-    """(xi, error, shells): the whole box's OZ xi at tau_alpha and how many q
-    shells lie below q xi = 1; xi is NaN with fewer than MIN_SHELLS shells
-    (not resolved at this N) or below XI_MIN."""
+    """(xi, error, shells): the whole box's OZ xi at tau_alpha (the
+    reproduction's xi: quantities.xi_of_cut) and how many q shells lie below
+    q xi = 1; xi is NaN with fewer than MIN_SHELLS shells (not resolved at
+    this N), below XI_MIN, beyond the box or outside the lags."""
     c = cutx(r, cr)
-    t = c["tau_alpha"]
-    g = whole_box_s4(c)
-    xi = np.interp(math.log(t), np.log(c["s4_lag"]), c["xi_t"][:, g]) if np.isfinite(t) else math.nan
-    if not np.isfinite(xi):
-        return math.nan, math.nan, 0
-    shells = shells_below(c, g, xi)
-    rel = c["s4_oz_xi_err"][g] / c["s4_oz_xi"][g] if c["s4_oz_xi"][g] > 0 else math.nan
-    if shells < MIN_SHELLS or xi < XI_MIN:
-        return math.nan, math.nan, shells
-    return xi, abs(xi) * rel, shells
+    return xi_of_cut(c, c["tau_alpha"])
 
 
 def shells_note(p, cr):
