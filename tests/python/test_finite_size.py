@@ -383,6 +383,59 @@ def test_a_tie_at_one_n_goes_to_the_study_that_runs_the_density_at_every_n():
     assert all(points_by_phi_n(A)[0.79][n] is scale[n] for n in scale)
 
 
+def test_each_densitys_table_is_one_protocol():
+    """The referee's rule: the same run lengths in units of the relaxation
+    time at every N. Protocols as the studies' run_length say (unit,
+    equilibration, origins, spacing; not the lag range)."""
+    from dynhet.analysis.size import others_note, points_by_phi_n
+
+    def point(study, n, seeds, phi=0.76, cr=False):
+        p = Point(("neighbours", 0.9, phi, n))
+        p.study = study
+        p.runs = [{"seed": s, "N": n, "study": study, **({"cut_cr": {0.6: {}}} if cr else {})}
+                  for s in range(1, seeds + 1)]
+        return p
+    A = Analysis.__new__(Analysis)
+    A.points = {}
+    scale = [point("scale", n, 3 if n <= 16384 else 1, cr=True) for n in (1024, 4096, 16384, 65536, 262144)]
+    d_size = [point("d_size", n, 1) for n in (4096, 16384, 65536, 262144, 1000000)]
+    quick = [point("quick", 4096, 4)]
+    fs = [point("finite_size", n, 1) for n in (1024, 16384)]
+    A.extra = {(p.study, p.pairs, p.eps, p.phi, p.N): p for p in scale + d_size + quick + fs}
+    A.protocols = {"scale": ("tau_alpha_cr", 10.0, 8, 1.0), "d_size": ("tau_alpha", 5.0, 4, 1.0),
+                   "quick": ("tau_alpha", 10.0, 8, 1.0), "finite_size": ("tau_alpha", 10.0, 8, 1.0)}
+    t = points_by_phi_n(A)[0.76]
+    # five sizes each: scale's (the cage-relative protocol); quick's four seeds at 4096 do not
+    # displace it, and d_size's 10^6 is named, not a column
+    assert t.protocol == A.protocols["scale"] and all(t[p.N] is p for p in scale) and 1000000 not in t
+    assert t.others == [("d_size", 1000000, 1)]
+    assert others_note(t) == "; not in this table, another study's protocol: N 1000000 of d_size (1 run)"
+    # D against N: the protocol reaching the largest N (d_size's), scale's 1024 named
+    t = points_by_phi_n(A, lead_by="n")[0.76]
+    assert t.protocol == A.protocols["d_size"] and sorted(t) == [4096, 16384, 65536, 262144, 1000000]
+    assert t.others == [("finite_size", 1024, 1), ("scale", 1024, 3)]
+    # quick and finite_size differ only in their lags: one protocol, merged (quick's seeds at 4096)
+    del A.extra["scale", "neighbours", 0.9, 0.76, 1024]
+    for p in d_size:
+        del A.extra["d_size", p.pairs, p.eps, p.phi, p.N]
+    A.protocols["scale"] = ("tau_alpha_cr", 10.0, 8, 2.0)      # not the same spacing
+    for n in (65536, 262144):
+        del A.extra["scale", "neighbours", 0.9, 0.76, n]
+    t = points_by_phi_n(A)[0.76]
+    assert t.protocol == A.protocols["quick"] and t[4096] is quick[0] and sorted(t) == [1024, 4096, 16384]
+    assert t.others == []   # scale's sizes (4096, 16384) are the table's already: none only it ran
+
+
+def test_a_studys_protocol_is_read_from_the_study_file_it_holds(tmp_path):
+    from dynhet.analysis.study import study_protocol
+    (tmp_path / "study.toml").write_text('[run_length]\nunit = "tau_alpha_cr"\nequilibration_tau = 10.0\n'
+                                         'origins = 8\nlag_max_tau = 4.0\n')
+    assert study_protocol(str(tmp_path)) == ("tau_alpha_cr", 10.0, 8, 1.0)   # the spacing's default
+    (tmp_path / "study.toml").write_text('[run_length]\nequilibration_tau = 5.0\norigins = 4\nlag_max_tau = 10.0\n')
+    assert study_protocol(str(tmp_path)) == ("tau_alpha", 5.0, 4, 1.0)
+    assert study_protocol(str(tmp_path / "none")) is None
+
+
 def test_the_reproduction_takes_xi_and_chi0_only_where_five_shells_resolve_them():
     """Item 4 holds for every xi and chi0 the reproduction uses (its rows and
     fits), not only for the finite-size table: xi = 2 in a box of side 100 has

@@ -14,7 +14,7 @@ from .config import A_MAIN
 from .plotting import colours, errorbar
 from .quantities import s4_at_tau
 from .points import MIN_CAL_DOF, ensure_calibrated, measured_error, spread_ratio as pooled_spread
-from .size import Z_CONVERGED, held_back, points_by_phi_n, size_verdict, study_of
+from .size import Z_CONVERGED, held_back, others_note, points_by_phi_n, size_verdict, study_of
 from .size_rows import (CHI4P_ROWS, MIN_SHELLS, TAU_ROWS, c_b_times, has_cr, lags_in_tau_cr, missing_cell, quantities,
                         shells_note, tau_b_bound, tau_b_points)
 from .verdicts import fmt
@@ -327,10 +327,12 @@ def write_finite_size(A, path, command):
          f"combined, times the study's factor below where its seeds scatter more; the seeds' spread where no run "
          f"quotes one; \"no error\" where one seed quotes none, and such a "
          f"size takes no part in the verdict); ¹ one seed: its error is the run's own (jackknife over origin blocks, times the study's factor below where it has one for that quantity), which no spread of seeds checks at that N; \"(k of m seeds)\": only k of the size's m runs have a "
-         f"value (the others not resolved or not reached), and it takes no part in the verdict either. Where several studies ran the same φ and N, the cells "
-         f"take the one with the most seeds, and among as many the study that runs that φ at the most N (one "
-         f"protocol, run lengths in units of τ_α^CR, across the sizes), then the one with the cage-relative "
-         f"measures (that protocol); the line under each table names each N's study. A verdict is computed from the "
+         f"value (the others not resolved or not reached), and it takes no part in the verdict either. Each density's "
+         f"table is one protocol's (the same unit of the run lengths, equilibration, origins and their spacing at "
+         f"every N: the studies' run_length): the protocol whose studies run that φ at the most N, and among as many "
+         f"the one with the cage-relative measures (run lengths in units of τ_α^CR); sizes only another protocol ran "
+         f"are named under the table, not used. Where several studies of it ran the same φ and N, the one with the "
+         f"most seeds; the line under each table names each N's study. A verdict is computed from the "
          f"numbers: **converged** from the smallest N whose value and every larger N's agree with the largest "
          f"N's within {Z_CONVERGED:g} combined errors, and where those are three sizes or more, whose weighted line "
          f"against log2 N is flat within {Z_CONVERGED:g} of its error (a steady drift in steps each within the errors "
@@ -374,7 +376,7 @@ def write_finite_size(A, path, command):
                 if slug == "xi":  # how many q shells its fits had below q xi = 1 (issue 27, item 4)
                     cells = [c + shells_note(dd.get(n), cr) for c, n in zip(cells, qn)]
                 L.append(f"| {label} | " + " | ".join(cells) + f" | {text} |")
-        seeds = ", ".join(f"N {n}: {len(d[n].runs)} ({study_of(d[n])})" for n in ns)
+        seeds = ", ".join(f"N {n}: {len(d[n].runs)} ({study_of(d[n])})" for n in ns) + others_note(d)
         held = [f"N {n} of {st} ({k} run{'s' if k > 1 else ''} not complete)" for n, st, k in held_back(A, phi)]
         if held:
             seeds += "; held back, no conclusion from a size whose runs did not all finish: " + ", ".join(held)

@@ -12,29 +12,93 @@ from .verdicts import fmt
 from .plotting import colours, errorbar, log_axes
 
 
-def points_by_phi_n(A, has=lambda p: True):
-    """{phi: {N: Point}} of the main dynamics over this study and the --also
-    studies, the point with most runs where several have the same phi and N,
-    and among those with as many, the one whose study runs that phi at the
-    most N: one protocol (run lengths in units of tau_alpha^CR) across the
-    sizes, not a single-N study's; then the one with the cage-relative
-    measures (that protocol's); only densities run at more than one N."""
+class SizeTable(dict):
+    """{N: Point} of one density, all of one protocol (`protocol`, the
+    leading one: leading_protocol); `others`: [(study, N, runs)] the sizes
+    only studies of another protocol ran, left out of the table, to be named
+    beside it."""
+    def __init__(self, protocol, points, others):
+        super().__init__(points)
+        self.protocol, self.others = protocol, others
+
+
+def main_candidates(A, has=lambda p: True):
+    """The points of the main series (neighbours, eps 0.9) that `has` takes
+    and whose sizes are not held back (held_sizes)."""
     held = held_sizes(A, has)
-    allp = [p for p in list(A.points.values()) + list(A.extra.values())
+    return [p for p in list(A.points.values()) + list(A.extra.values())
             if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p) and not held(p)]
-    sizes = {}
-    for p in allp:
-        sizes.setdefault((study_of(p), p.phi), set()).add(p.N)
-    # then the protocol that measures tau_alpha^CR (run lengths in its units, studies/scale.toml)
-    rank = lambda p: (len(p.runs), len(sizes[(study_of(p), p.phi)]),
-                      any(A_MAIN in (r.get("cut_cr") or {}) for r in p.runs))
+
+
+def protocol_of(A, study):
+    """A study's protocol: its run lengths' unit, equilibration, origins and
+    their spacing (Analysis.protocols, from each study's study.toml; the lag
+    range is not part of it: it sets what a run reaches, and a cell says
+    "not reached"). None where the study file does not say (all such
+    studies count as one)."""
+    return getattr(A, "protocols", {}).get(study)
+
+
+def leading_protocol(A, phi, ps, lead_by="cr"):
+    """The protocol whose runs a density's against-N table takes: the one
+    whose studies run phi at the most N (their unfinished sizes counted:
+    planned_sizes); among as many, with lead_by "cr" the one with the
+    cage-relative measures (studies/scale.toml: run lengths in units of
+    tau_alpha^CR), with "n" the one reaching the largest N (D against N:
+    studies/d_size.toml to 10^6); then the most runs."""
+    planned = planned_sizes(A, ps).get(phi, {})
+    studies = {}
+    for st in set(planned) | {study_of(p) for p in ps}:
+        studies.setdefault(protocol_of(A, st), set()).add(st)
+
+    def key(pr):
+        own = [p for p in ps if study_of(p) in studies[pr]]
+        sizes = set().union(*(planned.get(st, set()) for st in studies[pr])) | {p.N for p in own}
+        cr = any(A_MAIN in (r.get("cut_cr") or {}) for p in own for r in p.runs)
+        return (len(sizes), cr if lead_by == "cr" else max(sizes), sum(len(p.runs) for p in own), str(pr))
+    return max((pr for pr in studies if any(study_of(p) in studies[pr] for p in ps)), key=key)
+
+
+def points_by_phi_n(A, has=lambda p: True, lead_by="cr"):
+    """{phi: SizeTable} of the main dynamics over this study and the --also
+    studies, each density's sizes of one protocol (the same run lengths in
+    units of the same relaxation time, the same origins, at every N:
+    leading_protocol); at a size that several of its studies ran, the point
+    with the most runs, and among as many the study that runs that phi at
+    the most N (then the one with the cage-relative measures). The sizes
+    only another protocol ran are named in the table's `others`, not used
+    (d_size's one-seed N = 10^6 at phi 0.76, 5 tau_alpha of equilibration
+    and 4 origins, is not a column of scale's table). Only densities with
+    more than one N."""
     by_phi = {}
-    for p in allp:
-        by_phi.setdefault(p.phi, {})
-        q = by_phi[p.phi].get(p.N)
-        if q is None or rank(p) > rank(q):
-            by_phi[p.phi][p.N] = p
-    return {phi: d for phi, d in sorted(by_phi.items()) if len(d) > 1}
+    for p in main_candidates(A, has):
+        by_phi.setdefault(p.phi, []).append(p)
+    out = {}
+    for phi, ps in sorted(by_phi.items()):
+        lead = leading_protocol(A, phi, ps, lead_by)
+        mine = [p for p in ps if protocol_of(A, study_of(p)) == lead]
+        sizes = {}
+        for p in mine:
+            sizes.setdefault(study_of(p), set()).add(p.N)
+        rank = lambda p: (len(p.runs), len(sizes[study_of(p)]), any(A_MAIN in (r.get("cut_cr") or {}) for r in p.runs))
+        d = {}
+        for p in mine:
+            if p.N not in d or rank(p) > rank(d[p.N]):
+                d[p.N] = p
+        others = sorted({(str(study_of(p)), p.N, len(p.runs)) for p in ps if p.N not in d},
+                        key=lambda x: (x[1], x[0]))
+        if len(d) > 1:
+            out[phi] = SizeTable(lead, d, others)
+    return out
+
+
+def others_note(d):
+    """The sizes a density's table leaves out (SizeTable.others), as a clause; "" without."""
+    others = getattr(d, "others", [])
+    if not others:
+        return ""
+    return ("; not in this table, another study's protocol: "
+            + ", ".join(f"N {n} of {st} ({k} run{'s' if k > 1 else ''})" for st, n, k in others))
 
 
 def held_sizes(A, has=lambda p: True):
@@ -61,14 +125,7 @@ def protocol_waiting(A, allp):
     any of them: the studies' sizes say nothing of their protocols, and at
     phi 0.76 d_size's one-seed overlap-only runs tie scale's five sizes)
     has runs of that N unfinished (the first such study by name)."""
-    planned = {}
-    for p in allp:
-        planned.setdefault(p.phi, {}).setdefault(study_of(p), set()).add(p.N)
-    main = [(st, ph, n, k) for (st, pairs, eps, ph, n), k in getattr(A, "unfinished", {}).items()
-            if k and pairs == "neighbours" and abs(eps - EPS_MAIN) < 1e-9]
-    for st, ph, n, _ in main:
-        phi = next((f for f in planned if abs(f - ph) < 1e-9), ph)
-        planned.setdefault(phi, {}).setdefault(st, set()).add(n)
+    planned, main = planned_sizes(A, allp), unfinished_main(A)
     out = {}
     for st, ph, n, k in sorted(main):
         phi = next((f for f in planned if abs(f - ph) < 1e-9), ph)
@@ -76,6 +133,25 @@ def protocol_waiting(A, allp):
         if len(planned[phi][st]) == most and (phi, n) not in out:
             out[(phi, n)] = (st, k)
     return out
+
+
+def unfinished_main(A):
+    """[(study, phi, N, runs unfinished)] of the main series (Analysis.unfinished)."""
+    return [(st, ph, n, k) for (st, pairs, eps, ph, n), k in getattr(A, "unfinished", {}).items()
+            if k and pairs == "neighbours" and abs(eps - EPS_MAIN) < 1e-9]
+
+
+def planned_sizes(A, allp):
+    """{phi: {study: set of N}}: the sizes of points allp, and the sizes
+    with runs unfinished of the main series (a study's protocol counts the
+    sizes it will have)."""
+    planned = {}
+    for p in allp:
+        planned.setdefault(p.phi, {}).setdefault(study_of(p), set()).add(p.N)
+    for st, ph, n, _ in unfinished_main(A):
+        phi = next((f for f in planned if abs(f - ph) < 1e-9), ph)
+        planned.setdefault(phi, {}).setdefault(st, set()).add(n)
+    return planned
 
 
 def waiting_for(waiting, p):
@@ -185,7 +261,7 @@ def d_n_results(A):
     in two dimensions box-scale flows carry part of D and may make both
     depend on the box (issue 31, item 8)."""
     dD = lambda r: (r.get("D", math.nan), r.get("D_err", math.nan))
-    multi = points_by_phi_n(A, lambda p: np.isfinite(p.mean(dD)[0]))
+    multi = points_by_phi_n(A, lambda p: np.isfinite(p.mean(dD)[0]), lead_by="n")
     if not multi:
         A.row("D against N (box-scale flows)", "3.2 (D, θ)", "not studied",
               "one N per density (add studies/d_size.toml with --also)", "not run", "", [])

@@ -6,6 +6,7 @@ import tomllib
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ..study.model import RUN_LENGTH_DEFAULTS
 from .config import A_MAIN, EPS_MAIN
 from .runs import read_run
 from .points import Point, ensure_calibrated, point_error
@@ -29,6 +30,19 @@ def drawable(ax):
         if ok.any():
             return True
     return not ax.get_lines() and ax.has_data()  # images, patches: left as they are
+
+
+def study_protocol(sdir):
+    """(unit, equilibration_tau, origins, origin_spacing_tau) of the study
+    file its directory holds (run_study.sh copies it there): what makes two
+    studies' runs one protocol (size.protocol_of); None without one."""
+    try:
+        with open(os.path.join(sdir, "study.toml"), "rb") as fh:
+            rl = tomllib.load(fh).get("run_length", {})
+    except (OSError, tomllib.TOMLDecodeError):
+        return None
+    rl = dict(RUN_LENGTH_DEFAULTS, **rl)
+    return rl["unit"], float(rl["equilibration_tau"]), int(rl["origins"]), float(rl["origin_spacing_tau"])
 
 
 class Analysis:
@@ -63,6 +77,8 @@ class Analysis:
         with open(idx, "rb") as fh:
             runs = tomllib.load(fh).get("runs", {})
         study = os.path.basename(sdir.rstrip("/"))
+        self.protocols = getattr(self, "protocols", {})
+        self.protocols[study] = study_protocol(sdir)
         for name, m in sorted(runs.items()):
             path = os.path.join(sdir, m["path"], "run.h5")
             try:
