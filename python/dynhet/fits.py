@@ -36,6 +36,7 @@ class Fit:
         self.err = {n: math.nan for n in names}     # from the covariance of the fit
         self.jk = {n: math.nan for n in names}      # jackknife over seeds (set by jackknife_over_seeds)
         self.jk_seeds = 0                           # the seeds behind jk
+        self.jk_partial = False                     # some points have one seed: jk misses their noise
         self.jk_p = []                              # the jackknife replicas' parameters (derived())
         self.cov, self.cov_names = None, []         # the fit's covariance, where it keeps it (derived())
         self.chi2 = math.nan
@@ -61,7 +62,7 @@ class Fit:
 
     def _quoted(self, jk, own):
         e = jk if np.isfinite(jk) else own
-        if self.jk_seeds < MIN_JK_SEEDS and np.isfinite(own):
+        if (self.jk_seeds < MIN_JK_SEEDS or self.jk_partial) and np.isfinite(own):
             e = max(e, own)
         r = self.chi2_dof()
         if np.isfinite(r) and r > 1 and np.isfinite(own):
@@ -374,10 +375,16 @@ def jackknife_over_seeds(fit_fn, seeds, fit=None):
     n = len(reps)
     fit.jk_seeds = n
     fit.jk_p = [dict(r.p) for r in reps]
+    failed = set()
     for name in fit.names:
-        th = np.array([r.p.get(name, math.nan) for r in reps], float)
+        th = np.array([r.p.get(name, math.nan) if r.ok else math.nan for r in reps], float)
         if np.all(np.isfinite(th)):
             fit.jk[name] = float(math.sqrt((n - 1) / n * ((th - th.mean()) ** 2).sum()))
+        else:
+            failed |= {s for s, t in zip(seeds, th) if not np.isfinite(t)}
+    if failed:   # no jackknife where a replicate has no value: the fit's own error, and it says so
+        fit.note = ((fit.note + "; " if fit.note else "") + f"the fit without seed {', '.join(map(str, sorted(failed)))} "
+                    "failed: the fit's own error, no jackknife over seeds")
     return fit
 
 

@@ -72,6 +72,41 @@ def test_a_jackknife_over_two_seeds_is_not_taken_alone():
     assert four.chi2_dof() < 1
 
 
+def test_a_seed_jackknife_keeps_the_points_of_one_seed_in_every_replicate():
+    # The largest-N table mixes points of 4 seeds with points of one (scale's
+    # N = 262144): leaving "seed 1" out of a one-seed point dropped the point,
+    # and the replicates were fits over other densities. It stays; the
+    # jackknife then misses its noise, so the fit's own error is a floor.
+    from dynhet.analysis.points import Point, fit_series
+    rng = np.random.default_rng(11)
+    pts = []
+    for k, x in enumerate(np.geomspace(1, 50, 6)):
+        p = Point(("neighbours", 0.9, 0.70 + 0.01 * k, 4096))
+        for seed in ((1,) if k >= 4 else (1, 2, 3, 4)):
+            v = 2 * x ** 1.5 * np.exp(rng.normal(0, 0.05))
+            p.runs.append({"seed": seed, "x": x, "y": v, "y_err": 0.05 * v})
+        pts.append(p)
+    assert pts[5].mean(lambda r: (r["y"], r["y_err"]), drop=1)[3] == 1   # one seed: kept
+    assert pts[0].mean(lambda r: (r["y"], r["y_err"]), drop=1)[3] == 3   # four: seed 1 left out
+    sizes = []
+    f = fit_series(pts, lambda r: (r["y"], r["y_err"]), lambda x, y, e: (sizes.append(len(x)), sf.power(x, y, e))[1],
+                   xpoint=lambda p: p.runs[0]["x"])
+    assert sizes == [6] * 5                # the fit and each of the 4 replicates: every point
+    assert f.jk_seeds == 4 and f.jk_partial
+    assert f.error("s") >= f.err["s"] and abs(f.p["s"] - 1.5) < 4 * f.error("s")
+
+
+def test_a_jackknife_replicate_that_fails_is_said():
+    x = np.geomspace(1, 50, 8)
+    y = 2 * x
+
+    def one(drop):
+        return sf.power(x, y if drop != 3 else np.full_like(y, np.nan), 0.1 * y)
+    f = sf.jackknife_over_seeds(one, [1, 2, 3, 4])
+    assert math.isnan(f.jk["s"]) and "the fit without seed 3 failed" in f.note
+    assert f.error("s") == f.err["s"]
+
+
 def test_no_verdict_from_a_fit_whose_error_exceeds_its_value():
     from dynhet.analysis.verdicts import fit_verdict
     rng = np.random.default_rng(3)

@@ -133,7 +133,14 @@ class Point:
         """(mean over seeds, its error: the runs' quoted errors combined, times
         the study's calibration factor for fn, or the seeds' spread where no run
         quotes one; the seeds' own standard error; seeds used)."""
-        vals = [(s, v, e) for s, v, e in self.values(fn) if s != drop and np.isfinite(v)]
+        vals = [(s, v, e) for s, v, e in self.values(fn) if np.isfinite(v)]
+        # A jackknife over seeds leaves a seed out of every point that has
+        # others; a point of one seed stays (left out, each replicate would
+        # be a fit over other points, and the replicates' scatter no spread
+        # of seeds). Its noise is then in the fit's own error only, which
+        # Fit.error takes as a floor (jk_partial, fit_series).
+        if len(vals) > 1:
+            vals = [x for x in vals if x[0] != drop]
         if not vals:
             return math.nan, math.nan, math.nan, 0
         m, sem, n = sf.seed_mean([v for _, v, _ in vals])
@@ -195,4 +202,7 @@ def fit_series(points, fn, form, xrun=None, xpoint=lambda p: p.phi, **kw):
     def one(drop):
         a = paired_arrays(points, fn, xrun, drop, xpoint)
         return form(*a[:3], sx=a[3], **kw) if len(a) == 4 else form(*a, **kw)
-    return sf.jackknife_over_seeds(one, seeds_of(points))
+    fit = sf.jackknife_over_seeds(one, seeds_of(points))
+    # points measured by one seed: the jackknife cannot see their noise
+    fit.jk_partial = any(0 < p.mean(fn)[3] < 2 or (xrun is not None and 0 < p.mean(xrun)[3] < 2) for p in points)
+    return fit
