@@ -78,3 +78,20 @@ def test_the_cutoff_studys_d_f_prime_fits_over_the_same_xi_range_as_every_other(
         pts.append(p)
     f = df_fit(pts, lambda r: (r["chi4"], 0.02 * r["chi4"]), lambda r: (r["xi"], 0.01 * r["xi"]))
     assert f.ok and f.n == 4 and abs(f.p["s"] - 1.6) < 0.02
+
+
+def test_chi4_at_tau_alpha_takes_one_sub_box_size_at_every_n():
+    # With --largest-n a series mixes N = 4096 with 65536 and 262144: the
+    # largest grid below the whole box would be 455 particles at one density
+    # and 29127 at another. chi4(tau_alpha) takes the grid of about 4096 / 9.
+    from dynhet.analysis.quantities import proper_subbox
+    sizes = {4096: [28.4, 113.8, 455.1, 4096.0],
+             65536: [28.4, 113.8, 455.1, 1820.4, 7281.8, 65536.0],
+             262144: [28.4, 113.8, 455.1, 1820.4, 7281.8, 29127.1, 262144.0]}
+    for n, ns in sizes.items():
+        assert math.isclose(ns[proper_subbox({"chi4_N": np.array(ns)}, n)], 455.1)
+    # a box too small for it: its largest proper grid; one grid only: that one
+    assert proper_subbox({"chi4_N": np.array([28.4, 113.8, 1024.0])}, 1024) == 1
+    assert proper_subbox({"chi4_N": np.array([1024.0])}, 1024) == 0
+    # sub-boxes far from 455 (a study that asked for others): the largest below the box
+    assert proper_subbox({"chi4_N": np.array([64.0, 1600.0, 65536.0])}, 65536) == 1

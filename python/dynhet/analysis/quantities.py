@@ -16,11 +16,29 @@ def tau(r, a=A_MAIN):
     return c["tau_alpha"], c["tau_alpha_err"]
 
 
+# The sub-box of chi4(tau_alpha), tau4 and every fit across densities: one
+# size at every N (the paper divides its box into sub-boxes of a chosen
+# number of particles), 4096 / 9, the largest proper sub-box of the N = 4096
+# box the reproduction was first made at. With --largest-n a series mixes
+# N = 4096 with 65536 and 262144: "the largest grid below the whole box"
+# would have been 455 particles at one density and 29127 at the next, and
+# chi4 grows with the sub-box until it saturates (fig. chi4P).
+CHI4_SUBBOX = 4096 / 9
+
+
 def proper_subbox(c, N):
-    """Index of the largest sub-box grid smaller than the whole box (or the largest)."""
+    """Index of the sub-box grid of chi4(tau_alpha): the one of about
+    CHI4_SUBBOX particles (within a factor 1.6) where it is smaller than the
+    whole box; else the largest grid smaller than the whole box (N < 4096:
+    the size is not there), else the largest."""
     ns = np.asarray(c["chi4_N"], float)
     ok = np.where(ns < 0.999 * N)[0]
-    return int(ok[np.argmax(ns[ok])]) if len(ok) else int(np.argmax(ns))
+    if not len(ok):
+        return int(np.argmax(ns))
+    near = ok[np.argmin(np.abs(np.log(ns[ok] / CHI4_SUBBOX)))]
+    if abs(math.log(ns[near] / CHI4_SUBBOX)) <= math.log(1.6):
+        return int(near)
+    return int(ok[np.argmax(ns[ok])])
 
 
 def tau4_of(r, g):
