@@ -28,9 +28,9 @@ def test_each_differing_row_is_restated(tmp_path):
             dict(item="φ_c", ours="0.8004 ± 0.0005", verdict="not judged: on the edge of the data"),
             dict(item="β", ours="1.4", verdict="figure")]
     text = "\n".join(restate(str(old), rows))
-    assert "| d_f' | 0.95 ± 0.09; differs (7.4 σ) | 1.5 ± 0.2; agrees (0.5 σ) | now agrees |" in text
+    assert "| d_f' | 0.95 ± 0.09; differs (7.4 σ) | 1.5 ± 0.2; agrees (0.5 σ) | now agrees; error 2.2× the earlier one's |" in text
     assert "| φ_c (own) | 0.8004 ± 0.0005; differs (40.0 σ); χ²/dof 22 | 0.8004 ± 0.0005; not judged: on the edge" in text
-    assert "now not judged |" in text
+    assert "now not judged; error 1× the earlier one's |" in text   # the same error: the verdict moved, not the error
     assert "| gone row | 1.66 ± 0.005; differs (26.6 σ) | — | no such row now |" in text
     assert "3 rows differed; 0 still differ, 2 have another verdict now, 1 have no row now." in text
 
@@ -50,7 +50,7 @@ def test_tables_between_say_at_which_step_a_verdict_moved(tmp_path):
     text = "\n".join(restate(str(old), rows, [("errors fixed", str(fixed)), ("other seeds", str(seeds))]))
     assert "| result (earlier) | earlier: ours, verdict | errors fixed | other seeds | now: ours, verdict | change |" in text
     assert ("| d_f' | 0.95 ± 0.09; differs (7.4 σ) | 0.84 ± 0.52; agrees (1.5 σ) | 0.7 ± 0.2; differs (4.5 σ) | "
-            "1.3 ± 0.2; agrees (1.2 σ) | now agrees (agrees at errors fixed, differs at other seeds, agrees at now) |"
+            "1.3 ± 0.2; agrees (1.2 σ) | now agrees (agrees at errors fixed, differs at other seeds, agrees at now); error 2.2× the earlier one's |"
             in text)
     # the row is not in "other seeds": its column says so, and the verdict compared across the gap
     assert "| gone row | 1.66 ± 0.005; differs (26.6 σ) | 1.66 ± 0.005; differs (26.6 σ) | — | 1.72 ± 0.006; " \
@@ -88,4 +88,4 @@ def test_how_far_each_step_moved_the_value_in_errors(tmp_path):
     old.write_text(OLD, encoding="utf-8")
     rows = [dict(item="d_f'", ours="1.3 ± 0.2", verdict="agrees (1.2 σ)")]
     text = "\n".join(restate(str(old), rows))
-    assert "| d_f' | 0.95 ± 0.09; differs (7.4 σ) | 1.3 ± 0.2; agrees (1.2 σ) | now agrees | 1.6 |" in text
+    assert "| d_f' | 0.95 ± 0.09; differs (7.4 σ) | 1.3 ± 0.2; agrees (1.2 σ) | now agrees; error 2.2× the earlier one's | 1.6 |" in text

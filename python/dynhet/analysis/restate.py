@@ -117,6 +117,11 @@ def restate(old_path, rows, via=()):
                     prev = k
             if moves:
                 change += " (" + ", ".join(moves) + ")"
+        # a verdict can change because the value moved or because the error grew (one seed at a larger
+        # N): the error's ratio to the earlier one says which
+        vo, vn = value_of(ours), value_of(match[0])
+        if kind(match[1]) != kind(verdict) and vo and vn and vo[1] > 0:
+            change += f"; error {vn[1] / vo[1]:.2g}× the earlier one's"
         n["same" if kind(match[1]) == "differs" else "new"] += 1
         moved = shifts([ours] + [m[0] if m else "" for m in mids] + [match[0]])
         out.append(f"| {item} | {ours}; {verdict} | " + "".join(c + " | " for c in cells)
