@@ -645,6 +645,11 @@ def test_a_size_whose_tau_alpha_moves_over_its_production_is_not_steady(tmp_path
     write_finite_size(A, str(out), "analyse_study.sh study")
     row = next(l for l in out.read_text().splitlines() if l.startswith("| τ_α(t0): change over the production"))
     assert "| not steady at N = 262144 (-5" in row and "0 within 3 errors at N = 4096, 16384 |" in row
+    # its values are no steady state's: marked, and out of the verdict (which ends at 16384)
+    row = next(l for l in out.read_text().splitlines() if l.startswith("| τ_α |"))
+    cells = row.split(" | ")
+    assert cells[3].endswith("‡") and not cells[1].endswith("‡") and not cells[2].endswith("‡")
+    assert "converged from N = 4096 on (within 2σ of N = 16384" in row
     notes = still_drifting({0.78: d}, d, {}, 262144)
     assert len(notes) == 1 and notes[0].startswith("τ_α(t0) not steady over the production at N = 262144 (-5")
     assert still_drifting({0.78: d}, d, {}, 16384) == []

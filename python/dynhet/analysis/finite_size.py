@@ -16,7 +16,7 @@ from .quantities import s4_at_tau
 from .points import MIN_CAL_DOF, ensure_calibrated, measured_error, spread_ratio as pooled_spread
 from .size import Z_CONVERGED, held_back, others_note, points_by_phi_n, size_verdict, study_of
 from .size_rows import (CHI4P_ROWS, MIN_SHELLS, TAU_ROWS, c_b_times, has_cr, lags_in_tau_cr, missing_cell, quantities,
-                        shells_note, tau_b_bound, tau_b_points)
+                        production_change, shells_note, tau_b_bound, tau_b_points)
 from .verdicts import fmt
 
 
@@ -88,9 +88,13 @@ def quantity_rows(d, fn, cr, ns=None, slug=None):
     ms = [d[n].mean(lambda r: fn(r, cr)) if n in d and not (slug == "tau_b" and tau_b_bound(d[n]) is not None)
           else nan for n in ns]
     whole = [n in d and m[3] == len(d[n].runs) for n, m in zip(ns, ms)]   # every seed has it (cell)
-    verdict = size_verdict(ns, [m[0] for m in ms], [measured_error(m) if w else math.nan for m, w in zip(ms, whole)])
     if slug == "tau_t0_change":   # a steady state is 0 at each N, not an N-independent value
         return ns, ms, (steady_verdict(ns, ms, whole), None, math.nan, math.nan)
+    # a size whose tau_alpha(t0) still moves over its production (of the same measure, standard or
+    # cage-relative) is no steady state: shown, marked, and out of the verdict
+    off = [n in d and bool(unsteady(d[n], cr)) for n in ns]
+    verdict = size_verdict(ns, [m[0] for m in ms], [measured_error(m) if w and not o else math.nan
+                                                    for m, w, o in zip(ms, whole, off)])
     shown = sum(np.isfinite(m[0]) for m in ms)
     judged = sum(np.isfinite(m[0]) and w and np.isfinite(measured_error(m)) for m, w in zip(ms, whole))
     if verdict[1] is None and judged < 2 and shown > judged:   # the cells show sizes the verdict cannot take
@@ -110,6 +114,14 @@ def steady_off(m, whole):
     if not (whole and np.isfinite(m[0]) and np.isfinite(e)):
         return None
     return abs(m[0]) > Z_STEADY * e
+
+
+def unsteady(p, cr):
+    """Whether point p's tau_alpha(t0) (cage-relative with cr) moves over the
+    production by more than Z_STEADY errors (steady_off; False where it
+    cannot be judged)."""
+    m = p.mean(lambda r: production_change(r, cr))
+    return bool(steady_off(m, m[3] == len(p.runs)))
 
 
 def steady_verdict(ns, ms, whole):
@@ -327,7 +339,10 @@ def write_finite_size(A, path, command):
          f"combined, times the study's factor below where its seeds scatter more; the seeds' spread where no run "
          f"quotes one; \"no error\" where one seed quotes none, and such a "
          f"size takes no part in the verdict); ¹ one seed: its error is the run's own (jackknife over origin blocks, times the study's factor below where it has one for that quantity), which no spread of seeds checks at that N; \"(k of m seeds)\": only k of the size's m runs have a "
-         f"value (the others not resolved or not reached), and it takes no part in the verdict either. Each density's "
+         f"value (the others not resolved or not reached), and it takes no part in the verdict either; ‡ not steady: "
+         f"the size's τ_α(t0) (of the same measure, standard or cage-relative) moves over its production by more "
+         f"than {Z_STEADY:g} errors (the row \"τ_α(t0): change over the production\"), so its values are no "
+         f"steady state's: shown, and out of the verdict. Each density's "
          f"table is one protocol's (the same unit of the run lengths, equilibration, origins and their spacing at "
          f"every N: the studies' run_length): the protocol whose studies run that φ at the most N, and among as many "
          f"the one with the cage-relative measures (run lengths in units of τ_α^CR); sizes only another protocol ran "
@@ -372,7 +387,9 @@ def write_finite_size(A, path, command):
                 label = name + (" — cage-relative" if cr else "")
                 if slug == "c_b":
                     label = f"C_B at t = {dict(cb_at).get(round(float(phi), 6), math.nan):.4g} (bond breaking)"
-                cells = [w or cell(m, len(dd[n].runs) if n in dd else 0) for m, w, n in zip(ms, why, qn)]
+                cells = [w or cell(m, len(dd[n].runs) if n in dd else 0)
+                         + (" ‡" if slug != "tau_t0_change" and n in dd and unsteady(dd[n], cr) else "")
+                         for m, w, n in zip(ms, why, qn)]
                 if slug == "xi":  # how many q shells its fits had below q xi = 1 (issue 27, item 4)
                     cells = [c + shells_note(dd.get(n), cr) for c, n in zip(cells, qn)]
                 L.append(f"| {label} | " + " | ".join(cells) + f" | {text} |")

@@ -270,7 +270,7 @@ def largest_n_notes(A):
     tau_alpha (size_verdict over the sizes of that density: "largest
     converged", else "largest available"), and the larger sizes held back
     because runs of them are unfinished."""
-    from .finite_size import quantity_rows   # the finite-size table's own verdicts
+    from .finite_size import quantity_rows, unsteady   # the finite-size table's own verdicts
     from .size import points_by_phi_n
     from .size_rows import has_cr, tau_of
     multi = points_by_phi_n(A)   # the main series (neighbours, eps = 0.9): the others have no sizes of their own here
@@ -284,7 +284,9 @@ def largest_n_notes(A):
             continue
         _, _, (text, n0, _, _) = quantity_rows({n: d[n] for n in ns}, tau_of, False)
         drifting = still_drifting(multi, d, multi_cr.get(p.phi, {}), p.N)
-        out.append(f"φ = {p.phi:g}: N = {p.N} is the largest " + ("converged" if n0 is not None else "available")
+        # a size that is not steady takes no part in the verdict: not "converged" itself
+        converged = n0 is not None and not unsteady(d[p.N], False)
+        out.append(f"φ = {p.phi:g}: N = {p.N} is the largest " + ("converged" if converged else "available")
                    + f" N for τ_α ({text})" + (f"; at that N still drifting, or not steady (finite_size.md): {'; '.join(drifting)}"
                                               if drifting else ""))
     if out:
