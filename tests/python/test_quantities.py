@@ -95,3 +95,21 @@ def test_chi4_at_tau_alpha_takes_one_sub_box_size_at_every_n():
     assert proper_subbox({"chi4_N": np.array([1024.0])}, 1024) == 0
     # sub-boxes far from 455 (a study that asked for others): the largest below the box
     assert proper_subbox({"chi4_N": np.array([64.0, 1600.0, 65536.0])}, 65536) == 1
+
+
+def test_kappa_of_a_run_carries_the_scatter_of_its_bins():
+    # bins that scatter 3 times their errors about the power law: kappa's
+    # error is the fit's times sqrt(chi2/dof), not the covariance's alone
+    from dynhet import fits as sf
+    from dynhet.analysis.quantities import kappa_of
+    rng = np.random.default_rng(4)
+    n = np.geomspace(1, 3000, 25)
+    p = n ** -1.8 * np.exp(-n / 1000.0)
+    pe = 0.02 * p
+    noisy = p * (1 + 3 * 0.02 * rng.standard_normal(len(n)))
+    r = {"cut": {0.6: {"cl_size": n, "cl_width": np.gradient(n), "cl_p_slow": noisy, "cl_p_slow_err": pe}}}
+    k, e = kappa_of(r)
+    from dynhet.analysis.quantities import n_star
+    m = (n >= 3) & (n <= n_star(r)[0])
+    f = sf.power(n[m], noisy[m], pe[m])
+    assert f.chi2_dof() > 3 and math.isclose(e, f.err["s"] * math.sqrt(f.chi2_dof()))

@@ -164,7 +164,9 @@ def kappa_of(r, lo=3.0, a=A_MAIN):
     """kappa of slow clusters: P(N_c) ~ N_c^-kappa fitted to the bins with
     lo <= N_c <= N* (the run's cutoff size <N_c^2>/<N_c>: beyond it the
     scaling function cuts the power law off), weighted by the bins' errors;
-    NaN with fewer than 3 bins."""
+    its error the fit's, times sqrt(chi2/dof) where the bins scatter more
+    than their errors say (Fit.error: the Birge ratio); NaN with fewer than
+    3 bins."""
     c = cut(r, a)
     if "cl_size" not in c:
         return math.nan, math.nan
@@ -174,7 +176,7 @@ def kappa_of(r, lo=3.0, a=A_MAIN):
     if m.sum() < 3:
         return math.nan, math.nan
     f = sf.power(n[m], p[m], pe[m])
-    return (-f.p["s"], f.err["s"]) if f.ok else (math.nan, math.nan)
+    return (-f.p["s"], f.error("s")) if f.ok else (math.nan, math.nan)
 
 
 def oz_fit(q, s, q_max):
