@@ -96,10 +96,11 @@ def quantity_rows(d, fn, cr, ns=None, slug=None):
     verdict = size_verdict(ns, [m[0] for m in ms], [measured_error(m) if w and not o else math.nan
                                                     for m, w, o in zip(ms, whole, off)])
     shown = sum(np.isfinite(m[0]) for m in ms)
-    judged = sum(np.isfinite(m[0]) and w and np.isfinite(measured_error(m)) for m, w in zip(ms, whole))
+    judged = sum(np.isfinite(m[0]) and w and not o and np.isfinite(measured_error(m)) for m, w, o in zip(ms, whole, off))
     if verdict[1] is None and judged < 2 and shown > judged:   # the cells show sizes the verdict cannot take
         verdict = (f"no verdict: {judged} of the {shown} size{'s' if shown > 1 else ''} shown "
-                   f"{'has' if judged == 1 else 'have'} every seed's value with an error", None, math.nan, math.nan)
+                   f"{'has' if judged == 1 else 'have'} every seed's value with an error and a steady state",
+                   None, math.nan, math.nan)
     return ns, ms, verdict
 
 
@@ -349,8 +350,9 @@ def write_finite_size(A, path, command):
          f"are named under the table, not used. Where several studies of it ran the same φ and N, the one with the "
          f"most seeds; the line under each table names each N's study. A verdict is computed from the "
          f"numbers: **converged** from the smallest N whose value and every larger N's agree with the largest "
-         f"N's within {Z_CONVERGED:g} combined errors, and where those are three sizes or more, whose weighted line "
-         f"against log2 N is flat within {Z_CONVERGED:g} of its error (a steady drift in steps each within the errors "
+         f"N's within {Z_CONVERGED:g} combined errors, and whose weighted line against log2 N (through at least the "
+         f"three largest sizes) is flat within {Z_CONVERGED:g} of its error, or, from the second largest N, whose last "
+         f"step levels off from the one before beyond the errors (a steady drift in steps each within the errors "
          f"is a drift); otherwise **drifting**; either way with the change per doubling "
          f"of N between the two largest sizes and its error, which says how tightly \"converged\" holds. χ4^P is the peak of χ4(t) of sub-boxes of about that many particles "
          f"(interior peaks only); ξ is the whole box's Ornstein-Zernike ξ at τ_α, taken only where at least "

@@ -39,13 +39,14 @@ def protocol_of(A, study):
     return getattr(A, "protocols", {}).get(study)
 
 
-def leading_protocol(A, phi, ps, lead_by="cr"):
+def leading_protocol(A, phi, ps, lead_by="cr", planned_too=False):
     """The protocol whose runs a density's against-N table takes: the one
     whose studies run phi at the most N (their unfinished sizes counted:
     planned_sizes); among as many, with lead_by "cr" the one with the
     cage-relative measures (studies/scale.toml: run lengths in units of
     tau_alpha^CR), with "n" the one reaching the largest N (D against N:
-    studies/d_size.toml to 10^6); then the most runs."""
+    studies/d_size.toml to 10^6); then the most runs. Among the protocols
+    with points in ps, or (planned_too) with sizes planned at phi at all."""
     planned = planned_sizes(A, ps).get(phi, {})
     studies = {}
     for st in set(planned) | {study_of(p) for p in ps}:
@@ -56,7 +57,8 @@ def leading_protocol(A, phi, ps, lead_by="cr"):
         sizes = set().union(*(planned.get(st, set()) for st in studies[pr])) | {p.N for p in own}
         cr = any(A_MAIN in (r.get("cut_cr") or {}) for p in own for r in p.runs)
         return (len(sizes), cr if lead_by == "cr" else max(sizes), sum(len(p.runs) for p in own), str(pr))
-    return max((pr for pr in studies if any(study_of(p) in studies[pr] for p in ps)), key=key)
+    with_points = [pr for pr in studies if any(study_of(p) in studies[pr] for p in ps)]
+    return max(with_points if with_points and not planned_too else studies, key=key)
 
 
 def points_by_phi_n(A, has=lambda p: True, lead_by="cr"):
@@ -108,7 +110,7 @@ def held_sizes(A, has=lambda p: True):
     counted, has not finished is held back at that phi, not filled from a
     study of other run lengths)."""
     waiting = waiting_sizes(A, has)
-    return lambda p: bool(unfinished_runs(A, p)) or waiting_for(waiting, p) is not None
+    return lambda p: bool(unfinished_runs(A, p)) or waiting_for(waiting, p, A) is not None
 
 
 def waiting_sizes(A, has=lambda p: True):
@@ -121,16 +123,22 @@ def waiting_sizes(A, has=lambda p: True):
 
 def protocol_waiting(A, allp):
     """{(phi, N): (study, runs unfinished)} of the main series where a study
-    that runs phi at the most N (counting its unfinished sizes; with a tie,
-    any of them: the studies' sizes say nothing of their protocols, and at
-    phi 0.76 d_size's one-seed overlap-only runs tie scale's five sizes)
-    has runs of that N unfinished (the first such study by name)."""
+    of the leading protocol (leading_protocol over every size planned at phi,
+    unfinished ones counted: at phi 0.76 scale's five sizes tie d_size's,
+    and the cage-relative scale leads) has runs of that N unfinished (the
+    first such study by name). Another protocol's unfinished size holds
+    nothing back: d_size's unfinished N = 262144 does not hide scale's
+    finished one."""
     planned, main = planned_sizes(A, allp), unfinished_main(A)
-    out = {}
+    by_phi = {}
+    for p in allp:
+        by_phi.setdefault(p.phi, []).append(p)
+    lead, out = {}, {}
     for st, ph, n, k in sorted(main):
         phi = next((f for f in planned if abs(f - ph) < 1e-9), ph)
-        most = max(len(v) for v in planned[phi].values())
-        if len(planned[phi][st]) == most and (phi, n) not in out:
+        if phi not in lead:
+            lead[phi] = leading_protocol(A, phi, by_phi.get(phi, []), planned_too=True)
+        if protocol_of(A, st) == lead[phi] and (phi, n) not in out:
             out[(phi, n)] = (st, k)
     return out
 
@@ -154,10 +162,16 @@ def planned_sizes(A, allp):
     return planned
 
 
-def waiting_for(waiting, p):
+def waiting_for(waiting, p, A=None):
     """(study, runs unfinished) of the leading protocol holding point p's size
-    back (protocol_waiting), or None."""
-    return next((v for (ph, n), v in waiting.items() if abs(ph - p.phi) < 1e-9 and n == p.N), None)
+    back (protocol_waiting), or None; with A, never for a point of that very
+    protocol (another of its studies finished that size: it is that
+    protocol's run, not a stand-in)."""
+    v = next((v for (ph, n), v in waiting.items() if abs(ph - p.phi) < 1e-9 and n == p.N), None)
+    if v is not None and A is not None and getattr(A, "protocols", None) and \
+            protocol_of(A, v[0]) == protocol_of(A, study_of(p)) and study_of(p) != v[0]:
+        return None
+    return v
 
 
 def unfinished_runs(A, p):
@@ -207,16 +221,31 @@ def flat_slope(d):
     return float((w * (x - xm) * (y - ym)).sum() / sxx), float(1.0 / math.sqrt(sxx))
 
 
+def levels_off(d3):
+    """Whether, of three sizes [(N, value, error)], the change per doubling
+    of N over the last step differs from that over the step before by more
+    than Z_CONVERGED combined errors: 200, 250, 251 (errors 0.7) level off;
+    27, 24, 21 (errors 1, 1, 3) fall on as they fell."""
+    (n1, v1, e1), (n2, v2, e2), (n3, v3, e3) = d3
+    a, b = math.log2(n2 / n1), math.log2(n3 / n2)
+    s1, s2 = (v2 - v1) / a, (v3 - v2) / b
+    err = math.sqrt((e1 / a) ** 2 + (e2 * (1 / a + 1 / b)) ** 2 + (e3 / b) ** 2)
+    return abs(s2 - s1) > Z_CONVERGED * err
+
+
 def size_verdict(ns, vals, errs):
     """Converged or drifting, from the numbers (the one rule of every
     against-N verdict: the finite-size tables and the reproduction's rows):
     the smallest N0 such that the value at every N >= N0 agrees with the
-    largest N's within Z_CONVERGED combined errors (at least two sizes) and,
-    where N >= N0 holds three sizes or more, the weighted line through them
-    against log2 N is flat within Z_CONVERGED of its error (a steady drift
-    whose every step is within the errors is a drift: 30, 27, 24, 21 with
-    errors 1, 1, 1, 3 each agree with 21 from 4096 on, and fall by 1.5 ± 0.6
-    per doubling); otherwise drifting. Either way the change per doubling
+    largest N's within Z_CONVERGED combined errors (at least two sizes) and
+    the weighted line against log2 N through the sizes from N0 on, and at
+    least the three largest where there are three, is flat within
+    Z_CONVERGED of its error (a steady drift whose every step is within the
+    errors is a drift: 30, 27, 24, 21 with errors 1, 1, 1, 3 each agree with
+    21 from 4096 on, and fall by 1.5 ± 0.6 per doubling), unless N0 is the
+    second largest and the last step levels off from the one before
+    (levels_off: 200, 250, 251 converge from the middle size); otherwise
+    drifting. Either way the change per doubling
     of N between the two largest sizes with its error, which bounds what
     "converged" means. Returns (text, N0 or None, drift, error)."""
     d = [(n, v, e) for n, v, e in zip(ns, vals, errs) if np.isfinite(v) and np.isfinite(e)]
@@ -233,10 +262,13 @@ def size_verdict(ns, vals, errs):
     for k in range(len(d) - 1):
         if not all(abs(v - vmax) <= Z_CONVERGED * math.hypot(e, emax) for _, v, e in d[k:-1]):
             continue
-        if len(d) - k >= 3:
-            b, be = flat_slope(d[k:])
-            if abs(b) > Z_CONVERGED * be:
-                sloped = sloped or (d[k][0], b, be)
+        # the line through the sizes from N0 on (three or more) must be flat; two sizes that agree
+        # within their errors converge only where the three largest lie flat too, or where the last
+        # step is flatter than the one before it beyond the errors (the approach levels off)
+        if len(d) >= 3:
+            b, be = flat_slope(d[min(k, len(d) - 3):])
+            if abs(b) > Z_CONVERGED * be and not (len(d) - k == 2 and levels_off(d[-3:])):
+                sloped = sloped or (d[min(k, len(d) - 3)][0], b, be)
                 continue
         n0 = d[k][0]
         break

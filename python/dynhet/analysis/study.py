@@ -156,7 +156,7 @@ class Analysis:
             if left:   # no conclusion from a size whose runs did not all finish
                 self.held_back.append((p, left))
                 continue
-            wait = waiting_for(waiting, p) if main(p) else None
+            wait = waiting_for(waiting, p, self) if main(p) else None
             if wait:
                 stand_in = Point(k[1:])
                 stand_in.study = wait[0]
