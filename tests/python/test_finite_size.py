@@ -316,6 +316,16 @@ def test_a_whole_box_xi_or_chi0_without_a_value_says_why():
     unreached = {"cut": {0.6: dict(s4_cut(2.0, L), tau_alpha=math.nan)}}
     assert s4_reason(unreached, False, "xi") == "τ_α not reached"
     assert s4_reason({"cut": {0.6: {"tau_alpha": 1.0}}}, False, "xi") is None   # no S4 measured
+    # tau_alpha beyond the S4 lags (1 to 100): said as such, not "not resolved" (np.interp took the
+    # last lag's xi there); a xi beyond the box (side 100, largest wavelength 100)
+    beyond = {"cut": {0.6: dict(s4_cut(2.0, L), tau_alpha=150.0)}}
+    assert s4_reason(beyond, False, "xi") == "τ_α beyond the S4 lags"
+    huge = {"cut": {0.6: s4_cut(120.0, L)}}
+    assert s4_reason(huge, False, "xi") == "ξ beyond the box"
+    # one lag around tau_alpha below 0.3: the interpolated xi the cell would show is none
+    half = {"cut": {0.6: dict(s4_cut(2.0, L), tau_alpha=31.6)}}
+    half["cut"][0.6]["xi_t"] = np.array([[2.0], [2.0], [0.2]])
+    assert s4_reason(half, False, "xi") is not None and math.isnan(xi_shells(half)[0])
 
 
 def test_s4_of_every_n_is_drawn_standard_and_cage_relative(tmp_path):

@@ -357,7 +357,8 @@ def write_finite_size(A, path, command):
          f"of N between the two largest sizes and its error, which says how tightly \"converged\" holds. χ4^P is the peak of χ4(t) of sub-boxes of about that many particles "
          f"(interior peaks only); ξ is the whole box's Ornstein-Zernike ξ at τ_α, taken only where at least "
          f"{MIN_SHELLS} q shells lie below q ξ = 1 (else \"not resolved\" at this N; \"no OZ fit\": the S4 node refused the fit at τ_α, for ξ beyond the "
-         f"box, below the q range, or with a jackknife error not below ξ); [k q]: the shells below "
+         f"box, below the q range, or with a jackknife error not below ξ; \"ξ beyond the box\", \"ξ < 0.3\", \"τ_α beyond the S4 "
+         f"lags\" say so); [k q]: the shells below "
          f"q ξ = 1 of its runs (the range over seeds), which are the q points its OZ fit ran over (the S4 node "
          f"fits over q ξ ≤ 1, and over the 3 smallest q where fewer lie there). a = {A_MAIN}, ε = 0.9, "
          f"neighbour kick pairs. Nothing here is tuned toward the paper's numbers.", ""]

@@ -7,7 +7,7 @@ import math
 import numpy as np
 
 from .config import A_MAIN, EPS_MAIN
-from .quantities import MIN_SHELLS, PER_RUN, XI_MIN, chi0_at_tau, kappa_of, whole_box_s4, xi_of_cut
+from .quantities import MIN_SHELLS, PER_RUN, XI_MIN, chi0_at_tau, kappa_of, shells_below, whole_box_s4, xi_of_cut
 from .runs import blocks_span
 from ..fits import interp_ln_t, slope_with_error
 
@@ -216,10 +216,12 @@ def missing_cell(slug, p, cr):
 
 def s4_reason(r, cr, slug):
     """Why a run has no whole-box xi (or chi0) at tau_alpha: "τ_α not
-    reached", "no OZ fit" (the S4 node refused its fit at that lag: xi beyond
-    the box, below the q range, or its jackknife error not below xi), "ξ <
-    0.3" (not determined), "not resolved" (fewer than MIN_SHELLS q shells
-    below q xi = 1); None where it has one, or no S4."""
+    reached", "τ_α beyond the S4 lags", "no OZ fit" (the S4 node refused
+    its fit at a lag around tau_alpha: xi beyond the box, below the q range,
+    or its jackknife error not below xi), "ξ < 0.3" (not determined), "ξ
+    beyond the box", "not resolved" (fewer than MIN_SHELLS q shells below
+    q xi = 1); None where it has one, or no S4. The xi judged is the one
+    the cell would show (quantities.xi_of_cut)."""
     try:
         c = cutx(r, cr)
         if not len(c.get("xi_t", ())):
@@ -227,15 +229,26 @@ def s4_reason(r, cr, slug):
         t = c["tau_alpha"]
         if not np.isfinite(t):
             return "τ_α not reached"
+        lag = np.asarray(c["s4_lag"], float)
+        if not lag[0] <= t <= lag[-1]:
+            return "τ_α beyond the S4 lags"
         g = whole_box_s4(c)
-        xi = np.interp(math.log(t), np.log(c["s4_lag"]), c["xi_t"][:, g])
-        if not np.isfinite(xi):
+        raw, _ = interp_ln_t(lag, c["xi_t"][:, g], t)   # the node's xi, before XI_MIN and the box
+        if not np.isfinite(raw):
             return "no OZ fit"
+        xi, _, _ = xi_of_cut(c, t)
+        resolved = shells_below(c, g, raw) >= MIN_SHELLS
         if slug == "chi0":   # the q -> 0 extrapolation of the same fit: as resolved as its xi
-            return None if xi_shells(r, cr)[2] >= MIN_SHELLS or xi < XI_MIN else "not resolved"
-        if xi < XI_MIN:
+            return None if resolved or raw < XI_MIN else "not resolved"
+        if np.isfinite(xi):
+            return None
+        if raw < XI_MIN:
             return f"ξ < {XI_MIN:g}"
-        return "not resolved" if xi_shells(r, cr)[2] < MIN_SHELLS else None
+        off = int(np.sum(c["s4_nshells"][:g]))
+        q = np.asarray(c["s4_q"][off:off + int(c["s4_nshells"][g])])
+        if raw > 2 * math.pi / q[q > 0].min():
+            return "ξ beyond the box"
+        return "not resolved" if not resolved else "ξ < 0.3 or beyond the box at a lag around τ_α"
     except (KeyError, TypeError, IndexError, ValueError):
         return None
 
