@@ -69,3 +69,13 @@ def test_kappa_against_n_sees_a_change(tmp_path):
             c["cl_p_slow_err"] = 0.04 * p_ * (1 + SIZES / CUTOFF[p.phi])
     kappa_n_results(A)
     assert A.rows[-1]["verdict"].startswith("drifting: "), A.rows[-1]
+
+
+def test_a_one_seed_point_stays_in_every_jackknife_replicate_of_the_collapse(tmp_path):
+    # scale's N = 262144 points have one seed: leaving "seed 1" out dropped
+    # the point, and the replicate was a collapse over the other densities
+    A = analysis(tmp_path, ns=(4096,))
+    pts = sorted(A.points.values(), key=lambda p: p.phi)
+    pts[3].runs = pts[3].runs[:1]                                 # one seed
+    assert len(collapse_curves(pts, drop=1)) == 4 == len(collapse_curves(pts))
+    assert len(collapse_curves(pts, drop=2)) == 4

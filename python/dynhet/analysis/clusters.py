@@ -189,10 +189,13 @@ def has_clusters(r, like=None):
 def collapse_curves(pts, drop=None):
     """Per point the slow clusters' P(N_c), the mean over its seeds (seed
     `drop` left out) with the runs' errors combined: the histograms of fig.
-    dist-collapse (collapse.py takes N* from each)."""
+    dist-collapse (collapse.py takes N* from each). A point of one seed
+    keeps it (as Point.mean does: a replicate without the point would be a
+    collapse over other densities, not over other seeds)."""
     curves = []
     for p in pts:
-        runs = [r for r in p.runs if r["seed"] != drop and has_clusters(r)]
+        runs = [r for r in p.runs if has_clusters(r)]
+        runs = [r for r in runs if r["seed"] != drop] if len(runs) > 1 else runs
         runs = [r for r in runs if has_clusters(r, runs[0])] if runs else []
         if not runs:
             continue

@@ -79,10 +79,14 @@ def local_n_results(A):
             cells = ", ".join(f"N {ns[i]}: {fmt(ms[i][0], measured_error(ms[i]))} (seeds {ms[i][3]}"
                               + (f" of {len(d[ns[i]].runs)}" if ms[i][3] < len(d[ns[i]].runs) else "")
                               + (f", spread ± {ms[i][2]:.2g})" if ms[i][3] > 1 else ")") for i in ok)
-            # the finite-size table's rule and inputs: measured errors only, sizes where every seed has a value
+            # the finite-size table's rule and inputs: measured errors only, sizes where every seed has a
+            # value, and not a size whose tau_alpha(t0) (of the same measure) moves over its production
+            from .finite_size import unsteady   # (tau_B: the standard tau_alpha(t0))
+            steady = {i: not unsteady(d[ns[i]], fn is TAU_CR) for i in ok}
             verdict = size_verdict([ns[i] for i in ok], [ms[i][0] for i in ok],
-                                   [measured_error(ms[i]) if ms[i][3] == len(d[ns[i]].runs) else math.nan
+                                   [measured_error(ms[i]) if ms[i][3] == len(d[ns[i]].runs) and steady[i] else math.nan
                                     for i in ok])[0]
+            cells += "".join(f"; N {ns[i]} not steady (out of the verdict)" for i in ok if not steady[i])
             A.row(f"{label.split(' ')[0]} against N at φ = {phi:g}", "issue 26, item 8 (not in the paper)",
                   "not measured", cells, verdict, "", used)
         ax.set_xscale("log")
