@@ -3,6 +3,8 @@
 enough q shells, and the report on synthetic points at three N."""
 import math
 
+import pytest
+
 import matplotlib
 import numpy as np
 
@@ -470,6 +472,64 @@ def test_another_protocols_unfinished_size_holds_nothing_back():
     t = points_by_phi_n(A)[0.76]
     assert t.protocol == A.protocols["scale"] and sorted(t) == [1024, 4096, 16384, 65536]
     assert (("d_size", 262144, 1) not in t.others)   # held back, not named as another protocol's size
+
+
+def test_the_d_table_holds_back_by_its_own_leading_protocol():
+    # D against N leads with d_size (to 10^6): scale's unfinished 65536 must not hold back d_size's
+    # finished one (the hold used the cage-relative tie rule, d_size fell to four sizes and the
+    # table went to scale); and a size of the leading protocol finished by one of its studies is
+    # not held back by another of its studies that has it unfinished
+    from dynhet.analysis.size import points_by_phi_n
+
+    def point(study, n, cr=False):
+        p = Point(("neighbours", 0.9, 0.76, n))
+        p.study = study
+        p.runs = [{"seed": 1, "N": n, "study": study, **({"cut_cr": {0.6: {}}} if cr else {})}]
+        return p
+    A = Analysis.__new__(Analysis)
+    A.points = {}
+    A.protocols = {"scale": ("tau_alpha_cr", 10.0, 8, 1.0), "d_size": ("tau_alpha", 5.0, 4, 1.0),
+                   "d_more": ("tau_alpha", 5.0, 4, 1.0)}
+    scale = [point("scale", n, cr=True) for n in (1024, 4096, 16384, 262144)]
+    d_size = [point("d_size", n) for n in (4096, 16384, 65536, 262144, 1000000)]
+    A.extra = {(p.study, p.pairs, p.eps, p.phi, p.N): p for p in scale + d_size}
+    A.unfinished = {("scale", "neighbours", 0.9, 0.76, 65536): 1}
+    t = points_by_phi_n(A, lead_by="n")[0.76]
+    assert t.protocol == A.protocols["d_size"] and sorted(t) == [4096, 16384, 65536, 262144, 1000000]
+    t = points_by_phi_n(A)[0.76]            # the cage-relative rule: scale's, its 65536 held back
+    assert t.protocol == A.protocols["scale"] and 65536 not in t
+    A.unfinished = {("d_more", "neighbours", 0.9, 0.76, 65536): 1}   # d_size's protocol, another study
+    assert 65536 in points_by_phi_n(A, lead_by="n")[0.76]
+
+
+def test_a_size_verdict_takes_no_zero_error_and_no_size_twice():
+    # an error of 0 (a fit's, passed straight in) made the flatness test NaN, so the line was never
+    # judged: such a size is no measurement, like one without an error, and takes no part
+    text, n0, _, _ = size_verdict([1024, 4096, 16384, 65536], [10.0, 10.4, 10.8, 11.2], [0.3, 0.3, 0.3, 0.0])
+    assert "within 2σ of N = 16384" in text
+    text, n0, _, _ = size_verdict([1024, 4096, 16384, 65536], [10.0, 10.4, 10.8, 11.2], [0.3, 0.3, 0.3, 1e-9])
+    assert n0 is None and "3.0σ from flat" in text
+    with pytest.raises(ValueError, match="a size given twice"):
+        size_verdict([1024, 1024, 4096], [1.0, 1.1, 1.2], [0.1] * 3)
+
+
+def test_an_unsteady_size_is_judged_nowhere():
+    # the tau_alpha table and local_measures' tau_alpha against N leave it out alike
+    from dynhet.analysis.finite_size import quantity_rows
+    from dynhet.analysis.size_rows import tau_of
+    t0 = 923.5 + 92.35 * np.arange(8)
+    d = {}
+    for n, fall in ((4096, 0.0), (262144, 0.05)):
+        p = Point(("neighbours", 0.9, 0.78, n))
+        for seed in (1, 2):
+            alt = np.array([1, -1, 1, -1, -1, 1, -1, 1]) * 0.004 * seed
+            line = 1.0 - fall * (t0 - t0[0]) / (t0[-1] - t0[0])
+            p.runs.append({"seed": seed, "N": n, "cut": {0.6: {"t0": t0, "tau_t0": 13.6 * (line + alt),
+                                                                "tau_alpha": 13.6 + (0.3 if n > 4096 else 0),
+                                                                "tau_alpha_err": 0.1}}})
+        d[n] = p
+    _, _, (text, n0, _, _) = quantity_rows(d, tau_of, False)
+    assert text.startswith("no verdict: 1 of the 2 sizes shown has every seed's value with an error and a steady")
 
 
 def test_a_studys_protocol_is_read_from_the_study_file_it_holds(tmp_path):

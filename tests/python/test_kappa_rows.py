@@ -79,3 +79,14 @@ def test_a_one_seed_point_stays_in_every_jackknife_replicate_of_the_collapse(tmp
     pts[3].runs = pts[3].runs[:1]                                 # one seed
     assert len(collapse_curves(pts, drop=1)) == 4 == len(collapse_curves(pts))
     assert len(collapse_curves(pts, drop=2)) == 4
+
+
+def test_a_jackknife_replicate_of_the_collapse_leaves_a_seed_out_never_swaps_one_in(tmp_path):
+    # a point whose two runs have other bins takes its first run's (the bins must match); leaving
+    # that seed out once swapped the other run in, where the point has one usable seed
+    A = analysis(tmp_path, ns=(4096,))
+    pts = sorted(A.points.values(), key=lambda p: p.phi)
+    pts[0].runs = [pts[0].runs[0], run(0.76, 2, np.random.default_rng(3), SIZES[:-3])]
+    full = collapse_curves(pts)[0]
+    left = collapse_curves(pts, drop=1)[0]
+    assert len(full[0]) == len(SIZES) and np.array_equal(full[2], left[2])

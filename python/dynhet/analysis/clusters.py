@@ -195,8 +195,8 @@ def collapse_curves(pts, drop=None):
     curves = []
     for p in pts:
         runs = [r for r in p.runs if has_clusters(r)]
+        runs = [r for r in runs if has_clusters(r, runs[0])] if runs else []   # the bins of its first run
         runs = [r for r in runs if r["seed"] != drop] if len(runs) > 1 else runs
-        runs = [r for r in runs if has_clusters(r, runs[0])] if runs else []
         if not runs:
             continue
         cs = [cut(r) for r in runs]

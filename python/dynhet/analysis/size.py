@@ -22,10 +22,11 @@ class SizeTable(dict):
         self.protocol, self.others = protocol, others
 
 
-def main_candidates(A, has=lambda p: True):
+def main_candidates(A, has=lambda p: True, lead_by="cr"):
     """The points of the main series (neighbours, eps 0.9) that `has` takes
-    and whose sizes are not held back (held_sizes)."""
-    held = held_sizes(A, has)
+    and whose sizes are not held back (held_sizes, by the same leading
+    protocol as the table's: lead_by)."""
+    held = held_sizes(A, has, lead_by)
     return [p for p in list(A.points.values()) + list(A.extra.values())
             if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p) and not held(p)]
 
@@ -73,7 +74,7 @@ def points_by_phi_n(A, has=lambda p: True, lead_by="cr"):
     and 4 origins, is not a column of scale's table). Only densities with
     more than one N."""
     by_phi = {}
-    for p in main_candidates(A, has):
+    for p in main_candidates(A, has, lead_by):
         by_phi.setdefault(p.phi, []).append(p)
     out = {}
     for phi, ps in sorted(by_phi.items()):
@@ -103,25 +104,25 @@ def others_note(d):
             + ", ".join(f"N {n} of {st} ({k} run{'s' if k > 1 else ''})" for st, n, k in others))
 
 
-def held_sizes(A, has=lambda p: True):
+def held_sizes(A, has=lambda p: True, lead_by="cr"):
     """p -> whether point p's size is held back: no conclusion from a size
     whose runs did not all finish, nor another protocol's run in its place (a
-    size that the study running that phi at the most N, its unfinished sizes
-    counted, has not finished is held back at that phi, not filled from a
-    study of other run lengths)."""
-    waiting = waiting_sizes(A, has)
+    size that a study of the leading protocol, its unfinished sizes counted,
+    has not finished is held back at that phi, not filled from a study of
+    other run lengths; lead_by: leading_protocol's tie rule)."""
+    waiting = waiting_sizes(A, has, lead_by)
     return lambda p: bool(unfinished_runs(A, p)) or waiting_for(waiting, p, A) is not None
 
 
-def waiting_sizes(A, has=lambda p: True):
+def waiting_sizes(A, has=lambda p: True, lead_by="cr"):
     """protocol_waiting over the main series' points whose runs all finished
     (held_sizes, and Analysis.promote_largest_n)."""
     done = [p for p in list(A.points.values()) + list(A.extra.values())
             if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and has(p) and not unfinished_runs(A, p)]
-    return protocol_waiting(A, done)
+    return protocol_waiting(A, done, lead_by)
 
 
-def protocol_waiting(A, allp):
+def protocol_waiting(A, allp, lead_by="cr"):
     """{(phi, N): (study, runs unfinished)} of the main series where a study
     of the leading protocol (leading_protocol over every size planned at phi,
     unfinished ones counted: at phi 0.76 scale's five sizes tie d_size's,
@@ -137,7 +138,7 @@ def protocol_waiting(A, allp):
     for st, ph, n, k in sorted(main):
         phi = next((f for f in planned if abs(f - ph) < 1e-9), ph)
         if phi not in lead:
-            lead[phi] = leading_protocol(A, phi, by_phi.get(phi, []), planned_too=True)
+            lead[phi] = leading_protocol(A, phi, by_phi.get(phi, []), lead_by, planned_too=True)
         if protocol_of(A, st) == lead[phi] and (phi, n) not in out:
             out[(phi, n)] = (st, k)
     return out
@@ -166,7 +167,9 @@ def waiting_for(waiting, p, A=None):
     """(study, runs unfinished) of the leading protocol holding point p's size
     back (protocol_waiting), or None; with A, never for a point of that very
     protocol (another of its studies finished that size: it is that
-    protocol's run, not a stand-in)."""
+    protocol's run, not a stand-in). Without the studies' protocols
+    (A.protocols empty: made by hand) nothing is exempt: holding back is the
+    side to err on."""
     v = next((v for (ph, n), v in waiting.items() if abs(ph - p.phi) < 1e-9 and n == p.N), None)
     if v is not None and A is not None and getattr(A, "protocols", None) and \
             protocol_of(A, v[0]) == protocol_of(A, study_of(p)) and study_of(p) != v[0]:
@@ -248,7 +251,9 @@ def size_verdict(ns, vals, errs):
     drifting. Either way the change per doubling
     of N between the two largest sizes with its error, which bounds what
     "converged" means. Returns (text, N0 or None, drift, error)."""
-    d = [(n, v, e) for n, v, e in zip(ns, vals, errs) if np.isfinite(v) and np.isfinite(e)]
+    d = [(n, v, e) for n, v, e in zip(ns, vals, errs) if np.isfinite(v) and np.isfinite(e) and e > 0]
+    if len({n for n, _, _ in d}) != len(d):
+        raise ValueError(f"size_verdict: a size given twice ({sorted(n for n, _, _ in d)})")
     if len(d) < 2:
         return ("one N only" if d else "no data"), None, math.nan, math.nan
     d.sort()

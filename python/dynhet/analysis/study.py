@@ -140,8 +140,8 @@ class Analysis:
         def measured(p):
             return set.intersection(*[set(r["cut"].get(A_MAIN, {})) | set(r) for r in p.runs]) if p.runs else set()
         main = lambda p: p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9
-        # a size the leading protocol (the study running phi at the most N) has not finished is
-        # not filled from another study's runs of other lengths (size.protocol_waiting)
+        # a size the leading protocol (size.leading_protocol) has not finished is not filled
+        # from another study's runs of other lengths (size.protocol_waiting)
         waiting = waiting_sizes(self)
         best, self.held_back = {}, []
         for k, p in self.extra.items():
