@@ -805,3 +805,25 @@ def test_tau_against_n_rows_give_a_spread_only_where_seeds_can_have_one(tmp_path
     cell = rows["τ_α against N at φ = 0.79"]
     assert "N 4096: 29 ± 0.58 (seeds 3, spread ± 0.58)" in cell and "N 65536: 28 ± 1 (seeds 1)" in cell
     assert "nan" not in " ".join(rows.values())
+
+
+def test_local_measures_leave_an_unsteady_size_out_of_their_verdict(tmp_path):
+    # tau_alpha against N at 0.79: 262144's tau_alpha(t0) falls by 5 % over its production
+    from dynhet.analysis.local_measures import local_n_results
+    A = Analysis.__new__(Analysis)
+    A.dir, A.figdir, A.also = str(tmp_path / "study"), str(tmp_path / "study" / "figures"), []
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    t0 = 2700.0 + 270.0 * np.arange(8)
+    for n, fall, tau in ((4096, 0.0, 27.0), (16384, 0.0, 27.1), (262144, 0.05, 31.0)):
+        p = Point(("neighbours", 0.9, 0.79, n))
+        for seed in (1, 2):
+            alt = np.array([1, -1, 1, -1, -1, 1, -1, 1]) * 0.004 * seed
+            line = 1.0 - fall * (t0 - t0[0]) / (t0[-1] - t0[0])
+            p.runs.append({"seed": seed, "N": n, "cut": {0.6: {
+                "tau_alpha": tau, "tau_alpha_err": 0.1, "tau_cr": 240.0, "tau_cr_err": 5.0,
+                "t0": t0, "tau_t0": tau * (line + alt)}}})
+        A.points[p.pairs, p.eps, p.phi, p.N] = p
+    local_n_results(A)
+    row = next(r for r in A.rows if r["item"] == "τ_α against N at φ = 0.79")
+    assert "N 262144 not steady (out of the verdict)" in row["ours"]
+    assert row["verdict"].startswith("converged from N = 4096 on (within 2σ of N = 16384")
