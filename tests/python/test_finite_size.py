@@ -401,27 +401,35 @@ def test_a_tie_at_one_n_goes_to_the_study_that_runs_the_density_at_every_n():
     assert all(points_by_phi_n(A)[0.79][n] is scale[n] for n in scale)
 
 
+def protocol_point(study, n, seeds=1, cr=False, phi=0.76):
+    """A point of `study` at (phi, N) with `seeds` runs (cage-relative measures with cr)."""
+    p = Point(("neighbours", 0.9, phi, n))
+    p.study = study
+    p.runs = [{"seed": s, "N": n, "study": study, **({"cut_cr": {0.6: {}}} if cr else {})}
+              for s in range(1, seeds + 1)]
+    return p
+
+
+def protocol_analysis(points, protocols):
+    """An Analysis holding `points` as --also points, with the studies' protocols."""
+    A = Analysis.__new__(Analysis)
+    A.points, A.protocols = {}, protocols
+    A.extra = {(p.study, p.pairs, p.eps, p.phi, p.N): p for p in points}
+    return A
+
+
 def test_each_densitys_table_is_one_protocol():
     """The referee's rule: the same run lengths in units of the relaxation
     time at every N. Protocols as the studies' run_length say (unit,
     equilibration, origins, spacing; not the lag range)."""
     from dynhet.analysis.size import others_note, points_by_phi_n
-
-    def point(study, n, seeds, phi=0.76, cr=False):
-        p = Point(("neighbours", 0.9, phi, n))
-        p.study = study
-        p.runs = [{"seed": s, "N": n, "study": study, **({"cut_cr": {0.6: {}}} if cr else {})}
-                  for s in range(1, seeds + 1)]
-        return p
-    A = Analysis.__new__(Analysis)
-    A.points = {}
-    scale = [point("scale", n, 3 if n <= 16384 else 1, cr=True) for n in (1024, 4096, 16384, 65536, 262144)]
-    d_size = [point("d_size", n, 1) for n in (4096, 16384, 65536, 262144, 1000000)]
-    quick = [point("quick", 4096, 4)]
-    fs = [point("finite_size", n, 1) for n in (1024, 16384)]
-    A.extra = {(p.study, p.pairs, p.eps, p.phi, p.N): p for p in scale + d_size + quick + fs}
-    A.protocols = {"scale": ("tau_alpha_cr", 10.0, 8, 1.0), "d_size": ("tau_alpha", 5.0, 4, 1.0),
-                   "quick": ("tau_alpha", 10.0, 8, 1.0), "finite_size": ("tau_alpha", 10.0, 8, 1.0)}
+    scale = [protocol_point("scale", n, 3 if n <= 16384 else 1, cr=True) for n in (1024, 4096, 16384, 65536, 262144)]
+    d_size = [protocol_point("d_size", n) for n in (4096, 16384, 65536, 262144, 1000000)]
+    quick = [protocol_point("quick", 4096, 4)]
+    fs = [protocol_point("finite_size", n) for n in (1024, 16384)]
+    A = protocol_analysis(scale + d_size + quick + fs,
+                          {"scale": ("tau_alpha_cr", 10.0, 8, 1.0), "d_size": ("tau_alpha", 5.0, 4, 1.0),
+                           "quick": ("tau_alpha", 10.0, 8, 1.0), "finite_size": ("tau_alpha", 10.0, 8, 1.0)})
     t = points_by_phi_n(A)[0.76]
     # five sizes each: scale's (the cage-relative protocol); quick's four seeds at 4096 do not
     # displace it, and d_size's 10^6 is named, not a column
@@ -450,24 +458,15 @@ def test_another_protocols_unfinished_size_holds_nothing_back():
     # 262144 vanished); scale's own unfinished size is still held back, and
     # not filled from d_size's.
     from dynhet.analysis.size import points_by_phi_n
-
-    def point(study, n, cr=False):
-        p = Point(("neighbours", 0.9, 0.76, n))
-        p.study = study
-        p.runs = [{"seed": 1, "N": n, "study": study, **({"cut_cr": {0.6: {}}} if cr else {})}]
-        return p
-    A = Analysis.__new__(Analysis)
-    A.points = {}
-    A.protocols = {"scale": ("tau_alpha_cr", 10.0, 8, 1.0), "d_size": ("tau_alpha", 5.0, 4, 1.0)}
-    scale = [point("scale", n, cr=True) for n in (1024, 4096, 16384, 65536, 262144)]
-    d_size = [point("d_size", n) for n in (4096, 16384, 65536, 1000000)]
-    A.extra = {(p.study, p.pairs, p.eps, p.phi, p.N): p for p in scale + d_size}
+    scale = [protocol_point("scale", n, cr=True) for n in (1024, 4096, 16384, 65536, 262144)]
+    d_size = [protocol_point("d_size", n) for n in (4096, 16384, 65536, 1000000)]
+    A = protocol_analysis(scale + d_size, {"scale": ("tau_alpha_cr", 10.0, 8, 1.0), "d_size": ("tau_alpha", 5.0, 4, 1.0)})
     A.unfinished = {("d_size", "neighbours", 0.9, 0.76, 262144): 1}
     t = points_by_phi_n(A)[0.76]
     assert t.protocol == A.protocols["scale"] and sorted(t) == [1024, 4096, 16384, 65536, 262144]
     # the other way round: scale's 262144 unfinished, d_size's finished
     del A.extra["scale", "neighbours", 0.9, 0.76, 262144]
-    A.extra["d_size", "neighbours", 0.9, 0.76, 262144] = point("d_size", 262144)
+    A.extra["d_size", "neighbours", 0.9, 0.76, 262144] = protocol_point("d_size", 262144)
     A.unfinished = {("scale", "neighbours", 0.9, 0.76, 262144): 1}
     t = points_by_phi_n(A)[0.76]
     assert t.protocol == A.protocols["scale"] and sorted(t) == [1024, 4096, 16384, 65536]
@@ -480,19 +479,10 @@ def test_the_d_table_holds_back_by_its_own_leading_protocol():
     # table went to scale); and a size of the leading protocol finished by one of its studies is
     # not held back by another of its studies that has it unfinished
     from dynhet.analysis.size import points_by_phi_n
-
-    def point(study, n, cr=False):
-        p = Point(("neighbours", 0.9, 0.76, n))
-        p.study = study
-        p.runs = [{"seed": 1, "N": n, "study": study, **({"cut_cr": {0.6: {}}} if cr else {})}]
-        return p
-    A = Analysis.__new__(Analysis)
-    A.points = {}
-    A.protocols = {"scale": ("tau_alpha_cr", 10.0, 8, 1.0), "d_size": ("tau_alpha", 5.0, 4, 1.0),
-                   "d_more": ("tau_alpha", 5.0, 4, 1.0)}
-    scale = [point("scale", n, cr=True) for n in (1024, 4096, 16384, 262144)]
-    d_size = [point("d_size", n) for n in (4096, 16384, 65536, 262144, 1000000)]
-    A.extra = {(p.study, p.pairs, p.eps, p.phi, p.N): p for p in scale + d_size}
+    scale = [protocol_point("scale", n, cr=True) for n in (1024, 4096, 16384, 262144)]
+    d_size = [protocol_point("d_size", n) for n in (4096, 16384, 65536, 262144, 1000000)]
+    A = protocol_analysis(scale + d_size, {"scale": ("tau_alpha_cr", 10.0, 8, 1.0), "d_size": ("tau_alpha", 5.0, 4, 1.0),
+                                           "d_more": ("tau_alpha", 5.0, 4, 1.0)})
     A.unfinished = {("scale", "neighbours", 0.9, 0.76, 65536): 1}
     t = points_by_phi_n(A, lead_by="n")[0.76]
     assert t.protocol == A.protocols["d_size"] and sorted(t) == [4096, 16384, 65536, 262144, 1000000]
