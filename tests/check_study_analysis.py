@@ -3,7 +3,8 @@
 the runs themselves, recomputed here from each run.h5 without the
 analysis code: every point's tau_alpha, beta, D and Z are the means over
 its seeds of the runs' final values; chi4 and xi at tau_alpha are the
-runs' chi4(t) (largest proper sub-box) and OZ xi(t) (whole box)
+runs' chi4(t) (the largest proper sub-box: the study's N = 300 box is
+below quantities.CHI4_SUBBOX's 455 particles) and OZ xi(t) (whole box)
 interpolated linearly in ln t at the run's own tau_alpha (xi only where
 at least 5 q shells of the whole box lie below q xi = 1); the table has a
 row per result and every figure it names exists; fits that cannot be made
