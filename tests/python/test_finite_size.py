@@ -166,6 +166,9 @@ def test_a_point_without_a_measured_error_says_so_and_stays_out_of_the_verdict()
     one_unquoted = (1930.0, math.nan, math.nan, 1)   # one seed, no quoted error (tau_B)
     assert math.isnan(measured_error(one_unquoted)) and cell(one_unquoted) == "1930 (no error) ¹"
     assert "± 12" in cell((1930.0, 12.0, math.nan, 2))
+    # two seeds and no quoted error: the spread of two, marked (one dof); three: not marked; quoted: not
+    assert cell((1930.0, 40.0, 40.0, 2)).endswith("²") and not cell((1930.0, 40.0, 40.0, 3)).endswith("²")
+    assert not cell((1930.0, 12.0, 40.0, 2)).endswith("²")
     text, n0, _, _ = size_verdict([1024, 4096, 16384], [1900.0, 1930.0, 2500.0], [20.0, 20.0, math.nan])
     assert n0 == 1024 and "N = 4096" in text  # the largest N, without an error, is left out
 
