@@ -1,6 +1,8 @@
 """The kappa collapse rows on Points (clusters.collapse_fit, size.kappa_n_results):
 runs without clusters or with other bins are left out, not fatal; exact
 scaling histograms give back their exponent at every N."""
+import math
+
 import numpy as np
 
 from dynhet.analysis.clusters import collapse_curves, collapse_fit
@@ -90,3 +92,26 @@ def test_a_jackknife_replicate_of_the_collapse_leaves_a_seed_out_never_swaps_one
     full = collapse_curves(pts)[0]
     left = collapse_curves(pts, drop=1)[0]
     assert len(full[0]) == len(SIZES) and np.array_equal(full[2], left[2])
+
+
+def test_kappa_against_n_fits_one_window_of_cluster_sizes_at_every_n(tmp_path):
+    # each run's own N* grows with the box where the box cuts clusters off; the finite-size
+    # row fits 3 <= N_c <= the density's smallest N* at every N (size_rows.kappa_windows)
+    from dynhet.analysis.quantities import kappa_of, n_star
+    from dynhet.analysis.size_rows import kappa_common, kappa_windows
+    A = analysis(tmp_path)
+    multi = {}
+    for p in list(A.points.values()) + list(A.extra.values()):
+        for r in p.runs:
+            r["packing_fraction"] = p.phi
+        multi.setdefault(p.phi, {})[p.N] = p
+    small = multi[0.78][4096].runs[0]
+    for r in multi[0.78][16384].runs:           # the larger box: clusters cut off later
+        c = r["cut"][0.6]
+        c["cl_p_slow"] = SIZES ** -1.8 * np.exp(-SIZES / 2000.0)
+    kw = kappa_windows(multi)
+    lo = min(n_star(r)[0] for p in multi[0.78].values() for r in p.runs)
+    assert math.isclose(kw[(0.78, False)], lo) and lo < n_star(multi[0.78][16384].runs[0])[0] / 3
+    big = multi[0.78][16384].runs[0]
+    assert kappa_common(kw)(big) == kappa_of(big, hi=lo) != kappa_of(big)
+    assert kappa_common(kw)(small) == kappa_of(small, hi=lo)

@@ -15,8 +15,8 @@ from .plotting import colours, errorbar
 from .quantities import s4_at_tau
 from .points import MIN_CAL_DOF, ensure_calibrated, measured_error, spread_ratio as pooled_spread
 from .size import Z_CONVERGED, held_back, others_note, points_by_phi_n, size_verdict, study_of
-from .size_rows import (CHI4P_ROWS, MIN_SHELLS, TAU_ROWS, c_b_times, has_cr, lags_in_tau_cr, missing_cell, quantities,
-                        production_change, shells_note, tau_b_bound, tau_b_points)
+from .size_rows import (CHI4P_ROWS, MIN_SHELLS, TAU_ROWS, c_b_times, has_cr, kappa_windows, lags_in_tau_cr, missing_cell,
+                        production_change, quantities, shells_note, tau_b_bound, tau_b_points)
 from .verdicts import fmt
 
 
@@ -372,7 +372,7 @@ def write_finite_size(A, path, command):
         L += ["No density was run at more than one N.", ""]
     multi_tb = tau_b_points(A, multi)
     L += calibration_note(A, multi, multi_cr, multi_tb)
-    rows, cb_at = quantities(multi), c_b_times(multi)
+    rows, cb_at, kw = quantities(multi), c_b_times(multi), kappa_windows(multi)
     figures = []
     for phi, d in multi.items():
         ns = sorted(d)
@@ -396,6 +396,9 @@ def write_finite_size(A, path, command):
                 label = name + (" — cage-relative" if cr else "")
                 if slug == "c_b":
                     label = f"C_B at t = {dict(cb_at).get(round(float(phi), 6), math.nan):.4g} (bond breaking)"
+                if slug == "kappa":   # the window every N of this density fits (size_rows.kappa_windows)
+                    hi = kw.get((round(float(phi), 6), cr))
+                    label += f", 3 ≤ N_c ≤ {hi:.3g}" if hi is not None else ""
                 cells = [w or cell(m, len(dd[n].runs) if n in dd else 0)
                          + (" ‡" if slug != "tau_t0_change" and n in dd and unsteady(dd[n], cr) else "")
                          for m, w, n in zip(ms, why, qn)]

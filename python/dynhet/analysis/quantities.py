@@ -160,10 +160,12 @@ def n_star(r, a=A_MAIN):
 KAPPA_LO = (1.0, 3.0, 10.0)   # lower bounds of the kappa fit scanned (monomers in or out)
 
 
-def kappa_of(r, lo=3.0, a=A_MAIN):
+def kappa_of(r, lo=3.0, a=A_MAIN, hi=None):
     """kappa of slow clusters: P(N_c) ~ N_c^-kappa fitted to the bins with
     lo <= N_c <= N* (the run's cutoff size <N_c^2>/<N_c>: beyond it the
-    scaling function cuts the power law off), weighted by the bins' errors;
+    scaling function cuts the power law off; hi in its place where given:
+    the finite-size table's window common to every N of a density),
+    weighted by the bins' errors;
     its error the fit's, times sqrt(chi2/dof) where the bins scatter more
     than their errors say (Fit.error: the Birge ratio); NaN with fewer than
     3 bins."""
@@ -171,7 +173,7 @@ def kappa_of(r, lo=3.0, a=A_MAIN):
     if "cl_size" not in c:
         return math.nan, math.nan
     p, pe, n = c["cl_p_slow"], c["cl_p_slow_err"], c["cl_size"]
-    ns = n_star(r, a)[0]
+    ns = n_star(r, a)[0] if hi is None else hi
     m = np.isfinite(p) & (p > 0) & np.isfinite(pe) & (pe > 0) & (n >= lo) & (n <= ns)
     if m.sum() < 3:
         return math.nan, math.nan

@@ -7,7 +7,8 @@ import math
 import numpy as np
 
 from .config import A_MAIN, EPS_MAIN
-from .quantities import MIN_SHELLS, PER_RUN, XI_MIN, chi0_at_tau, kappa_of, shells_below, whole_box_s4, xi_of_cut
+from .quantities import (MIN_SHELLS, PER_RUN, XI_MIN, chi0_at_tau, kappa_of, n_star, shells_below, whole_box_s4,
+                         xi_of_cut)
 from .runs import blocks_span
 from ..fits import interp_ln_t, slope_with_error
 
@@ -165,9 +166,46 @@ QUANTITIES = TAU_ROWS + CHI4P_ROWS + REST_ROWS
 
 def quantities(multi):
     """Every row of the report: QUANTITIES and C_B at each density's common
-    last lag (bond breaking measured where tau_B lies beyond the lags)."""
+    last lag (bond breaking measured where tau_B lies beyond the lags); kappa
+    over each density's common window of cluster sizes (kappa_windows)."""
     cb = [("C_B at the longest common lag with an error (bond breaking)", "c_b", c_b_at(c_b_times(multi)), False, False)]
-    return TAU_ROWS + cb + CHI4P_ROWS + REST_ROWS
+    kw = kappa_windows(multi)
+    rest = [(name, slug, kappa_common(kw), c, lg) if slug == "kappa" else (name, slug, fn, c, lg)
+            for name, slug, fn, c, lg in REST_ROWS]
+    return TAU_ROWS + cb + CHI4P_ROWS + rest
+
+
+def kappa_windows(multi):
+    """{(phi, cr): N*_min}: per density and measure the smallest cutoff size
+    N* = <N_c^2>/<N_c> over every run at every N, the common upper end of
+    the kappa fits (3 <= N_c <= N*_min), so that every N fits the same
+    cluster sizes: each run's own N* grows with the box where the box cuts
+    the largest clusters off, and so would the window."""
+    out = {}
+    for phi, d in multi.items():
+        for cr in (False, True):
+            vals = []
+            for p in d.values():
+                for r in p.runs:
+                    try:
+                        v = n_star(dict(r, cut=r["cut_cr"]) if cr else r)[0]
+                    except (KeyError, TypeError, ValueError):
+                        continue
+                    if np.isfinite(v):
+                        vals.append(v)
+            if vals:
+                out[(round(float(phi), 6), cr)] = min(vals)
+    return out
+
+
+def kappa_common(windows):
+    """kappa_of over the density's common window (kappa_windows); NaN where it has none."""
+    def fn(r, cr=False):
+        hi = windows.get((round(float(r["packing_fraction"]), 6), cr))
+        if hi is None:
+            return math.nan, math.nan
+        return kappa_of(dict(r, cut=r["cut_cr"]) if cr else r, hi=hi)
+    return fn
 
 
 def tau_b_bound(p):
