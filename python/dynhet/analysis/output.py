@@ -274,7 +274,7 @@ def largest_n_notes(A):
     from .size import points_by_phi_n
     from .size_rows import has_cr, tau_of
     multi = points_by_phi_n(A)   # the main series (neighbours, eps = 0.9): the others have no sizes of their own here
-    multi_cr = {phi: {n: q for n, q in d.items() if has_cr(q)} for phi, d in points_by_phi_n(A, has_cr).items()}
+    multi_cr = points_by_phi_n(A, has_cr)   # (its points have the cage-relative measures: has_cr)
     out = []
     for p in A.promoted:
         main = p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9
