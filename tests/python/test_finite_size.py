@@ -743,7 +743,7 @@ def test_a_size_whose_tau_alpha_moves_over_its_production_is_not_steady(tmp_path
     out = tmp_path / "finite_size.md"
     write_finite_size(A, str(out), "analyse_study.sh study")
     row = next(l for l in out.read_text().splitlines() if l.startswith("| τ_α(t0): change over the production"))
-    assert "| not steady at N = 262144 (-5" in row and "0 within 3 errors at N = 4096, 16384 |" in row
+    assert "| not steady at N = 262144 (-5" in row and "0 within 3σ's probability at N = 4096, 16384 |" in row
     # its values are no steady state's: marked, and out of the verdict (which ends at 16384)
     row = next(l for l in out.read_text().splitlines() if l.startswith("| τ_α |"))
     cells = row.split(" | ")
@@ -756,7 +756,7 @@ def test_a_size_whose_tau_alpha_moves_over_its_production_is_not_steady(tmp_path
     from dynhet.analysis.finite_size import steady_verdict
     nan = float("nan")
     text = steady_verdict([4096, 262144], [(0.5, 1.0, 1.0, 2), (1.0, nan, nan, 1)], [True, True])
-    assert text == "steady: 0 within 3 errors at N = 4096; not judged (no error) at N = 262144"
+    assert text == "steady: 0 within 3σ's probability at N = 4096; not judged (no error) at N = 262144"
 
 
 def test_the_tau_b_row_takes_no_size_whose_runs_did_not_all_finish():
@@ -820,3 +820,16 @@ def test_local_measures_leave_an_unsteady_size_out_of_their_verdict(tmp_path):
     row = next(r for r in A.rows if r["item"] == "τ_α against N at φ = 0.79")
     assert "N 262144 not steady (out of the verdict)" in row["ours"]
     assert row["verdict"].startswith("converged from N = 4096 on (within 2σ of N = 16384")
+
+
+def test_not_steady_takes_the_student_t_of_the_origins_scatter():
+    # an error from 4 origins about a line has 2 dof: 3 of them are no 3 sigma (t = 19.2 is);
+    # one run of 8 origins, 6 dof: 4.9; a known error: 3
+    from dynhet.analysis.finite_size import change_dof, steady_limit, steady_off
+    assert steady_limit(None) == 3.0
+    assert abs(steady_limit(6) - 4.90) < 0.01 and abs(steady_limit(2) - 19.2) < 0.1 and abs(steady_limit(18) - 3.475) < 0.01
+    m = (-5.0, 1.0, math.nan, 1)               # 5 errors from 0
+    assert steady_off(m, True) and steady_off(m, True, 6) and not steady_off(m, True, 2)
+    p = Point(("neighbours", 0.9, 0.78, 4096))
+    p.runs = [{"seed": s, "cut": {0.6: {"tau_t0": np.r_[np.ones(7), np.nan]}}} for s in (1, 2, 3)]
+    assert change_dof(p, False) == 15 and change_dof(Point(("neighbours", 0.9, 0.78, 4096)), False) is None

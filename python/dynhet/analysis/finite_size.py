@@ -15,7 +15,7 @@ from .plotting import colours, errorbar
 from .quantities import s4_at_tau
 from .points import MIN_CAL_DOF, ensure_calibrated, measured_error, spread_ratio as pooled_spread
 from .size import Z_CONVERGED, held_back, others_note, points_by_phi_n, size_verdict, study_of
-from .size_rows import (CHI4P_ROWS, MIN_SHELLS, TAU_ROWS, c_b_times, has_cr, kappa_windows, lags_in_tau_cr, missing_cell,
+from .size_rows import (CHI4P_ROWS, MIN_SHELLS, TAU_ROWS, c_b_times, cutx, has_cr, kappa_windows, lags_in_tau_cr, missing_cell,
                         production_change, quantities, shells_note, tau_b_bound, tau_b_points)
 from .verdicts import fmt
 
@@ -91,7 +91,8 @@ def quantity_rows(d, fn, cr, ns=None, slug=None):
           else nan for n in ns]
     whole = [n in d and m[3] == len(d[n].runs) for n, m in zip(ns, ms)]   # every seed has it (cell)
     if slug == "tau_t0_change":   # a steady state is 0 at each N, not an N-independent value
-        return ns, ms, (steady_verdict(ns, ms, whole), None, math.nan, math.nan)
+        dofs = [change_dof(d[n], cr) if n in d else None for n in ns]
+        return ns, ms, (steady_verdict(ns, ms, whole, dofs), None, math.nan, math.nan)
     # a size whose tau_alpha(t0) still moves over its production (of the same measure, standard or
     # cage-relative) is no steady state: shown, marked, and out of the verdict
     off = [n in d and bool(unsteady(d[n], cr)) for n in ns]
@@ -107,35 +108,62 @@ def quantity_rows(d, fn, cr, ns=None, slug=None):
 
 
 Z_STEADY = 3.0   # a size is "not steady" beyond 3 errors: some 30 cells judged at 2 would flag one or two by chance
+P_STEADY = 0.0027   # the same as a two-sided probability (3 sigma of a normal error)
 
 
-def steady_off(m, whole):
+def steady_limit(dof):
+    """How many errors from 0 make a change "not steady": Z_STEADY for an
+    error of known size; with the slopes' residual dof, the Student t
+    quantile of the same probability (one run of 8 origins, 6 dof: 4.9; of
+    4 origins, 2 dof: 19; three runs of 8, 18 dof: 3.5), since an error from the
+    scatter of a few origins about a line is itself uncertain."""
+    if dof is None or not dof > 0:
+        return Z_STEADY
+    from scipy.stats import t
+    return float(t.ppf(1 - P_STEADY / 2, dof))
+
+
+def change_dof(p, cr):
+    """The residual dof behind a point's tau_alpha(t0) slopes: over its runs,
+    the origins with a tau_alpha(t0) less 2 (None where none is known)."""
+    k = 0
+    for r in p.runs:
+        try:
+            tt = np.asarray(cutx(r, cr)["tau_t0"], float)
+        except (KeyError, TypeError, ValueError):
+            continue
+        k += max(0, int(np.isfinite(tt).sum()) - 2)
+    return k or None
+
+
+def steady_off(m, whole, dof=None):
     """Whether a size's change over the production (m, Point.mean's) lies
-    more than Z_STEADY errors from 0; None where it cannot be judged (no
-    value, no error, or not every seed has one)."""
+    beyond steady_limit(dof) errors from 0; None where it cannot be judged
+    (no value, no error, or not every seed has one)."""
     e = measured_error(m)
     if not (whole and np.isfinite(m[0]) and np.isfinite(e)):
         return None
-    return abs(m[0]) > Z_STEADY * e
+    return abs(m[0]) > steady_limit(dof) * e
 
 
 def unsteady(p, cr):
     """Whether point p's tau_alpha(t0) (cage-relative with cr) moves over the
-    production by more than Z_STEADY errors (steady_off; False where it
-    cannot be judged)."""
+    production beyond steady_limit (steady_off; False where it cannot be
+    judged)."""
     m = p.mean(lambda r: production_change(r, cr))
-    return bool(steady_off(m, m[3] == len(p.runs)))
+    return bool(steady_off(m, m[3] == len(p.runs), change_dof(p, cr)))
 
 
-def steady_verdict(ns, ms, whole):
+def steady_verdict(ns, ms, whole, dofs=None):
     """tau_alpha(t0)'s change over the production against 0 at each size
-    (every seed's value with an error): the sizes where it lies more than
-    Z_STEADY errors from 0 are "not steady"."""
+    (every seed's value with an error): the sizes where it lies beyond
+    steady_limit (3 sigma's probability, Student t with the slopes' dof)
+    from 0 are "not steady"."""
     off, ok, unjudged = [], [], []
-    for n, m, w in zip(ns, ms, whole):
+    for n, m, w, k in zip(ns, ms, whole, dofs or [None] * len(ns)):
         if not np.isfinite(m[0]):
             continue
-        away = steady_off(m, w)
+        away = steady_off(m, w, k)
         if away is None:
             unjudged.append(n)
             continue
@@ -144,10 +172,10 @@ def steady_verdict(ns, ms, whole):
     if not off and not ok:
         return "no verdict: no size with every seed's value and an error"
     if not off:
-        return (f"steady: 0 within {Z_STEADY:g} errors at "
+        return (f"steady: 0 within 3σ's probability at "
                 + ("every N" if not unjudged else "N = " + ", ".join(str(n) for n, _, _ in ok)) + tail)
     return ("not steady at " + ", ".join(f"N = {n} ({fmt(v, e)} %)" for n, v, e in off)
-            + (f"; 0 within {Z_STEADY:g} errors at N = " + ", ".join(str(n) for n, _, _ in ok) if ok else "") + tail)
+            + (f"; 0 within 3σ's probability at N = " + ", ".join(str(n) for n, _, _ in ok) if ok else "") + tail)
 
 
 def bound_conflict(ns, ms, bounds):
@@ -345,8 +373,9 @@ def write_finite_size(A, path, command):
          f"value (the others not resolved or not reached), and it takes no part in the verdict either; ² no run quotes "
          f"an error and it is the spread of two seeds (one degree of freedom: itself uncertain by some 70 %); "
          f"‡ not steady: "
-         f"the size's τ_α(t0) (of the same measure, standard or cage-relative) moves over its production by more "
-         f"than {Z_STEADY:g} errors (the row \"τ_α(t0): change over the production\"), so its values are no "
+         f"the size's τ_α(t0) (of the same measure, standard or cage-relative) moves over its production beyond "
+         f"3σ's probability (Student t with the dof of its origins' scatter about the line: 4.9 errors for one run "
+         f"of 8 origins, 3.5 for three; the row \"τ_α(t0): change over the production\"), so its values are no "
          f"steady state's: shown, and out of the verdict. Each density's "
          f"table is one protocol's (the same unit of the run lengths, equilibration, origins and their spacing at "
          f"every N: the studies' run_length): the protocol whose studies run that φ at the most N, and among as many "
@@ -417,7 +446,7 @@ def write_finite_size(A, path, command):
         seeds += others_note(crs, "; cage-relative rows: not in them")
         tbs = [(n, p) for n, p in sorted(multi_tb.get(phi, {}).items()) if p is not d.get(n)]
         if tbs:
-            seeds += "; τ_B row: " + ", ".join(f"N {n}: {len(p.runs)} of study {getattr(p, 'study', '?')}"
+            seeds += "; τ_B row: " + ", ".join(f"N {n}: {len(p.runs)} of study {study_of(p)}"
                                                for n, p in tbs)
         L += ["", f"Runs (seeds) per N: {seeds}." + (f" Longest lag in units of each run's own measured "
                                                       f"τ_α^CR (a study in units of τ_α^CR sets every N's lags from its pilot's; a run's own τ_α^CR scatters about that, and so does this ratio): {spans}."

@@ -239,7 +239,7 @@ def still_drifting(multi, d, d_cr, n_top):
     whose verdict over the sizes up to n_top at one density says "drifting":
     the rows taken at that N carry them, not only tau_alpha ("name: the drift
     per doubling")."""
-    from .finite_size import quantity_rows, steady_off
+    from .finite_size import change_dof, quantity_rows, steady_off
     from .points import measured_error
     from .size_rows import quantities
     out = []
@@ -254,7 +254,7 @@ def still_drifting(multi, d, d_cr, n_top):
             ns, ms, (text, *_) = quantity_rows(sub, fn, cr, slug=slug)
             if slug == "tau_t0_change":   # not a drift in N: whether the run at that N was steady
                 m = ms[ns.index(n_top)]
-                if steady_off(m, m[3] == len(sub[n_top].runs)):
+                if steady_off(m, m[3] == len(sub[n_top].runs), change_dof(sub[n_top], cr)):
                     out.append(f"{name.split(':')[0]}{' — cage-relative' if cr else ''} not steady over the "
                                f"production at N = {n_top} ({fmt(m[0], measured_error(m))} %)")
                 continue
