@@ -830,6 +830,20 @@ def test_not_steady_takes_the_student_t_of_the_origins_scatter():
     assert abs(steady_limit(6) - 4.90) < 0.01 and abs(steady_limit(2) - 19.2) < 0.1 and abs(steady_limit(18) - 3.475) < 0.01
     m = (-5.0, 1.0, math.nan, 1)               # 5 errors from 0
     assert steady_off(m, True) and steady_off(m, True, 6) and not steady_off(m, True, 2)
+    # the dof of the error the verdict uses: three runs of 7 origins a tau_alpha apart, equal
+    # errors: 3 x 5; origins half a tau_alpha apart quote none, and the seeds' spread has 2
+    def runs(spacing, scatter):
+        out = []
+        for s, amp in zip((1, 2, 3), scatter):
+            t0 = 100.0 + spacing * 10.0 * np.arange(7)
+            tt = 10.0 * (1 + amp * np.array([1, -1, 1, -1, -1, 1, -1]))
+            out.append({"seed": s, "cut": {0.6: {"t0": t0, "tau_t0": tt, "tau_alpha": 10.0}}})
+        return out
     p = Point(("neighbours", 0.9, 0.78, 4096))
-    p.runs = [{"seed": s, "cut": {0.6: {"tau_t0": np.r_[np.ones(7), np.nan]}}} for s in (1, 2, 3)]
-    assert change_dof(p, False) == 15 and change_dof(Point(("neighbours", 0.9, 0.78, 4096)), False) is None
+    p.runs = runs(1.0, (0.01, 0.01, 0.01))
+    assert math.isclose(change_dof(p, False), 15.0)
+    p.runs = runs(1.0, (0.01, 0.01, 0.04))     # unequal errors: fewer than 15 (Welch-Satterthwaite)
+    assert 5.0 < change_dof(p, False) < 15.0
+    p.runs = runs(0.5, (0.01, 0.01, 0.01))
+    assert change_dof(p, False) == 2
+    assert change_dof(Point(("neighbours", 0.9, 0.78, 4096)), False) is None

@@ -115,3 +115,32 @@ def test_kappa_against_n_fits_one_window_of_cluster_sizes_at_every_n(tmp_path):
     big = multi[0.78][16384].runs[0]
     assert kappa_common(kw)(big) == kappa_of(big, hi=lo) != kappa_of(big)
     assert kappa_common(kw)(small) == kappa_of(small, hi=lo)
+
+
+def test_the_cage_relative_kappa_window_comes_from_the_cage_relative_points_and_ignores_a_run_that_fits_nothing(
+        tmp_path):
+    from dynhet.analysis.quantities import n_star
+    from dynhet.analysis.size_rows import kappa_common, kappa_windows
+    A = analysis(tmp_path)
+    multi, multi_cr = {}, {}
+    for p in list(A.points.values()) + list(A.extra.values()):
+        for r in p.runs:
+            r["packing_fraction"] = p.phi
+        multi.setdefault(p.phi, {})[p.N] = p
+    # the cage-relative rows' points (another study's) carry cut_cr; the table's do not
+    import copy
+    for phi, d in multi.items():
+        for n, p in d.items():
+            q = copy.deepcopy(p)
+            for r in q.runs:
+                r["cut_cr"] = r["cut"]
+            multi_cr.setdefault(phi, {})[n] = q
+    kw = kappa_windows(multi, multi_cr)
+    assert (0.78, True) in kw and (0.78, True) not in kappa_windows(multi)
+    r = multi_cr[0.78][4096].runs[0]
+    assert np.isfinite(kappa_common(kw)(r, cr=True)[0])
+    # a run whose slow clusters stop at N_c = 4 (N* about 2) does not narrow the density's window
+    tiny = multi[0.78][4096].runs[1]["cut"][0.6]
+    tiny["cl_p_slow"] = np.where(SIZES <= 4, SIZES ** -1.8, np.nan)
+    assert n_star(multi[0.78][4096].runs[1])[0] < 3
+    assert kappa_windows(multi)[(0.78, False)] > 10

@@ -124,16 +124,28 @@ def steady_limit(dof):
 
 
 def change_dof(p, cr):
-    """The residual dof behind a point's tau_alpha(t0) slopes: over its runs,
-    the origins with a tau_alpha(t0) less 2 (None where none is known)."""
-    k = 0
+    """The dof of the error Point.mean gives a point's change over the
+    production (production_change): where every run quotes one (its
+    origins' scatter about the line, n - 2 dof), Welch-Satterthwaite over
+    the runs, (sum e^2)^2 / sum (e^4 / (n - 2)), which is the sum for equal
+    errors and less otherwise; where some run quotes none (fewer than 4
+    origins, or origins closer than one tau_alpha), the seeds' spread:
+    seeds - 1; None where neither."""
+    errs, dofs = [], []
     for r in p.runs:
         try:
-            tt = np.asarray(cutx(r, cr)["tau_t0"], float)
+            v, e = production_change(r, cr)
+            k = int(np.isfinite(np.asarray(cutx(r, cr)["tau_t0"], float)).sum()) - 2
         except (KeyError, TypeError, ValueError):
             continue
-        k += max(0, int(np.isfinite(tt).sum()) - 2)
-    return k or None
+        if np.isfinite(v):
+            errs.append(e)
+            dofs.append(k)
+    if not errs:
+        return None
+    if all(np.isfinite(e) and e > 0 for e in errs) and all(k > 0 for k in dofs):
+        return sum(e * e for e in errs) ** 2 / sum(e ** 4 / k for e, k in zip(errs, dofs))
+    return (len(errs) - 1) or None
 
 
 def steady_off(m, whole, dof=None):
@@ -330,7 +342,7 @@ def calibration_note(A, multi, multi_cr, multi_tb=None):
         return {id(p.population): p.population for src in sources for d in src.values() for p in d.values()}
     main_pops, tb_pops = populations(multi, multi_cr), populations(multi, multi_tb or {})
     applied = []
-    for name, slug, fn, has_cr_version, _ in quantities(multi):
+    for name, slug, fn, has_cr_version, _ in quantities(multi, multi_cr):
         pops = tb_pops if slug == "tau_b" else main_pops   # the tau_B rows may take another study's points
         for cr in ((False, True) if has_cr_version else (False,)):
             f = lambda run: fn(run, cr)  # noqa: E731
@@ -401,7 +413,7 @@ def write_finite_size(A, path, command):
         L += ["No density was run at more than one N.", ""]
     multi_tb = tau_b_points(A, multi)
     L += calibration_note(A, multi, multi_cr, multi_tb)
-    rows, cb_at, kw = quantities(multi), c_b_times(multi), kappa_windows(multi)
+    rows, cb_at, kw = quantities(multi, multi_cr), c_b_times(multi), kappa_windows(multi, multi_cr)
     figures = []
     for phi, d in multi.items():
         ns = sorted(d)

@@ -243,7 +243,8 @@ def still_drifting(multi, d, d_cr, n_top):
     from .points import measured_error
     from .size_rows import quantities
     out = []
-    for name, slug, fn, has_cr_version, _ in quantities(multi):
+    phi = next(iter(d.values())).phi if d else None
+    for name, slug, fn, has_cr_version, _ in quantities(multi, {phi: d_cr} if d_cr else {}):
         if slug == "tau_b":    # its points are another study's (tau_b_points); its own row says
             continue
         for cr in ((False, True) if has_cr_version else (False,)):

@@ -95,13 +95,13 @@ def points_by_phi_n(A, has=lambda p: True, lead_by="cr"):
     return out
 
 
-def others_note(d, lead="; not in this table"):
+def others_note(d, lead="; not in this table", close=""):
     """The sizes a density's table leaves out (SizeTable.others), as a clause; "" without."""
     others = getattr(d, "others", [])
     if not others:
         return ""
     return (f"{lead}, another study's protocol: "
-            + ", ".join(f"N {n} of {st} ({k} run{'s' if k > 1 else ''})" for st, n, k in others))
+            + ", ".join(f"N {n} of {st} ({k} run{'s' if k > 1 else ''})" for st, n, k in others) + close)
 
 
 def held_sizes(A, has=lambda p: True, lead_by="cr"):
@@ -310,7 +310,7 @@ def d_n_results(A):
         vals = [d[n].mean(dD) for n in ns]
         errorbar(ax[0], ns, [v[0] for v in vals], [point_error(v) for v in vals], fmt="o-", color=col, label=f"φ = {phi:g}")
         cells.append(f"φ {phi:g}: " + ", ".join(f"{fmt(v[0], point_error(v))} (N {n})" for n, v in zip(ns, vals))
-                     + others_note(d, "; not taken"))
+                     + others_note(d, " [not taken", "]"))
         used += list(d.values())
     log_axes(ax[0], "N", "D", "D against the number of particles")
     # theta at each N over the same densities at every N (like with like: the
@@ -354,7 +354,7 @@ def tau_n_results(A):
         vals = [d[n].mean(tau) for n in ns]
         errorbar(ax, ns, [v[0] for v in vals], [v[1] for v in vals], fmt="o-", color=col, label=f"φ = {phi:g}")
         cells.append(f"φ {phi:g}: " + ", ".join(f"{fmt(v[0], v[1])} (N {n}, {d[n].mean(tau)[3]} seed{'s' if d[n].mean(tau)[3] > 1 else ''})"
-                                                 for n, v in zip(ns, vals)) + others_note(d, "; not taken"))
+                                                 for n, v in zip(ns, vals)) + others_note(d, " [not taken", "]"))
         used += list(d.values())
     ax.set_xscale("log")
     ax.set_yscale("log")

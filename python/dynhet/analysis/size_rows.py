@@ -164,34 +164,41 @@ REST_ROWS = [("χ0 of S4 (whole box, at τ_α)", "chi0", with_cr(chi0_at_tau), T
 QUANTITIES = TAU_ROWS + CHI4P_ROWS + REST_ROWS
 
 
-def quantities(multi):
+def quantities(multi, multi_cr=None):
     """Every row of the report: QUANTITIES and C_B at each density's common
     last lag (bond breaking measured where tau_B lies beyond the lags); kappa
-    over each density's common window of cluster sizes (kappa_windows)."""
+    over each density's common window of cluster sizes (kappa_windows; the
+    cage-relative window from multi_cr, the cage-relative rows' points)."""
     cb = [("C_B at the longest common lag with an error (bond breaking)", "c_b", c_b_at(c_b_times(multi)), False, False)]
-    kw = kappa_windows(multi)
+    kw = kappa_windows(multi, multi_cr)
     rest = [(name, slug, kappa_common(kw), c, lg) if slug == "kappa" else (name, slug, fn, c, lg)
             for name, slug, fn, c, lg in REST_ROWS]
     return TAU_ROWS + cb + CHI4P_ROWS + rest
 
 
-def kappa_windows(multi):
+def kappa_windows(multi, multi_cr=None):
     """{(phi, cr): N*_min}: per density and measure the smallest cutoff size
-    N* = <N_c^2>/<N_c> over every run at every N, the common upper end of
-    the kappa fits (3 <= N_c <= N*_min), so that every N fits the same
-    cluster sizes: each run's own N* grows with the box where the box cuts
-    the largest clusters off, and so would the window."""
+    N* = <N_c^2>/<N_c> over every run at every N (the cage-relative one over
+    multi_cr's runs, where given), the common upper end of the kappa fits
+    (3 <= N_c <= N*_min), so that every N fits the same cluster sizes: each
+    run's own N* grows with the box where the box cuts the largest clusters
+    off, and so would the window. A run whose own window holds fewer than 3
+    bins with data (it could fit no kappa itself) does not narrow the
+    others'."""
     out = {}
-    for phi, d in multi.items():
-        for cr in (False, True):
+    for cr, src in ((False, multi), (True, multi if multi_cr is None else multi_cr)):
+        for phi, d in src.items():
             vals = []
             for p in d.values():
                 for r in p.runs:
                     try:
+                        c = cutx(r, cr)
                         v = n_star(dict(r, cut=r["cut_cr"]) if cr else r)[0]
+                        n, pp, pe = (np.asarray(c[k], float) for k in ("cl_size", "cl_p_slow", "cl_p_slow_err"))
                     except (KeyError, TypeError, ValueError):
                         continue
-                    if np.isfinite(v):
+                    bins = np.isfinite(pp) & (pp > 0) & np.isfinite(pe) & (pe > 0) & (n >= 3) & (n <= v)
+                    if np.isfinite(v) and bins.sum() >= 3:
                         vals.append(v)
             if vals:
                 out[(round(float(phi), 6), cr)] = min(vals)
