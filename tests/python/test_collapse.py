@@ -1,5 +1,4 @@
 """collapse.py: the exponent of a data collapse (the paper's kappa, fig. dist-collapse)."""
-import math
 
 import numpy as np
 

@@ -158,7 +158,7 @@ def test_the_header_names_what_still_drifts_at_the_n_taken():
     assert still_drifting({0.79: d}, d, d, 4096) == ["τ_α — cage-relative: 25 ± 0.5 per doubling of N (+10%) from N = 1024 to 4096"]
 
 
-def test_a_size_the_leading_protocol_has_not_finished_is_not_filled_from_another_study():
+def test_the_finite_size_table_holds_back_a_size_the_leading_protocol_has_not_finished():
     """A referee's point: at phi 0.76 the scale study's N = 65536 was still
     running, and d_size's one-seed run (other run lengths) filled the
     column. The study that runs phi at the most N (its unfinished sizes

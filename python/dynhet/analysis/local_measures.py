@@ -81,7 +81,7 @@ def local_n_results(A):
                               + (f", spread ± {ms[i][2]:.2g})" if ms[i][3] > 1 else ")") for i in ok)
             # the finite-size table's rule and inputs: measured errors only, sizes where every seed has a
             # value, and not a size whose tau_alpha(t0) (of the same measure) moves over its production
-            from .finite_size import unsteady   # (tau_B: the standard tau_alpha(t0))
+            from .steady import unsteady   # (tau_B: the standard tau_alpha(t0))
             steady = {i: not unsteady(d[ns[i]], fn is TAU_CR) for i in ok}
             verdict = size_verdict([ns[i] for i in ok], [ms[i][0] for i in ok],
                                    [measured_error(ms[i]) if ms[i][3] == len(d[ns[i]].runs) and steady[i] else math.nan

@@ -239,7 +239,8 @@ def still_drifting(multi, d, d_cr, n_top):
     whose verdict over the sizes up to n_top at one density says "drifting":
     the rows taken at that N carry them, not only tau_alpha ("name: the drift
     per doubling")."""
-    from .finite_size import change_dof, quantity_rows, steady_off
+    from .finite_size import quantity_rows
+    from .steady import change_dof, steady_off
     from .points import measured_error
     from .size_rows import quantities
     out = []
@@ -271,7 +272,8 @@ def largest_n_notes(A):
     tau_alpha (size_verdict over the sizes of that density: "largest
     converged", else "largest available"), and the larger sizes held back
     because runs of them are unfinished."""
-    from .finite_size import quantity_rows, unsteady   # the finite-size table's own verdicts
+    from .finite_size import quantity_rows   # the finite-size table's own verdicts
+    from .steady import unsteady
     from .size import points_by_phi_n
     from .size_rows import has_cr, tau_of
     multi = points_by_phi_n(A)   # the main series (neighbours, eps = 0.9): the others have no sizes of their own here
