@@ -11,7 +11,7 @@ import numpy as np
 matplotlib.use("Agg")
 
 from dynhet.analysis.finite_size import size_verdict, spread_ratio, write_finite_size  # noqa: E402
-from dynhet.analysis.size_rows import MIN_SHELLS, xi_shells  # noqa: E402
+from dynhet.analysis.size_rows import MIN_SHELLS, chi4p_grid, xi_shells  # noqa: E402
 from dynhet.analysis.points import Point  # noqa: E402
 from dynhet.analysis.study import Analysis  # noqa: E402
 
@@ -363,10 +363,16 @@ def test_chi4p_against_the_sub_box_is_drawn_per_n_from_interior_peaks_only(tmp_p
     for n in (1024, 4096):
         p = Point(("neighbours", 0.9, 0.79, n))
         for seed in (1, 2):
-            c = {"chi4_N": np.array([32.0, 128.0, float(n)]), "chi4_peak": np.array([1.0, 2.0, 5.0]),
-                 "tau4_interior": np.array([True, True, seed == 1])}
+            c = {"chi4_N": np.array([32.0, 128.0, float(n)]), "chi4_peak": np.array([1.0, 2.0 + seed, 5.0]),
+                 "chi4_peak_err": np.array([0.1, 0.3, 0.5]), "tau4_interior": np.array([True, True, seed == 1])}
             p.runs.append({"seed": seed, "N": n, "cut": {0.6: c}})
         multi[0.79][n] = p
+    # the points and their error bars: the mean over seeds with the table's error (Point.mean)
+    p = multi[0.79][4096]
+    v, e, sem, k = p.mean(chi4p_grid(128))
+    assert (v, k) == (3.5, 2) and math.isclose(e, math.hypot(0.3, 0.3) / 2)
+    assert p.mean(chi4p_grid(4096))[:2] == (5.0, 0.5)          # the whole box: seed 2's peak is no peak
+    assert p.mean(chi4p_grid(512))[3] == 0                     # no grid of that size
     f = plot_chi4p_subbox(A, multi, multi_cr)
     assert f.endswith("fs_chi4p_subbox.png") and (tmp_path / "figures" / "fs_chi4p_subbox.png").stat().st_size > 5000
     for p in multi[0.79].values():

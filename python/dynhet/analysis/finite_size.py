@@ -15,8 +15,8 @@ from .plotting import colours, errorbar
 from .quantities import s4_at_tau
 from .points import MIN_CAL_DOF, ensure_calibrated, measured_error, spread_ratio as pooled_spread
 from .size import Z_CONVERGED, held_back, others_note, points_by_phi_n, size_verdict, study_of
-from .size_rows import (CHI4P_ROWS, MIN_SHELLS, TAU_ROWS, c_b_times, has_cr, kappa_windows, lags_in_tau_cr, missing_cell,
-                        quantities, shells_note, tau_b_bound, tau_b_points)
+from .size_rows import (CHI4P_ROWS, MIN_SHELLS, TAU_ROWS, c_b_times, chi4p_grid, has_cr, kappa_windows, lags_in_tau_cr,
+                        missing_cell, quantities, shells_note, tau_b_bound, tau_b_points)
 from .steady import change_dof, steady_verdict, unsteady
 from .verdicts import fmt
 
@@ -156,7 +156,8 @@ def plot_quantity(A, name, slug, fn, has_cr_version, log_y, multi, multi_cr):
 
 def panels_per_phi(A, multi, multi_cr, curve, title, xlabel, ylabel, name, ms):
     """One log-log panel per density, a curve per N, standard (filled, solid)
-    and cage-relative (open, dashed): curve(point, cr) -> (x, y) or None.
+    and cage-relative (open, dashed): curve(point, cr) -> (x, y), (x, y,
+    errors of y) or None.
     The saved figure's path, "" where no curve has data."""
     phis = list(multi)
     cols = min(3, len(phis))                      # three panels a row: readable at six densities
@@ -173,8 +174,12 @@ def panels_per_phi(A, multi, multi_cr, curve, title, xlabel, ylabel, name, ms):
                 xy = curve(p, cr) if p is not None else None
                 if xy is None:
                     continue
-                ax.loglog(*xy, ls, ms=ms, lw=1, color=col, mfc="none" if cr else col,
-                          label=f"N = {n}" + (" (cage-relative)" if cr else ""))
+                x, y = xy[0], xy[1]
+                yerr = xy[2] if len(xy) > 2 else None   # a curve may carry its errors
+                ax.errorbar(x, y, yerr=yerr, fmt=ls, ms=ms, lw=1, capsize=2, color=col, mfc="none" if cr else col,
+                            label=f"N = {n}" + (" (cage-relative)" if cr else ""))
+                ax.set_xscale("log")
+                ax.set_yscale("log")
                 drawn = True
         ax.set_title(f"φ = {phi:g}: {title}")
         ax.set_xlabel(xlabel)
@@ -215,24 +220,21 @@ def plot_s4_q(A, multi, multi_cr):
 def plot_chi4p_subbox(A, multi, multi_cr):
     """The paper's fig. chi4P(a) at every box size: chi4^P against the
     sub-box's particles, one panel per density, a curve per N (the mean over
-    seeds; interior peaks only; the last point of a curve is the whole box,
+    seeds with the table's error: size_rows.chi4p_grid; interior peaks
+    only; the last point of a curve is the whole box,
     where the study's sub-box sizes reach it: short_of_box),
     standard (filled) and cage-relative (open): where a sub-box's chi4^P
     does not depend on the box around it, and how far the larger boxes
     extend the curve."""
     def curve(p, cr):
-        by_size = {}
-        for r in p.runs:
-            c = r.get("cut_cr" if cr else "cut", {}).get(A_MAIN, {})
-            if "chi4_N" not in c:
-                continue
-            for size, peak, inside in zip(c["chi4_N"], c["chi4_peak"], c["tau4_interior"]):
-                if inside and np.isfinite(peak):
-                    by_size.setdefault(round(float(size)), []).append(float(peak))
-        if not by_size:
+        sizes = sorted({round(float(n)) for r in p.runs
+                        for n in r.get("cut_cr" if cr else "cut", {}).get(A_MAIN, {}).get("chi4_N", ())})
+        pts = [(s, p.mean(chi4p_grid(s, cr))) for s in sizes]
+        pts = [(s, m) for s, m in pts if m[3] and np.isfinite(m[0])]
+        if not pts:
             return None
-        x = sorted(by_size)
-        return x, [np.mean(by_size[k]) for k in x]
+        return ([s for s, _ in pts], [m[0] for _, m in pts],
+                [np.nan_to_num(measured_error(m)) for _, m in pts])
     return panels_per_phi(A, multi, multi_cr, curve, "χ4^P against the sub-box", "particles in the sub-box",
                           "χ4^P (mean over seeds)", "fs_chi4p_subbox.png", 3)
 

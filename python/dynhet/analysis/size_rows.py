@@ -39,6 +39,20 @@ def chi4p_of(size):
     return fn
 
 
+def chi4p_grid(size, cr=False):
+    """chi4^P of the run's grid of exactly `size` particles per sub-box
+    (rounded; the whole box too), as a per-run function for Point.mean
+    (the cage-relative one with cr): the points of fig. chi4P(a); NaN where
+    the run has no such grid or its peak is not interior."""
+    def fn(r):
+        c = cutx(r, cr)
+        for n, peak, err, inside in zip(c["chi4_N"], c["chi4_peak"], c["chi4_peak_err"], c["tau4_interior"]):
+            if round(float(n)) == size:
+                return (peak, err) if inside else (math.nan, math.nan)
+        return math.nan, math.nan
+    return fn
+
+
 def xi_shells(r, cr=False):
     """(xi, error, shells): the whole box's OZ xi at tau_alpha (the
     reproduction's xi: quantities.xi_of_cut) and how many q shells lie below
