@@ -174,16 +174,15 @@ def panels_per_phi(A, multi, multi_cr, curve, title, xlabel, ylabel, name, ms):
                 xy = curve(p, cr) if p is not None else None
                 if xy is None:
                     continue
-                x, y = xy[0], xy[1]
                 yerr = xy[2] if len(xy) > 2 else None   # a curve may carry its errors
-                ax.errorbar(x, y, yerr=yerr, fmt=ls, ms=ms, lw=1, capsize=2, color=col, mfc="none" if cr else col,
-                            label=f"N = {n}" + (" (cage-relative)" if cr else ""))
-                ax.set_xscale("log")
-                ax.set_yscale("log")
+                errorbar(ax, xy[0], xy[1], yerr, fmt=ls, ms=ms, lw=1, capsize=2, color=col,
+                         mfc="none" if cr else col, label=f"N = {n}" + (" (cage-relative)" if cr else ""))
                 drawn = True
         ax.set_title(f"φ = {phi:g}: {title}")
         ax.set_xlabel(xlabel)
         if ax.has_data():
+            ax.set_xscale("log")
+            ax.set_yscale("log")
             ax.legend(fontsize=6)
     if not drawn:
         plt.close(fig)
@@ -234,7 +233,7 @@ def plot_chi4p_subbox(A, multi, multi_cr):
         if not pts:
             return None
         return ([s for s, _ in pts], [m[0] for _, m in pts],
-                [np.nan_to_num(measured_error(m)) for _, m in pts])
+                [measured_error(m) for _, m in pts])
     return panels_per_phi(A, multi, multi_cr, curve, "χ4^P against the sub-box", "particles in the sub-box",
                           "χ4^P (mean over seeds)", "fs_chi4p_subbox.png", 3)
 
