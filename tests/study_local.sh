@@ -1,11 +1,11 @@
 #!/usr/bin/env bash
 # The study runner on the local executor (launch_scripts/run_study.sh):
 # studies/tiny.toml end to end; the same command again skips every run; a
-# study stopped by SIGTERM in a run's production is resumed from that
-# run's checkpoint and ends with the results of the uninterrupted study,
-# bit for bit; a changed study file and an invalid one are refused with
-# messages naming the problem. Each run is on its own private bus
-# (run_scene.sh).
+# study stopped by SIGTERM in a run's production (a second SIGTERM during
+# the stop is said, not raised) is resumed from that run's checkpoint and
+# ends with the results of the uninterrupted study, bit for bit; a changed
+# study file and an invalid one are refused with messages naming the
+# problem. Each run is on its own private bus (run_scene.sh).
 set -euo pipefail
 root=$1 build=$2
 export BUILD_DIR=$build
@@ -80,8 +80,13 @@ for _ in $(seq 600); do
   sleep 0.1
 done
 kill -TERM "$runner"
+# A second SIGTERM while the runs write their checkpoints (Ctrl-C twice, a
+# shutdown that repeats itself) is said, and the stop goes on.
+for _ in $(seq 200); do grep -q "stopping the runs" "$tmp/b.out" && break; sleep 0.02; done
+kill -TERM "$runner" 2>/dev/null || true
 wait "$runner" && rc=0 || rc=$?
 check '[[ $rc == 130 ]]' "stopped study exits 130 (got $rc)"
+check '! grep -q "Traceback" "$tmp/b.out"' "a second SIGTERM during the stop: no traceback"
 check 'grep -qs "state = \"interrupted\"" "$tmp"/b/runs/*/status.toml' "the stopped run is marked interrupted"
 stopped=$(grep -ls "state = \"interrupted\"" "$tmp"/b/runs/*/status.toml | head -1)
 cpu_before=$(sed -n 's/^cpu_s = //p' "$stopped")

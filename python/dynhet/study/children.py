@@ -31,6 +31,15 @@ def stop_children():
             os.killpg(proc.pid, signal.SIGKILL)
 
 
+def already_stopping(*_):
+    """The handler of SIGINT/SIGTERM once the study is stopping: a second
+    signal (Ctrl-C twice, a shutdown's repeated SIGTERM) is said, not raised.
+    Raised, it cut stop_children short: the runs went on writing their
+    checkpoints unwatched and the study died with a traceback, leaving a run
+    marked "running". A signal handler: one write, no lock."""
+    os.write(2, b"study: already stopping; each run is writing its checkpoint (at most 2 min, then it is killed)\n")
+
+
 RESUMABLE = 75  # run_scene.sh: interrupted, resumable from a whole checkpoint cut
 
 

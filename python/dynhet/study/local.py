@@ -1,5 +1,6 @@
 """The local executor: a pool of runs on this machine, with progress; the analysis when all are done."""
 import os
+import signal
 import subprocess
 import sys
 import threading
@@ -9,7 +10,7 @@ from .paths import ROOT
 from .model import AXES, StudyError, StudyInterrupted
 from .estimates import fmt_time
 from .rundir import read_status, write_status
-from .children import STOPPING, stop_children
+from .children import STOPPING, already_stopping, stop_children
 from .runner import do_run
 from .index import run_estimates, run_order, write_index
 from .progress import PROGRESS_EVERY, describe, eta_seconds, sim_progress, study_eta
@@ -111,6 +112,8 @@ def run_local(sd, jobs):
                 for name, (d, since) in active:
                     say(describe(name, d, since))
     except KeyboardInterrupt:
+        for sig in (signal.SIGINT, signal.SIGTERM):  # a second signal must not cut the stop short
+            signal.signal(sig, already_stopping)
         say(f"study {sd.study.name}: stopping the runs (each writes a checkpoint)")
         stop_children()
         for t in threads:
