@@ -457,11 +457,8 @@ grep -h -E "tau_alpha|frames whole|complete|missing" "$out"/*_node.log "$out/rec
 # A run stopped by a signal goes on later: no plots now (a Slurm task has
 # seconds left before its time limit).
 if ((plots)) && [[ -f $out/run.h5 && -z ${stop_signal:-} ]]; then
-  for obs in chi4 msd displacement clusters s4; do # plots of the observables the run has
-    /usr/bin/python3 -c "import h5py,sys; sys.exit(0 if 'observables/$obs' in h5py.File('$out/run.h5','r') else 1)" 2>/dev/null &&
-      { /usr/bin/python3 "$root/launch_scripts/plot_$obs.py" "$out/run.h5" "$out/$obs.png" || status=1; }
-  done
-  /usr/bin/python3 "$root/launch_scripts/plot_overlap.py" "$out/run.h5" "$out/overlap.png" ||
+  # every observable's figure that the run has, and overlap.png, in one process
+  /usr/bin/python3 "$root/launch_scripts/plot_run.py" "$out/run.h5" "$out" ||
     { echo "run_scene: plotting failed" >&2; status=1; }
 fi
 if [[ -n $cuts && $status -eq 0 && -f $out/run.h5 ]] &&
