@@ -18,6 +18,8 @@ check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
 DYNHET_STUDY_PROGRESS_EVERY=1 "${study[@]}" "$root/studies/tiny.toml" --out "$tmp/a" --jobs 2 >"$tmp/a.out" 2>&1 ||
   { cat "$tmp/a.out"; exit 1; }
 check 'grep -q "4 of 4 runs complete, 0 failed" "$tmp/a.out"' "tiny study: 4 of 4 runs complete"
+check '! ls "$tmp"/a/runs/*/*.png "$tmp"/a/pilots/*/*.png >/dev/null 2>&1 && grep -q -- "--no-plots" "$tmp"/a/runs/*/run_scene.log' \
+  "run_plots = false: no run or pilot drew its PNGs (run_scene.sh --no-plots)"
 # Progress while runs go on (every second here): a line per running run, from its sim's own progress line.
 check 'grep -Eq "^  phi0\.[0-9]+_eps0\.900_n300_seed[12]: (equilibrate|production|done) t = .* of the phase\), frames [0-9]+/[0-9]+, the sim.s ETA" "$tmp/a.out"' \
   "progress lines name each running run's phase, time, frames and ETA"

@@ -59,7 +59,7 @@ def test_points_overrides_and_run_lengths(tmp_path):
 
 def test_every_problem_is_named(tmp_path):
     bad = GOOD.replace('tau_alpha = "pilot"', 'tau_alpha = "guess"').replace("lag_max_tau = 30.0", "lag_max_tau = 0.01") \
-              .replace("[study]", "[study]\ncolour = 1").replace("packing_fraction = 0.70, restitution = 0.8",
+              .replace("[study]", "[study]\ncolour = 1\nrun_plots = \"no\"").replace("packing_fraction = 0.70, restitution = 0.8",
                                                                "packing_fraction = 0.75, restitution = 0.8")
     with pytest.raises(StudyError) as e:
         study(tmp_path, bad)
@@ -68,6 +68,7 @@ def test_every_problem_is_named(tmp_path):
     assert "run_length.lag_min_tau: must be smaller than run_length.lag_max_tau" in msg
     assert "override[0].when.packing_fraction: value 0.75 is not on axis" in msg
     assert "colour" in msg
+    assert "study.run_plots: value 'no' must be true or false" in msg
 
 
 def test_run_lengths_in_the_cage_relative_tau_alpha(tmp_path):

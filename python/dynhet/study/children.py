@@ -78,9 +78,11 @@ def call_child(cmd, log, **kw):
             CHILDREN.discard(proc)
 
 
-def run_scene(scene_path, out, log_path, resume=None, fresh=False):
-    """fresh: the run starts over (run_scene.sh --fresh), its old cuts and file discarded."""
+def run_scene(scene_path, out, log_path, resume=None, fresh=False, plots=True):
+    """fresh: the run starts over (run_scene.sh --fresh), its old cuts and file
+    discarded; plots=False: no PNGs (run_scene.sh --no-plots)."""
     cmd = ["bash", RUN_SCENE, "--no-build", "--out", out] + (["--fresh"] if fresh else [])
+    cmd += [] if plots else ["--no-plots"]
     cmd += ["--resume", resume] if resume else [scene_path]
     with open(log_path, "a") as log:
         log.write(f"\n# {time.strftime('%Y-%m-%d %H:%M:%S')} {' '.join(cmd)}\n")

@@ -69,9 +69,15 @@ class Study:
                 self.errors.append(f"{k}: unknown key or table; known: {', '.join(sorted(known))}")
         st = data.get("study", {})
         for k in st:
-            if k not in ("name", "description", "scene", "prepared_states"):
+            if k not in ("name", "description", "scene", "prepared_states", "run_plots"):
                 self.errors.append(f"study.{k}: unknown key; known keys in [study]: name, description, scene, "
-                                   "prepared_states")
+                                   "prepared_states, run_plots")
+        # Each run's own figures (run_scene.sh's PNGs); the study's analysis
+        # draws its figures either way.
+        self.run_plots = st.get("run_plots", True)
+        if not isinstance(self.run_plots, bool):
+            self.errors.append(f"study.run_plots: value {self.run_plots!r} must be true or false")
+            self.run_plots = True
         # true or "compressed": compression once per (N, phi, ratio, seed);
         # "equilibrated": also the equilibration, once per run dynamics
         # (extended, never repeated, when a run needs more); false: neither.

@@ -125,7 +125,7 @@ def do_run(sd, p, log=print):
     # can never make the run complete).
     again = state in ("failed", "too_short", "unknown")
     rc, wall, cpu = run_scene(scene_path, d, os.path.join(d, "run_scene.log"), None if resume == "cut" else resume,
-                              fresh=again and resume is None)
+                              fresh=again and resume is None, plots=sd.study.run_plots)
     # A process of the run died (exit 75: resumable): again from the last
     # whole cut, a few times, before the run counts as failed; twice in a row
     # without a new whole cut is no transient (a resume that fails the same
@@ -140,7 +140,7 @@ def do_run(sd, p, log=print):
             break
         cut0 = cut1
         log(f"{st.run_name(p)}: interrupted (a process died); resuming from its last checkpoint cut")
-        rc2, wall2, cpu2 = run_scene(scene_path, d, os.path.join(d, "run_scene.log"))
+        rc2, wall2, cpu2 = run_scene(scene_path, d, os.path.join(d, "run_scene.log"), plots=sd.study.run_plots)
         rc, wall, cpu = rc2, wall + wall2, cpu + cpu2
     if rc == RESUMABLE and not STOPPING.is_set() and newest_whole_cut(d) == cut0:
         rc = 1  # no progress: a failure, not an interruption

@@ -134,7 +134,8 @@ def pilot_locked(sd, p, name, d):
         sc = st.scene(p, g, pilot=True)
         prepared_state(sd, sc)
         write_atomic(os.path.join(d, "scene.toml"), toml_dump(sc, f"# pilot of {name}, tau guess {g:.6g}"))
-        rc, wall, cpu = run_scene(os.path.join(d, "scene.toml"), d, os.path.join(d, "run_scene.log"))
+        rc, wall, cpu = run_scene(os.path.join(d, "scene.toml"), d, os.path.join(d, "run_scene.log"),
+                                  plots=st.run_plots)
         if STOPPING.is_set():
             raise StudyInterrupted(f"pilot of {name} stopped")
         complete, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc), st.tau_group())
