@@ -24,12 +24,20 @@
 #                    refused, and the processes check each one again
 #   --only-verified  instead, play only the messages that verify, and say
 #                    how many did not
+#   --fresh          DIR holds results of something else (a live run's
+#                    run.h5 and logs, another replay; refused without it):
+#                    move them into DIR/old-<time>/ first (nothing is deleted).
+#                    A replay of the same LOGs into the DIR it wrote before
+#                    replays again without it
+# Exit: 0 replayed; 1 a process failed; 2 bad arguments, a log refused or a
+# refused DIR (nothing written); 130 interrupted (the same command replays
+# again). The last line says where and the exit.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
-log="" out="" build_first=1 run_id="" list=0 segments=() key_file="" only_verified=0 checked=0
+log="" out="" build_first=1 run_id="" list=0 segments=() key_file="" only_verified=0 checked=0 fresh=0
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
@@ -37,6 +45,7 @@ while (($#)); do
   --run-id) run_id=$2; shift 2 ;;
   --key-file) key_file=$2; shift 2 ;;
   --only-verified) only_verified=1; shift ;;
+  --fresh) fresh=1; shift ;;
   --log-checked) checked=1; shift ;; # internal: the first pass checked LOG (the re-run in the namespace)
   --list) list=1; shift ;;
   -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;;
@@ -45,6 +54,30 @@ while (($#)); do
   esac
 done
 for s in "${segments[@]}"; do [[ -f $s ]] || { echo "replay: no log file $s" >&2; exit 2; }; done
+# DIR may hold a replay of these same logs (its REPLAY file names them),
+# which this one replaces; results of anything else are refused, or moved
+# aside with --fresh. (The re-run inside the namespace comes after this.)
+if [[ -n $out && $list == 0 && $checked == 0 ]]; then
+  source "$root/launch_scripts/lib/out_dir.sh"
+  mapfile -t there < <(held "$out" run.h5 checkpoint.h5 checkpoint_before_frames.h5 checkpoints scene.toml '*.log' '*.png' \
+    segments.lcmlog verified.lcmlog)
+  replay_of=$(for s in "${segments[@]}"; do realpath -m "$s"; done)
+  if ((${#there[@]})) && ! { [[ -f $out/REPLAY ]] && [[ $(cat "$out/REPLAY") == "$replay_of" ]]; }; then
+    if ((fresh)); then
+      [[ ! -f $out/REPLAY ]] || there+=(REPLAY)
+      to=$(move_aside "$out" "${there[@]}")
+      echo "replay: --fresh: what $out held (${there[*]}) moved to $to" >&2
+    else
+      what="results that are not a replay of $(paste -sd' ' <<<"$replay_of")"
+      [[ ! -f $out/scene.toml ]] || what="a run's results (scene.toml: a live run, not a replay)"
+      echo "replay: refused: $out holds $what: ${there[*]}" >&2
+      echo "replay: nothing was written; give another --out, or add --fresh to move them into $out/old-<time>/ (nothing is deleted)" >&2
+      exit 2
+    fi
+  fi
+  mkdir -p "$out"
+  printf '%s\n' "$replay_of" >"$out/REPLAY"
+fi
 if ((${#segments[@]} == 1)); then
   log=${segments[0]}
 elif ((${#segments[@]} > 1)); then
@@ -111,6 +144,10 @@ fi
 
 # Which nodes ran: the observables named in the run info of the log. The
 # scene text is in the log; nodes are found by their results channels.
+# From here the last line says where the results are and how it ended.
+trap 'rc=$?; [[ -z ${rec:-} ]] || kill "$rec" 2>/dev/null || true
+  case $rc in 0 | 1 | 2 | 130) ;; *) rc=1 ;; esac; echo "replay: results in $out (exit $rc)" >&2; exit $rc' EXIT
+trap 'echo "replay: interrupted" >&2; exit 130' INT TERM
 nodes=$("$bin/recorder" --list-nodes "$log") || { echo "replay: cannot read run info from $log" >&2; exit 1; }
 bus="udpm://239.255.76.67:7670?ttl=0&recv_buf_size=4194304"
 
@@ -125,6 +162,7 @@ for n in $nodes; do
     echo "replay: $n failed; log $out/$n.log" >&2; tail -3 "$out/$n.log" >&2; status=1; }
 done
 wait $rec || { echo "replay: recorder failed; log $out/recorder.log" >&2; tail -3 "$out/recorder.log" >&2; status=1; }
+rec=""
 grep -h -E "tau_alpha|frames whole" "$out"/*_node.log >&2 || true
 if [[ -f $out/run.h5 ]]; then
   for obs in chi4 msd displacement clusters s4; do # plots of the observables the run has

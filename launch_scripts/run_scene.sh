@@ -3,15 +3,20 @@
 # the recorder, then plots. The whole pipeline checkpoints as it goes
 # (DIR/checkpoints, docs/checkpoints.md): the same command on the same
 # --out DIR resumes an interrupted run from its last whole cut, bit for bit.
-# Exit: 0 complete; 75 interrupted and resumable (SIGTERM/SIGINT, or a
-# process died: run the same command again); 1 failed; 2 bad arguments or
-# a scene that differs from the interrupted run's.
+# Exit: 0 complete; 1 the run failed; 2 bad arguments or a refused --out
+# (nothing written); 75 interrupted and resumable (SIGTERM/SIGINT, or a
+# process died: run the same command again); 130 interrupted, not
+# resumable (--no-checkpoints). The last line says where and the exit.
 #
 # Usage: launch_scripts/run_scene.sh SCENE.toml [options]
 #   --out DIR       where run.h5, plots and logs go (default runs/<scene>-<time>);
 #                   a DIR that holds an interrupted run of the same scene is
-#                   resumed from its last whole checkpoint cut
-#   --fresh         start over in DIR (its checkpoints and run.h5 go)
+#                   resumed from its last whole checkpoint cut; a DIR that
+#                   holds anything else of a run (a run.h5 without its
+#                   scene.toml, a run of another scene) is refused
+#   --fresh         start over in DIR: what it holds of an earlier run (run.h5,
+#                   checkpoints, logs, plots, key) is moved into DIR/old-<time>/,
+#                   never deleted
 #   --no-checkpoints  no checkpoint cuts (the run cannot be resumed)
 #   --bus private   (default) a private network namespace: no packet leaves
 #                   the machine, nothing else on the host sees the run
@@ -120,6 +125,60 @@ fi
 
 if ((build_first)) && [[ -z ${DYNHET_IN_NETNS:-} ]]; then BUILD_DIR=$build "$root/launch_scripts/setup.sh"; fi
 
+# What --out DIR may already hold: the run this command resumes (DIR's
+# scene.toml is this scene, checkpoint cuts on) or continues (--resume from
+# DIR's own checkpoint, its run.h5 not complete). Anything else of a run
+# that it would write over is refused, naming it; --fresh moves it into
+# DIR/old-<time>/ first (and the scene or checkpoint to run from, if it was
+# among it, is read from there).
+source "$root/launch_scripts/lib/out_dir.sh"
+guard_out() {
+  local own=0 why="" there=() move=() to f
+  if [[ $role == all && -z $resume && $no_cuts == 0 && -f $out/scene.toml ]] && cmp -s "$scene" "$out/scene.toml"; then own=1; fi
+  [[ -z $resume || $(realpath -m "$(dirname "$resume")") != "$(realpath -m "$out")" ]] || own=1
+  mapfile -t there < <(held "$out" run.h5 checkpoint.h5 checkpoint_before_frames.h5 checkpoints scene.toml '*.log' '*.png' |
+    grep -vx run_scene.log) # (run_scene.log: a study's log of its calls, open while this runs)
+  if ((${#there[@]})); then
+    if ((own)); then
+      [[ -z $resume ]] || ! complete_run "$out/run.h5" || why="a complete run, which --resume would compute again"
+    elif [[ -n $scene && -f $out/scene.toml ]] && ! cmp -s "$scene" "$out/scene.toml"; then
+      /usr/bin/python3 "$root/launch_scripts/scene_diff.py" "$out/scene.toml" "$scene" >&2 || true
+      why="a run of another scene (the keys that differ above)"
+    elif [[ -f $out/scene.toml ]]; then
+      why="a run of this scene that this command would start over, not resume (it resumes with checkpoint cuts on, --role all)"
+    else
+      why="results of a run without the scene.toml that says which (not written by run_scene.sh for this scene)"
+    fi
+  fi
+  if [[ -n $record && -e $record ]] && ((!own)); then
+    why+="${why:+; and }--record $record exists"
+  fi
+  if [[ -n $why ]] && ((!fresh)); then
+    echo "run_scene: refused: $out holds $why: ${there[*]:-}" >&2
+    echo "run_scene: nothing was written; give another --out, or add --fresh to move what it holds into $out/old-<time>/ (nothing is deleted)" >&2
+    exit 2
+  fi
+  ((fresh)) || return 0
+  # --fresh: the earlier run moves aside whole (with the scene it ran, which
+  # stays in place when it is the scene to run now, a study's run directory)
+  for f in "${there[@]}"; do
+    [[ $f == scene.toml && $(realpath -m "${scene:-/}") == "$(realpath -m "$out/scene.toml")" ]] || move+=("$f")
+  done
+  [[ -n $key_file || ! -e $out/bus.key ]] || move+=(bus.key) # a new run, a new key
+  if ((${#move[@]})); then
+    to=$(move_aside "$out" "${move[@]}")
+    [[ ! -f $out/scene.toml || " ${move[*]} " == *" scene.toml "* ]] || cp -p "$out/scene.toml" "$to/"
+    [[ -z $resume || ! -e $to/$(basename "$resume") || -e $resume ]] || resume=$to/$(basename "$resume")
+    echo "run_scene: --fresh: the earlier run in $out (${move[*]}) moved to $to" >&2
+  fi
+  if [[ -n $record && -e $record ]] && ((!own)); then
+    to=$record.old-$(date +%Y%m%d-%H%M%S)
+    mv -- "$record" "$to"
+    echo "run_scene: --fresh: the earlier log $record moved to $to" >&2
+  fi
+  return 0
+}
+
 # Refuse a bad scene before anything starts.
 check=$("$bin/sim_node" "${sim_input[@]}" --check) || exit 2
 nodes=$(sed -n 's/^nodes: *//p' <<<"$check")
@@ -127,6 +186,8 @@ nodes=$(sed -n 's/^nodes: *//p' <<<"$check")
 name=$(basename "${scene:-$resume}" .toml)
 name=${name%.h5}
 out=${out:-$root/runs/$name-$(date +%Y%m%d-%H%M%S)}
+guard_out
+[[ -z $resume ]] || sim_input=(--resume "$resume") # (moved aside with the run it belongs to)
 mkdir -p "$out"
 out=$(cd "$out" && pwd)
 [[ -z $record ]] || record=$(cd "$(dirname "$record")" && pwd)/$(basename "$record")
@@ -148,24 +209,30 @@ if [[ ($bus == private || $bus == tcpq) && -z ${DYNHET_IN_NETNS:-} ]]; then
   exec "$root/launch_scripts/netns.sh" "$0" ${scene:+"$scene"} "${args[@]}"
 fi
 
+pids=() names=() reaped=()
+# On every exit from here: the run's processes stopped (lcm-logger too: an
+# early exit left it recording), and the last line says where the results
+# are and how it ended, with one of the exit codes above (an unforeseen
+# failure of a command of this script is the run's failure, 1).
+cleanup() {
+  local rc=$?
+  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
+  [[ -z ${logger_pid:-} ]] || kill -INT "$logger_pid" 2>/dev/null || true
+  [[ -z ${hub_pid:-} ]] || kill "$hub_pid" 2>/dev/null || true
+  case $rc in 0 | 1 | 2 | 75 | 130) ;; *) rc=1 ;; esac
+  echo "run_scene: results in $out (exit $rc)" >&2
+  exit "$rc"
+}
+trap cleanup EXIT
+
 # Checkpoint cuts of the whole pipeline (one host, a scene given): a run
 # interrupted in DIR resumes from its last whole cut.
 cuts="" cut_args=() resume_cut=()
 if [[ $role == all && -z $resume && $no_cuts == 0 ]]; then
   cuts=$out/checkpoints
-  if ((fresh)); then
-    rm -rf "$cuts"/cut-* "$cuts"/frames "$cuts"/recorder.journal "$out/run.h5"
-    # (not the scene to run, when it is DIR's own: the study runner's)
-    [[ $(realpath "$scene") == $(realpath -m "$out/scene.toml") ]] || rm -f "$out/scene.toml"
-  fi
-  if [[ -f $out/scene.toml ]] && ! cmp -s "$scene" "$out/scene.toml"; then
-    # The run in DIR was of another scene: name the keys that differ.
-    /usr/bin/python3 "$root/launch_scripts/scene_diff.py" "$out/scene.toml" "$scene" >&2 || true
-    echo "run_scene: $out holds a run of another scene (above); use another --out, or --fresh to start over" >&2
-    exit 2
-  fi
-  if [[ -f $out/run.h5 ]] && /usr/bin/python3 -c "import h5py, sys; sys.exit(0 if int(h5py.File(sys.argv[1], 'r').attrs.get('complete', 0)) == 1 else 1)" "$out/run.h5" 2>/dev/null && [[ -f $out/scene.toml ]]; then
-    echo "run_scene: $out/run.h5 is complete: nothing to resume (--fresh starts over)" >&2
+  # (a DIR holding a run of another scene was refused, or moved aside by --fresh, above)
+  if [[ -f $out/run.h5 && -f $out/scene.toml ]] && complete_run "$out/run.h5"; then
+    echo "run_scene: $out/run.h5 is complete: nothing to resume (--fresh moves it aside and starts over)" >&2
     exit 0
   fi
   cp "$scene" "$out/scene.toml.tmp" && mv "$out/scene.toml.tmp" "$out/scene.toml"
@@ -192,12 +259,6 @@ if [[ $role == all && -z $resume && $no_cuts == 0 ]]; then
     fi
   fi
 fi
-pids=() names=() reaped=()
-cleanup() { # (lcm-logger too: an early exit left it recording)
-  for p in "${pids[@]}"; do kill "$p" 2>/dev/null || true; done
-  [[ -z ${logger_pid:-} ]] || kill -INT "$logger_pid" 2>/dev/null || true
-}
-trap cleanup EXIT
 # A signal while the processes start (before the sim): stop those started
 # and end as interrupted (75), before the sim starts. From the trap itself:
 # a group signal also ends the command the script is in (a sleep, a python
@@ -227,7 +288,6 @@ if [[ $bus == tcpq ]]; then
   # LCM's TCP hub on a free loopback port of this (private) namespace; it
   # goes when the run's processes have gone (hub_pid, below).
   port=$(/usr/bin/python3 -c 'import socket; s = socket.socket(); s.bind(("127.0.0.1", 0)); print(s.getsockname()[1])')
-  trap 'cleanup; [[ -z ${hub_pid:-} ]] || kill "$hub_pid" 2>/dev/null || true' EXIT
   java -cp /usr/share/java/lcm.jar lcm.lcm.TCPService "$port" >"$out/tcpservice.log" 2>&1 &
   hub_pid=$!
   hub_up=0
@@ -261,7 +321,6 @@ fi
 # The run's key: every message on the bus is tagged with it (docs/bus.md);
 # --fresh starts a new run, with a new key.
 if [[ -z $key_file ]]; then
-  ((fresh == 0)) || rm -f "$out/bus.key"
   [[ $role != sim ]] || { echo "run_scene: --role sim needs --key-file KEY: the run's key, copied from the analysis host's DIR/bus.key" >&2; exit 2; }
   key_file=$out/bus.key
   if [[ ! -e $key_file ]]; then
@@ -467,11 +526,15 @@ if [[ -n $cuts && $status -eq 0 && -f $out/run.h5 ]] &&
   rmdir "$cuts" 2>/dev/null || true
 fi
 if [[ -n $cuts && $status -ne 0 ]]; then
-  last=$(ls -d "$cuts"/cut-*/WHOLE 2>/dev/null | tail -1)
+  last=$(ls -d "$cuts"/cut-*/WHOLE 2>/dev/null | tail -1 || true) # (none: ls fails, and so would the script)
   if [[ -n $last ]]; then
     echo "run_scene: interrupted${stop_signal:+ by SIG$stop_signal}; resumable from $(dirname "$last"): run the same command again (exit 75)" >&2
     status=75
+  elif [[ -n ${stop_signal:-} ]]; then
+    echo "run_scene: interrupted by SIG$stop_signal before the first checkpoint cut: the same command starts the run again (exit 75)" >&2
+    status=75
   fi
 fi
-echo "run_scene: results in $out (exit $status)" >&2
+# (a process's own exit code is said above; the script's is one of those in its header)
+[[ $status == 0 || $status == 75 ]] || status=1
 exit $status

@@ -16,11 +16,17 @@
 #   --out DIR          the study directory (default runs/study-<name>)
 #   --dry-run          print every run with its times, estimated CPU time and
 #                      memory, and the totals; start nothing
+#   --fresh            the --out directory holds another study (or anything
+#                      without a study.toml, which is refused): move what it
+#                      holds into DIR/old-<time>/ and start this study there
 #   --no-build         skip setup.sh (packages and build)
 # The study directory holds study.toml (a copy; a study file that now says
 # something else is refused, one whose comments or spacing changed is
 # not), runs/<run>/{scene.toml,status.toml,run.h5,logs}, pilots/ and
 # index.toml, which the analysis reads.
+# Exit: 0 every run complete (and analysed); 1 a run or the analysis
+# failed; 2 bad arguments, a refused study or --out (nothing run); 75
+# interrupted: the same command resumes.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}

@@ -15,6 +15,14 @@ add_test(NAME run_scene_refuses_bad_scene
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/bad_scene.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(run_scene_refuses_bad_scene PROPERTIES LABELS process TIMEOUT 60)
 
+# No command writes over results it did not write for the same purpose:
+# each launch script refuses such a destination, unchanged, and --fresh
+# moves it aside intact; a run that fails at run time exits 1, said
+# (tests/data_safety.sh).
+add_test(NAME launch_scripts_keep_data
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/data_safety.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(launch_scripts_keep_data PROPERTIES LABELS process TIMEOUT 180)
+
 add_test(NAME checkpoint_resume_bit_for_bit
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/checkpoint_resume.sh ${PROJECT_SOURCE_DIR} $<TARGET_FILE_DIR:sim_node>)
 set_tests_properties(checkpoint_resume_bit_for_bit PROPERTIES LABELS process TIMEOUT 300)

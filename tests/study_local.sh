@@ -87,7 +87,7 @@ kill -TERM "$runner"
 for _ in $(seq 200); do grep -q "stopping the runs" "$tmp/b.out" && break; sleep 0.02; done
 kill -TERM "$runner" 2>/dev/null || true
 wait "$runner" && rc=0 || rc=$?
-check '[[ $rc == 130 ]]' "stopped study exits 130 (got $rc)"
+check '[[ $rc == 75 ]]' "stopped study exits 75, resumable (got $rc)"
 check '! grep -q "Traceback" "$tmp/b.out"' "a second SIGTERM during the stop: no traceback"
 check 'grep -qs "state = \"interrupted\"" "$tmp"/b/runs/*/status.toml' "the stopped run is marked interrupted"
 stopped=$(grep -ls "state = \"interrupted\"" "$tmp"/b/runs/*/status.toml | head -1)

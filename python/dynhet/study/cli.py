@@ -40,6 +40,9 @@ def main():
                                                        "slurm: array tasks at once, default no limit)")
     r.add_argument("--out", help="study directory (default runs/study-<name>)")
     r.add_argument("--dry-run", action="store_true")
+    r.add_argument("--fresh", action="store_true",
+                   help="the --out directory holds another study (or anything but a study): move it into "
+                        "DIR/old-<time>/ and start this one (nothing is deleted)")
     r.add_argument("--partition")
     r.add_argument("--time")
     r.add_argument("--mem")
@@ -57,22 +60,32 @@ def main():
     i.add_argument("dir")
     i.add_argument("--analyse", action="store_true", help="then, if every run is complete, the study analysis")
     a = ap.parse_args()
+    # A StudyError before anything runs (the study file, the directory, the
+    # scenes) is a bad argument, exit 2; once runs start, a run-time failure, 1.
+    running = False
     try:
         if a.cmd == "run":
             study = Study(a.study)
             sd = StudyDir(study, a.out or os.path.join(ROOT, "runs", f"study-{study.name}"))
+            why = sd.refusal()
+            if why and not a.fresh:
+                raise StudyError(why)
             if a.dry_run:
-                if os.path.exists(os.path.join(sd.dir, "study.toml")):
-                    sd.claim()
+                if why:
+                    print(f"# --fresh: what {sd.dir} holds would move into {sd.dir}/old-<time>/")
                 check_scenes(sd)
                 dry_run(sd)
                 return 0
             check_scenes(sd)
-            sd.claim()
+            moved = sd.claim(fresh=a.fresh)
+            if moved:
+                print(f"run_study: --fresh: what {sd.dir} held is now in {moved}", flush=True)
+            running = True
             if a.executor == "local":
                 return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2))
             return run_slurm(sd, a)
         sd = StudyDir(Study(os.path.join(a.dir, "study.toml"), os.path.join(a.dir, "base_scene.toml")), a.dir)
+        running = True
         if a.cmd == "task":
             return task(sd, a.name)
         rows = write_index(sd)
@@ -85,7 +98,7 @@ def main():
         return analyse(sd) if a.analyse else 0
     except StudyError as e:
         print(f"run_study: {e}", file=sys.stderr)
-        return 2
+        return 1 if running else 2
 
 
 def check_scenes(sd):

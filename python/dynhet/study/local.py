@@ -10,7 +10,7 @@ from .paths import ROOT
 from .model import AXES, StudyError, StudyInterrupted
 from .estimates import fmt_time
 from .rundir import read_status, write_status
-from .children import STOPPING, already_stopping, stop_children
+from .children import RESUMABLE, STOPPING, already_stopping, stop_children
 from .runner import do_run
 from .index import run_estimates, run_order, write_index
 from .progress import PROGRESS_EVERY, describe, eta_seconds, sim_progress, study_eta
@@ -120,7 +120,7 @@ def run_local(sd, jobs):
             t.join(timeout=30)
         write_index(sd)
         say(f"study {sd.study.name}: interrupted; run the same command again to resume")
-        return 130
+        return RESUMABLE
     write_index(sd)
     print(f"study {sd.study.name}: {state['done']} of {len(points)} runs complete, {state['failed']} failed "
           f"in {fmt_time(time.time() - t_start)} -> {sd.dir}/index.toml", flush=True)

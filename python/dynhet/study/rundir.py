@@ -3,6 +3,7 @@ import math
 import os
 import subprocess
 import threading
+import time
 import tomllib
 
 from .toml_io import read_toml, toml_dump, write_atomic
@@ -58,25 +59,69 @@ class StudyDir:
         self.runs_dir = os.path.join(self.dir, "runs")
         self.lock = threading.Lock()
 
-    def claim(self):
-        """Create the directory or check it holds this very study."""
+    def refusal(self):
+        """Why the directory cannot take this study (None if it can): it holds
+        another study, this study with another base scene, or anything
+        without a study.toml (what the study would write into or over is
+        never taken for its own). Earlier studies moved aside (old-*) do
+        not count."""
+        copy_path = os.path.join(self.dir, "study.toml")
+        base_path = os.path.join(self.dir, "base_scene.toml")
+        how = f"give another --out, or --fresh to move what it holds into {self.dir}/old-<time>/ (nothing is deleted)"
+        if os.path.exists(copy_path):
+            if not same_toml(open(copy_path, "rb").read(), self.study.text):
+                return (f"{self.study.path} differs from the study that {self.dir} holds ({copy_path}): a changed "
+                        f"study is never mixed into old runs; restore the study file, or {how}")
+            if os.path.exists(base_path) and open(base_path).read() != self.base_text():
+                return (f"the base scene of {self.study.path} changed since {self.dir} was started ({base_path} "
+                        f"holds the old one): restore the scene, or {how}")
+            return None
+        there = self.foreign_entries()
+        if there:
+            return (f"{self.dir} is not a study directory (no study.toml) and holds "
+                    f"{', '.join(there[:8])}{', ...' if len(there) > 8 else ''}: {how}")
+        return None
+
+    def foreign_entries(self):
+        if not os.path.isdir(self.dir):
+            return []
+        return sorted(e for e in os.listdir(self.dir) if not e.startswith("old-"))
+
+    def base_text(self):
+        return toml_dump(self.study.base, "# the study's base scene, as read when the study started")
+
+    def move_aside(self):
+        """--fresh: everything the directory holds (but earlier old-*) into
+        DIR/old-<time>/; returns that path."""
+        stamp = time.strftime("%Y%m%d-%H%M%S")
+        to, k = os.path.join(self.dir, f"old-{stamp}"), 1
+        while os.path.exists(to):
+            k += 1
+            to = os.path.join(self.dir, f"old-{stamp}-{k}")
+        os.makedirs(to)
+        for e in self.foreign_entries():
+            os.rename(os.path.join(self.dir, e), os.path.join(to, e))
+        return to
+
+    def claim(self, fresh=False):
+        """Create the directory or check it holds this very study; with
+        fresh, whatever else it holds is moved aside first (returns where,
+        or None)."""
+        why, moved = self.refusal(), None
+        if why and not fresh:
+            raise StudyError(why)
+        if why:
+            moved = self.move_aside()
         os.makedirs(self.runs_dir, exist_ok=True)
         copy_path = os.path.join(self.dir, "study.toml")
         base_path = os.path.join(self.dir, "base_scene.toml")
-        base_text = toml_dump(self.study.base, "# the study's base scene, as read when the study started")
-        if os.path.exists(copy_path):
-            if not same_toml(open(copy_path, "rb").read(), self.study.text):
-                raise StudyError(f"{self.study.path} differs from the study that {self.dir} holds "
-                                 f"({copy_path}): a changed study is never mixed into old runs; "
-                                 "give another --out, or restore the study file")
-            if os.path.exists(base_path) and open(base_path).read() != base_text:
-                raise StudyError(f"the base scene of {self.study.path} changed since {self.dir} was started "
-                                 f"({base_path} holds the old one): give another --out, or restore the scene")
-        else:
+        base_text = self.base_text()
+        if not os.path.exists(copy_path):
             with open(copy_path, "wb") as f:
                 f.write(self.study.text)
         if not os.path.exists(base_path):
             write_atomic(base_path, base_text)
+        return moved
 
     def run_dir(self, p):
         return os.path.join(self.runs_dir, self.study.run_name(p))
