@@ -20,7 +20,7 @@ export BUILD_DIR=$build
 # so then the live run and its recording are repeated (at most 3 times);
 # what the live run lost, if anything, still fails the checks.
 for attempt in 1 2 3; do
-  rm -rf "$tmp/live" "$tmp/replay1"
+  rm -rf "$tmp/live" "$tmp/replay1" "$tmp/run.lcmlog" # (a recording is never written over: each attempt its own)
   bash "$root/launch_scripts/run_scene.sh" "$root/scenes/tiny.toml" --out "$tmp/live" \
     --url 'udpm://239.255.76.67:7681?ttl=0' --record "$tmp/run.lcmlog" --no-build --author "E2E Tester"
   /usr/bin/python3 "$root/tests/check_run.py" "$tmp/live/run.h5" "$root/scenes/tiny.toml"

@@ -30,7 +30,7 @@ lacks() { # FROM TO
 # result the live recorder took cannot replay complete, so the recording is
 # repeated (at most 3 times).
 for attempt in 1 2 3; do
-  rm -rf "$tmp/live"
+  rm -rf "$tmp/live" "$tmp/run.lcmlog"
   bash "$root/launch_scripts/run_scene.sh" "$root/scenes/tiny.toml" --no-build --no-plots --run-id $id \
     --url 'udpm://239.255.76.67:7731?ttl=0' --out "$tmp/live" --record "$tmp/run.lcmlog" >"$tmp/live.log" 2>&1 ||
     { echo "FAIL the live run"; tail -5 "$tmp/live.log"; exit 1; }

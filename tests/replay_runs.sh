@@ -22,7 +22,7 @@ check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
 # log came out with holes is recorded again (at most three times, each said).
 for id in 111 222; do
   for attempt in 1 2 3; do
-    rm -rf "$tmp/live$id"
+    rm -rf "$tmp/live$id" "$tmp/r$id.lcmlog"
     bash "$root/launch_scripts/run_scene.sh" "$root/scenes/tiny.toml" --no-build --no-plots --out "$tmp/live$id" \
       --record "$tmp/r$id.lcmlog" --run-id $id >"$tmp/live$id.log" 2>&1 || { tail -5 "$tmp/live$id.log"; exit 1; }
     grep -q "is not whole" "$tmp/live$id.log" || break
