@@ -13,13 +13,32 @@ the dataset (`.history(name)` gives every record with its time); a fixed
 dataset (lag_time, q, r, size_centre, ...) is itself; the group's
 attributes are `.attrs`. `value_error(name)` pairs `name` with `name_err`.
 Names are the datasets' own (docs/analysis.md says what each is).
+
+open_run takes a run directory or its run.h5 and nothing else: another
+HDF5 file (a checkpoint, a study's study.h5), a truncated file or one a
+recorder still writes is refused at open with what it is (RunFileError).
+An incomplete run opens with an IncompleteRunWarning naming what it lacks,
+unless allow_incomplete=True says that partial results are meant.
 """
 import math
+import os
+import re
+import warnings
 
 import h5py
 import numpy as np
 
 A_DEFAULT = 0.6  # the paper's cutoff, "unless stated otherwise"
+CUTOFF_REL_TOL = 1e-6  # a cutoff asked for matches the run's within this (labels and floats round)
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+class RunFileError(OSError):
+    """A path that is not a readable run: no run.h5, not a run file, truncated."""
+
+
+class IncompleteRunWarning(UserWarning):
+    """The run did not finish (run.h5's complete = 0): its results cover part of it."""
 
 
 def _text(v):
@@ -78,15 +97,24 @@ class Observable:
 class Run:
     """A run's run.h5, read-only. Use as a context manager or call close()."""
 
-    def __init__(self, path):
-        self.path = str(path)
+    def __init__(self, path, allow_incomplete=False):
+        self.path = _run_path(str(path))
         try:
             self._f = h5py.File(self.path, "r")
         except OSError as e:
-            raise OSError(f"{self.path}: cannot be read as a run file ({e})") from None
+            raise RunFileError(unreadable(self.path, e)) from None
         a = self._f.attrs
+        if "complete" not in a:  # the recorder writes it first, 0, and at the end
+            found = describe_h5(self._f)
+            self._f.close()
+            raise RunFileError(f"{self.path} is not a run file (a recorder's run.h5 has the attribute 'complete'): "
+                               f"it holds {found}")
         self.complete = int(a.get("complete", 0)) == 1
         self.missing = _text(a.get("missing", ""))
+        if not self.complete and not allow_incomplete:
+            warnings.warn(f"{self.path}: an incomplete run ({self.missing or 'no reason recorded'}): its results "
+                          "cover only part of it; open_run(..., allow_incomplete=True) reads it without this warning",
+                          IncompleteRunWarning, stacklevel=3)
         self.run_id = int(a["run_id"]) if "run_id" in a else None
         self.parameters = {k: {n: _text(v) for n, v in g.attrs.items()}
                            for k, g in self._f.get("parameters", {}).items() if isinstance(g, h5py.Group)}
@@ -122,10 +150,12 @@ class Run:
             raise KeyError(f"{self.path}: no observable {kind!r}; the run has {', '.join(self.observables())}")
         if a is not None or any(k.startswith("a") and k[1:2].isdigit() for k in g.keys()):
             a = A_DEFAULT if a is None else a
-            key = next((k for k in g.keys() if k.startswith("a") and _same(k[1:], a)), None)
-            if key is None:
-                raise KeyError(f"{self.path}: {kind} has no cutoff a = {a:g}; it has {self.cutoffs(kind)}")
-            g = g[key]
+            near = sorted((abs(_label(k[1:]) - a), k) for k in g.keys()
+                          if k.startswith("a") and _same(k[1:], a))
+            if not near:
+                raise KeyError(f"{self.path}: {kind} has no cutoff a = {a!r} (nor within a relative "
+                               f"{CUTOFF_REL_TOL:g} of it); it has {self.cutoffs(kind)}")
+            g = g[near[0][1]]
         return Observable(g)
 
     def overlap(self, a=A_DEFAULT):
@@ -160,13 +190,61 @@ class Run:
                 f"{'complete' if self.complete else 'incomplete: ' + self.missing})")
 
 
-def _same(label, a):
+def _label(label):
     try:
-        return abs(float(label) - a) < 1e-9
+        return float(label)
     except ValueError:
-        return False
+        return math.nan
 
 
-def open_run(path):
-    """A run's run.h5 (see Run)."""
-    return Run(path)
+def _same(label, a):
+    return math.isclose(_label(label), a, rel_tol=CUTOFF_REL_TOL, abs_tol=1e-12)
+
+
+def _run_path(path):
+    """run.h5 itself, or a run directory's."""
+    if os.path.isdir(path):
+        f = os.path.join(path, "run.h5")
+        if not os.path.exists(f):
+            there = sorted(os.listdir(path))
+            raise RunFileError(f"{path} holds no run.h5 (it holds {', '.join(there[:10]) or 'nothing'}"
+                               f"{', ...' if len(there) > 10 else ''})")
+        return f
+    return path
+
+
+def unreadable(path, e):
+    """What is wrong with a file h5py could not open, in words."""
+    if not os.path.exists(path):
+        return f"{path}: no such file"
+    size = os.path.getsize(path)
+    with open(path, "rb") as fh:
+        head = fh.read(8)
+    if head != HDF5_SIGNATURE:
+        return f"{path} is not an HDF5 file ({size} bytes, beginning {head!r}), so not a run.h5"
+    m = re.search(r"truncated file: eof = (\d+).*stored_eof = (\d+)", str(e))
+    if m:
+        return (f"{path} is truncated: {m.group(1)} bytes on disk of the {m.group(2)} it was written with "
+                "(a copy or a write cut short, a full disk): copy it again from where the run ran")
+    if "lock" in str(e):
+        return (f"{path} is open for writing by another process (a recorder still running?): read it once the "
+                "run has ended")
+    return f"{path}: cannot be read as a run file ({e})"
+
+
+def describe_h5(f):
+    """An HDF5 file's top level in words, with what it looks like."""
+    groups = sorted(f.keys())
+    attrs = sorted(f.attrs.keys())
+    what = ""
+    if "format" in f.attrs:
+        what = f" (format {_text(f.attrs['format'])!r}: a checkpoint, read by sim_node --resume)"
+    elif "points" in groups and "fits" in groups:
+        what = " (a study analysis's study.h5: dynhet.open_study reads the study directory)"
+    return (f"groups [{', '.join(groups)}] and attributes [{', '.join(attrs)}]{what}")
+
+
+def open_run(path, allow_incomplete=False):
+    """A run: its directory or its run.h5 (see Run). An incomplete run warns
+    (IncompleteRunWarning) unless allow_incomplete=True."""
+    return Run(path, allow_incomplete)

@@ -27,5 +27,5 @@ def test_bad_arguments_are_refused_by_name(tmp_path):
     with pytest.raises(OSError, match="no such directory"):
         draw_all(str(tmp_path / "run.h5"), str(tmp_path / "nowhere"))
     (tmp_path / "run.h5").write_text("not a run")
-    with pytest.raises(OSError, match="cannot be read as a run file"):
+    with pytest.raises(OSError, match="is not an HDF5 file"):
         draw_all(str(tmp_path / "run.h5"), str(tmp_path))

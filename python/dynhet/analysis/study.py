@@ -202,6 +202,11 @@ class Analysis:
         if quantity not in PER_RUN:
             raise KeyError(f"no quantity {quantity!r}; known: {', '.join(PER_RUN)}")
         pts = self.series(pairs, eps, N)
+        if not pts:  # a series the study lacks: said, not empty arrays
+            have = sorted({(k[0], k[1], k[3]) for k in self.points})
+            raise KeyError(f"no complete run of the series pairs = {pairs!r}, eps = {eps!r}"
+                           + (f", N = {N}" if N is not None else "") + " in this study; it has "
+                           + ("; ".join(f"pairs = {q!r}, eps = {e!r}, N = {n}" for q, e, n in have) or "no complete run"))
         ms = [p.mean(PER_RUN[quantity]) for p in pts]
         return (np.array([p.phi for p in pts]), np.array([m[0] for m in ms]), np.array([point_error(m) if m[3] else np.nan
                                                                                      for m in ms]),
