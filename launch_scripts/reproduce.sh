@@ -88,7 +88,7 @@ if ((!analyse_only)); then
   }
 fi
 
-[[ -f $runs/quick/index.toml ]] || { echo "reproduce: $runs/quick/index.toml does not exist: run the studies first" >&2; exit 1; }
+[[ -f $runs/quick/index.toml ]] || { echo "reproduce: $runs/quick/index.toml does not exist: run the studies first" >&2; exit 2; }
 # Every run of every study complete? (each index.toml: [runs.<name>] tables with a state)
 unfinished=$(/usr/bin/python3 - "$runs" "${all[@]}" <<'PY'
 import os, sys, tomllib
@@ -110,7 +110,7 @@ if [[ -n $unfinished ]]; then
     echo "reproduce: the documents are left as they are; --analyse-only --partial writes them from what is complete" >&2
     exit 0
   fi
-  ((partial)) || { echo "reproduce: refused: --partial to write the documents from what is complete" >&2; exit 1; }
+  ((partial)) || { echo "reproduce: refused: --partial to write the documents from what is complete" >&2; exit 2; }
 fi
 rel=$(realpath -m --relative-to="$root" "$runs") # the documents' headers name the studies relative to the checkout
 also=()

@@ -377,7 +377,11 @@ if [[ -n $record ]]; then
     record=$record.$n
     echo "run_scene: recording this segment into $record (replay.sh takes the segments in order)" >&2
   fi
-  rm -f "$record"
+  if [[ -e $record ]]; then # (this run's own earlier attempt, started over: its log is kept)
+    to=$record.old-$(date +%Y%m%d-%H%M%S)
+    mv -- "$record" "$to"
+    echo "run_scene: the earlier attempt's log $record moved to $to" >&2
+  fi
   # Ahead of the other processes where allowed (root): a starved lcm-logger
   # drops what overflows its 30-message subscription queue.
   nice -n -5 lcm-logger --lcm-url="$url" --force "$record" >"$out/lcm-logger.log" 2>&1 &

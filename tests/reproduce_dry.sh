@@ -24,12 +24,12 @@ PY
 rc=0; bash "$root/launch_scripts/reproduce.sh" --no-build --only quick,nope --runs "$tmp/runs" 2>"$tmp/err" || rc=$?
 [[ $rc == 2 ]] && grep -q "no study 'nope'" "$tmp/err" || { echo "FAIL bad --only: rc $rc: $(cat "$tmp/err")"; exit 1; }
 rc=0; bash "$root/launch_scripts/reproduce.sh" --no-build --analyse-only --runs "$tmp/runs" 2>"$tmp/err" || rc=$?
-[[ $rc == 1 ]] && grep -q "quick/index.toml does not exist" "$tmp/err" || { echo "FAIL analyse-only without studies: rc $rc: $(cat "$tmp/err")"; exit 1; }
+[[ $rc == 2 ]] && grep -q "quick/index.toml does not exist" "$tmp/err" || { echo "FAIL analyse-only without studies: rc $rc: $(cat "$tmp/err")"; exit 1; }
 [[ ! -e $tmp/runs || -z $(ls -A "$tmp/runs") ]] || { echo "FAIL: the dry run left $(ls -A "$tmp/runs")"; exit 1; }
 # An analysis while runs are unfinished would rewrite the tracked documents from part of the data.
 mkdir -p "$tmp/runs/quick"
 printf '[runs.a]\nstate = "complete"\n[runs.b]\nstate = "running"\n' >"$tmp/runs/quick/index.toml"
 rc=0; bash "$root/launch_scripts/reproduce.sh" --no-build --analyse-only --runs "$tmp/runs" 2>"$tmp/err" || rc=$?
-[[ $rc == 1 ]] && grep -q "quick (1 of 2 runs not complete); finite_size (not run)" "$tmp/err" && grep -q "refused" "$tmp/err" ||
+[[ $rc == 2 ]] && grep -q "quick (1 of 2 runs not complete); finite_size (not run)" "$tmp/err" && grep -q "refused" "$tmp/err" ||
   { echo "FAIL analyse-only with unfinished runs: rc $rc: $(cat "$tmp/err")"; exit 1; }
 echo "ok   refused: an unknown study, an analysis without its studies, one while runs are unfinished"
