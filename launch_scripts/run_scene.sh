@@ -134,6 +134,7 @@ if ((build_first)) && [[ -z ${DYNHET_IN_NETNS:-} ]]; then BUILD_DIR=$build "$roo
 source "$root/launch_scripts/lib/out_dir.sh"
 guard_out() {
   local own=0 why="" there=() move=() to f
+  [[ ! -e $out || -d $out ]] || { echo "run_scene: --out $out is a file, not a directory" >&2; exit 2; }
   if [[ $role == all && -z $resume && $no_cuts == 0 && -f $out/scene.toml ]] && cmp -s "$scene" "$out/scene.toml"; then own=1; fi
   [[ -z $resume || $(realpath -m "$(dirname "$resume")") != "$(realpath -m "$out")" ]] || own=1
   mapfile -t there < <(held "$out" run.h5 checkpoint.h5 checkpoint_before_frames.h5 checkpoints scene.toml '*.log' '*.png' |
