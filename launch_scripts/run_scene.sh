@@ -139,6 +139,8 @@ guard_out() {
   [[ -z $resume || $(realpath -m "$(dirname "$resume")") != "$(realpath -m "$out")" ]] || own=1
   mapfile -t there < <(held "$out" run.h5 checkpoint.h5 checkpoint_before_frames.h5 checkpoints scene.toml '*.log' '*.png' |
     grep -vx run_scene.log) # (run_scene.log: a study's log of its calls, open while this runs)
+  # (an empty checkpoints/ holds nothing: one may be made beforehand, e.g. a link to another disk)
+  [[ -n $(ls -A "$out/checkpoints/" 2>/dev/null) ]] || mapfile -t there < <(printf '%s\n' "${there[@]}" | grep -vx -e checkpoints -e '')
   if ((${#there[@]})); then
     if ((own)); then
       [[ -z $resume ]] || ! complete_run "$out/run.h5" || why="a complete run, which --resume would compute again"
