@@ -76,6 +76,12 @@ run "$tmp/p2.out" bash "$root/launch_scripts/replay.sh" "$tmp/live/run.lcmlog" -
 old=$(sed -n "s|^replay: --fresh: what .* moved to \(.*\)$|\1|p" "$tmp/p2.out")
 check '[[ -n $old && $(sum "$old/run.h5") == "$h" && $(sum "$old/sim_node.log") == "$hl" && -f $tmp/live/run.lcmlog && -f $tmp/live/bus.key ]]' \
   "replay --fresh: the live run's run.h5 and logs are intact where it says ($old), its log and key stay"
+# ... a replay of the same log into the directory it wrote before replays again (its REPLAY names the log).
+mkdir -p "$tmp/again"
+realpath "$tmp/live/run.lcmlog" >"$tmp/again/REPLAY"
+echo "recorder: ready" >"$tmp/again/recorder.log"
+run "$tmp/p3.out" bash "$root/launch_scripts/replay.sh" "$tmp/live/run.lcmlog" --out "$tmp/again" --no-build --key-file "$tmp/live/bus.key"
+check '! grep -q refused "$tmp/p3.out" && [[ $rc == 2 ]]' "replay: its own earlier replay of the same log is not refused (exit $rc: the log is no lcm log)"
 
 # record.sh LOG over an existing log.
 head -c 1000 /dev/urandom >"$tmp/rec.lcmlog"
