@@ -40,6 +40,14 @@ add_test(NAME study_local_tiny
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/study_local.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(study_local_tiny PROPERTIES LABELS process TIMEOUT 400)
 
+# The results archive on studies/tiny.toml: entries written as runs complete,
+# checked against the runs; the same analysis from the archive as from the
+# study directory; a study resumed from its archive alone; corrupted,
+# unlisted and half-written entries never read (tests/study_archive.sh).
+add_test(NAME study_archive_tiny
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/study_archive.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(study_archive_tiny PROPERTIES LABELS process TIMEOUT 400)
+
 # The study runner, Slurm executor, against a real throwaway single-host
 # Slurm cluster in a private network namespace (tests/slurm_study.sh): every
 # run equals the local executor's bit for bit.

@@ -43,13 +43,29 @@ from .finite_size import write_finite_size
 from .output import write_h5, write_table
 
 
+def out_dir(study_dir, out):
+    """Where the analysis writes: --out, else the study directory, else (a
+    results archive, which holds runs only) runs/analysis-<study> of the
+    repository."""
+    from ..archive import is_archive
+    if out:
+        return out
+    if not is_archive(study_dir):
+        return study_dir
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+    return os.path.join(root, "runs", "analysis-" + os.path.basename(os.path.abspath(study_dir).rstrip("/")))
+
+
 DOC = __doc__.rstrip("\n") + "\n\nConventions " + CONVENTIONS
 
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=DOC.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter,
                                  epilog=DOC.split("\n\n", 1)[1])
-    ap.add_argument("study_dir")
+    ap.add_argument("study_dir", help="a study directory (run_study.sh --out) or a results archive (results/<study>)")
+    ap.add_argument("--out", metavar="DIR",
+                    help="write study.h5, reproduction.md, finite_size.md and figures/ here (default: the study "
+                         "directory; for a results archive, runs/analysis-<study> beside the repository's results/)")
     ap.add_argument("--table", help="also write the reproduction table here (e.g. docs/reproduction.md)")
     ap.add_argument("--finite-size", metavar="FILE",
                     help="also write the finite-size report here (e.g. docs/finite_size.md)")
@@ -79,7 +95,8 @@ def main(argv=None):
     if via and not a.restate:
         raise SystemExit("analyse_study: --restate-via needs --restate (the table the steps start from)")
     t0 = time.time()
-    A = Analysis(a.study_dir, a.also)
+    A = Analysis(a.study_dir, a.also, out_dir(a.study_dir, a.out))
+    os.makedirs(A.out, exist_ok=True)
     if a.largest_n:
         if not a.also:
             raise SystemExit("analyse_study: --largest-n takes the largest N over the --also studies: give at least one")
@@ -152,13 +169,13 @@ def main(argv=None):
     A.driving = ({}, "")
     step("driving rules", driving_results)
     driving_rows(A)
-    write_h5(A, os.path.join(A.dir, "study.h5"))
+    write_h5(A, os.path.join(A.out, "study.h5"))
     cmd = "launch_scripts/analyse_study.sh " + " ".join(argv if argv is not None else sys.argv[1:])
-    write_table(A, os.path.join(A.dir, "reproduction.md"), cmd, a.discussion, a.restate, via)
+    write_table(A, os.path.join(A.out, "reproduction.md"), cmd, a.discussion, a.restate, via)
     if a.table:
         write_table(A, a.table, cmd, a.discussion, a.restate, via)
     try:
-        densities = write_finite_size(A, os.path.join(A.dir, "finite_size.md"), cmd)
+        densities = write_finite_size(A, os.path.join(A.out, "finite_size.md"), cmd)
         if a.finite_size:
             write_finite_size(A, a.finite_size, cmd)
         say(f"  finite size: {densities} densities run at several N")
@@ -168,7 +185,7 @@ def main(argv=None):
         failed.append("finite-size report")
     differ = [r["item"] for r in A.rows if r["verdict"].startswith("differs")]
     say(f"analyse_study: {len(A.rows)} rows, {len(differ)} differ from the paper; {len(A.fits)} fits; "
-        f"study.h5, reproduction.md and {(len(os.listdir(A.figdir)) if os.path.isdir(A.figdir) else 0)} figures in {A.dir} ({time.time() - t0:.1f} s)")
+        f"study.h5, reproduction.md and {(len(os.listdir(A.figdir)) if os.path.isdir(A.figdir) else 0)} figures in {A.out} ({time.time() - t0:.1f} s)")
     if failed:
         say(f"analyse_study: FAILED: {', '.join(failed)} (the rest is written)")
         return 1

@@ -410,7 +410,7 @@ def write_finite_size(A, path, command):
     if figures:
         os.makedirs(fig_dir, exist_ok=True)
         for f in figures:
-            shutil.copy(os.path.join(A.dir, f), os.path.join(fig_dir, os.path.basename(f)))
+            shutil.copy(os.path.join(A.out, f), os.path.join(fig_dir, os.path.basename(f)))
     with open(path, "w") as fh:
         fh.write("\n".join(L))
     return len(multi)

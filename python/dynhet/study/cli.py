@@ -8,6 +8,9 @@ runs, reads their files and keeps their status on disk.
                           [--partition P] [--time T] [--mem M] [--sbatch ARG]...
   study.py task DIR NAME      one run of a study directory (what a Slurm task runs)
   study.py index DIR          write DIR/index.toml from the runs' status files
+  study.py archive DIR [--to ARCHIVE]
+                              reduce every complete run of study directory DIR into its results
+                              archive (the study's [study] archive, or ARCHIVE): dynhet.archive
 
 The study file format is in studies/README.md."""
 import argparse
@@ -40,6 +43,9 @@ def main():
                                                        "slurm: array tasks at once, default no limit)")
     r.add_argument("--out", help="study directory (default runs/study-<name>)")
     r.add_argument("--dry-run", action="store_true")
+    r.add_argument("--archive", metavar="DIR",
+                   help="the results archive each complete run is reduced into (default: the study file's "
+                        "[study] archive, relative to the repository; none if it names none)")
     r.add_argument("--partition")
     r.add_argument("--time")
     r.add_argument("--mem")
@@ -56,11 +62,15 @@ def main():
     i = sub.add_parser("index")
     i.add_argument("dir")
     i.add_argument("--analyse", action="store_true", help="then, if every run is complete, the study analysis")
+    ar = sub.add_parser("archive")
+    ar.add_argument("dir")
+    ar.add_argument("--to", metavar="ARCHIVE", help="the archive directory (default: the study's own)")
     a = ap.parse_args()
     try:
         if a.cmd == "run":
             study = Study(a.study)
-            sd = StudyDir(study, a.out or os.path.join(ROOT, "runs", f"study-{study.name}"))
+            sd = StudyDir(study, a.out or os.path.join(ROOT, "runs", f"study-{study.name}"),
+                          os.path.abspath(a.archive) if a.archive else None)
             if a.dry_run:
                 if os.path.exists(os.path.join(sd.dir, "study.toml")):
                     sd.claim()
@@ -72,7 +82,10 @@ def main():
             if a.executor == "local":
                 return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2))
             return run_slurm(sd, a)
-        sd = StudyDir(Study(os.path.join(a.dir, "study.toml"), os.path.join(a.dir, "base_scene.toml")), a.dir)
+        sd = StudyDir(Study(os.path.join(a.dir, "study.toml"), os.path.join(a.dir, "base_scene.toml")), a.dir,
+                      os.path.abspath(a.to) if getattr(a, "to", None) else None)
+        if a.cmd == "archive":
+            return archive_dir(sd)
         if a.cmd == "task":
             return task(sd, a.name)
         rows = write_index(sd)
@@ -86,6 +99,23 @@ def main():
     except StudyError as e:
         print(f"run_study: {e}", file=sys.stderr)
         return 2
+
+
+def archive_dir(sd):
+    """study.py archive: every complete run of a study directory into its archive."""
+    from ..archive import ArchiveError
+    from .archiving import archive_existing
+    if sd.archive is None:
+        raise StudyError(f"{sd.dir}: the study names no archive ([study] archive): give --to DIR")
+    try:
+        sd.archive.claim(sd.study)
+    except ArchiveError as e:
+        raise StudyError(str(e)) from None
+    added, kept, left = archive_existing(sd)
+    n = len(sd.archive.runs())
+    print(f"study {sd.study.name}: {added} runs archived now, {kept} already, {left} not complete; "
+          f"{n} runs in {sd.archive.dir}", flush=True)
+    return 0
 
 
 def check_scenes(sd):
