@@ -345,3 +345,55 @@ def largest_datasets(path):
     with h5py.File(path, "r") as f:
         f.visititems(lambda n, o: out.append((n, o.id.get_storage_size())) if isinstance(o, h5py.Dataset) else None)
     return sorted(out, key=lambda x: -x[1])
+
+
+# -- results/README.md
+
+README_HEAD = """# results: the archived runs every generated document comes from
+
+Each folder is one study's results archive (python/dynhet/archive.py): its
+study file, its base scene, index.toml (every archived run with its axes,
+CPU time, size and sha256, and the pilots' tau_alpha) and runs/, one reduced
+run.h5 per complete run with its provenance (the resolved scene, the build,
+the study layer's commit, the command, CPU seconds, dates). Run directories
+are scratch; this is the record. `launch_scripts/run_study.sh
+studies/<study>.toml` writes into results/<study> as each run completes and
+resumes from it; `launch_scripts/analyse_study.sh results/<study>` analyses
+it. This page is generated (`launch_scripts/study.py results`).
+
+| study | what | command | runs archived | CPU-hours | size |
+|---|---|---|---|---|---|
+"""
+
+
+def study_summary(d):
+    """(name, description, runs archived, runs planned, CPU-hours, bytes) of one archive."""
+    from .study.model import Study, StudyError
+    idx = Archive(d).read()
+    runs = idx["runs"]
+    try:
+        planned = len(list(Study(os.path.join(d, "study.toml"), os.path.join(d, "base_scene.toml")).points()))
+    except (StudyError, OSError):
+        planned = None
+    cpu = (sum(float(r.get("cpu_s", 0.0)) for r in runs.values())
+           + sum(float(p.get("cpu_s", 0.0)) for p in idx["pilots"].values())) / 3600
+    size = sum(int(r.get("bytes", 0)) for r in runs.values())
+    return idx["archive"].get("study", os.path.basename(d)), idx["archive"].get("description", ""), len(runs), \
+        planned, cpu, size
+
+
+def results_readme(results):
+    """The text of results/README.md: one line per archived study."""
+    lines = [README_HEAD]
+    total = 0
+    for s in sorted(os.listdir(results)):
+        d = os.path.join(results, s)
+        if not is_archive(d):
+            continue
+        name, what, n, planned, cpu, size = study_summary(d)
+        total += size
+        of = f" of {planned}" if planned is not None else ""
+        lines.append(f"| `{s}` | {what} | `launch_scripts/run_study.sh studies/{name}.toml` | {n}{of} | {cpu:.2f} "
+                     f"(runs and pilots) | {size / 2**20:.1f} MiB |\n")
+    lines.append(f"\nIn all {total / 2**20:.1f} MiB of entries (the folder is kept under 150 MB).\n")
+    return "".join(lines)

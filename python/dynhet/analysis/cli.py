@@ -40,7 +40,22 @@ from .restitution import restitution_results
 from .appendix import appendix_results
 from .driving import driving_results, driving_rows
 from .finite_size import write_finite_size
+from .restate import exists as restate_exists
 from .output import write_h5, write_table
+
+
+def stated_args(args):
+    """The command line as the documents state it: without --out and its
+    directory (where the scratch output went is not what made the numbers)."""
+    out, skip = [], False
+    for x in args:
+        if skip:
+            skip = False
+        elif x == "--out":
+            skip = True
+        elif not x.startswith("--out="):
+            out.append(x)
+    return out
 
 
 def out_dir(study_dir, out):
@@ -76,20 +91,23 @@ def main(argv=None):
     ap.add_argument("--largest-n", action="store_true",
                     help="at each density of the study, take the point of the largest N over it and the --also "
                          "studies for every row and fit (the table says which N each density has)")
+    ap.add_argument("--command", metavar="TEXT",
+                    help="the command the documents state as having made them (default: this one, without --out); "
+                         "launch_scripts/reproduce.sh names itself")
     ap.add_argument("--restate", metavar="OLD_TABLE",
-                    help="an earlier reproduction.md: append, for each row it judged \"differs\", the verdict now")
+                    help="an earlier reproduction.md (a file, or COMMIT:PATH from git history): append, for each row it judged \"differs\", the verdict now")
     ap.add_argument("--restate-via", action="append", default=[], metavar="LABEL=TABLE",
                     help="a table made between --restate's and this one (repeatable, in order): a column of its "
                          "verdicts, and the change column says at which step each verdict moved")
     a = ap.parse_args(argv)
-    if a.restate and not os.path.isfile(a.restate):
+    if a.restate and not restate_exists(a.restate):
         raise SystemExit(f"analyse_study: --restate {a.restate}: no such file")
     via = []
     for v in a.restate_via:
         label, eq, path = v.rpartition("=")  # the last "=": a label may hold one (N = 4096)
         if not eq or not label or not path:
             raise SystemExit(f"analyse_study: --restate-via {v}: give LABEL=TABLE (e.g. \"other seeds=old.md\")")
-        if not os.path.isfile(path):
+        if not restate_exists(path):
             raise SystemExit(f"analyse_study: --restate-via {v}: no such file {path}")
         via.append((label, path))
     if via and not a.restate:
@@ -170,7 +188,7 @@ def main(argv=None):
     step("driving rules", driving_results)
     driving_rows(A)
     write_h5(A, os.path.join(A.out, "study.h5"))
-    cmd = "launch_scripts/analyse_study.sh " + " ".join(argv if argv is not None else sys.argv[1:])
+    cmd = a.command or "launch_scripts/analyse_study.sh " + " ".join(stated_args(argv if argv is not None else sys.argv[1:]))
     write_table(A, os.path.join(A.out, "reproduction.md"), cmd, a.discussion, a.restate, via)
     if a.table:
         write_table(A, a.table, cmd, a.discussion, a.restate, via)

@@ -8,6 +8,7 @@ runs, reads their files and keeps their status on disk.
                           [--partition P] [--time T] [--mem M] [--sbatch ARG]...
   study.py task DIR NAME      one run of a study directory (what a Slurm task runs)
   study.py index DIR          write DIR/index.toml from the runs' status files
+  study.py results [DIR]      write DIR/README.md (default results/): a line per archived study
   study.py archive DIR [--to ARCHIVE]
                               reduce every complete run of study directory DIR into its results
                               archive (the study's [study] archive, or ARCHIVE): dynhet.archive
@@ -65,7 +66,14 @@ def main():
     ar = sub.add_parser("archive")
     ar.add_argument("dir")
     ar.add_argument("--to", metavar="ARCHIVE", help="the archive directory (default: the study's own)")
+    rs = sub.add_parser("results")
+    rs.add_argument("dir", nargs="?", default=os.path.join(ROOT, "results"))
     a = ap.parse_args()
+    if a.cmd == "results":
+        from ..archive import results_readme
+        write_atomic(os.path.join(a.dir, "README.md"), results_readme(a.dir))
+        print(f"wrote {os.path.join(a.dir, 'README.md')}")
+        return 0
     try:
         if a.cmd == "run":
             study = Study(a.study)

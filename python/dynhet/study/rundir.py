@@ -164,7 +164,7 @@ class StudyDir:
         finished points' range the table's shape, scaled to the nearest
         finished point: ln tau is far from linear in phi near the transition,
         and a line through two high densities extrapolated down undershoots
-        (scale.toml: 0.78 and 0.80 put 0.76 at 3.6, where the table has a
+        (a finite-size study: 0.78 and 0.80 put 0.76 at 3.6, where the table has a
         third of 0.78's). Estimates only (the dry run, the ETA, the order of
         the runs) unless the study's run lengths interpolate."""
         phi = p["packing_fraction"]
