@@ -40,6 +40,12 @@ add_test(NAME study_local_tiny
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/study_local.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(study_local_tiny PROPERTIES LABELS process TIMEOUT 400)
 
+# Kept frames for the field's tools: run.frames() and the GSD export, read
+# back by MDAnalysis (tests/frames_export.sh).
+add_test(NAME frames_to_mdanalysis
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/frames_export.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(frames_to_mdanalysis PROPERTIES LABELS process TIMEOUT 120)
+
 # The results archive on studies/tiny.toml: entries written as runs complete,
 # checked against the runs; the same analysis from the archive as from the
 # study directory; a study resumed from its archive alone; corrupted,

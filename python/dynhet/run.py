@@ -150,6 +150,18 @@ class Run:
         """Whether the run kept its frames (observables.keep_frames)."""
         return "particles" in self._f and "position" in self._f["particles/all"]
 
+    def frames(self, start=0, stop=None, step=1):
+        """The kept frames [start:stop:step] (observables.keep_frames), one
+        dynhet.frames.Frame each: time, box, positions, images, radii,
+        species. export_gsd(path) writes them for MDAnalysis, OVITO, HOOMD."""
+        from .frames import frames
+        return frames(self, start, stop, step)
+
+    def export_gsd(self, path, start=0, stop=None, step=1):
+        """The kept frames as a GSD file (dynhet.frames.export_gsd); returns the frames written."""
+        from .frames import export_gsd
+        return export_gsd(self, path, start, stop, step)
+
     def tau_alpha(self, a=A_DEFAULT):
         """tau_alpha of cutoff a with its error: (value, error)."""
         v, e = self.overlap(a).value_error("tau_alpha")
