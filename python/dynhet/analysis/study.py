@@ -63,6 +63,8 @@ def run_file(sdir, name, m, archive):
     archive's entry, verified against its hash (a corrupted or changed entry
     is refused by name)."""
     if archive is not None:
+        if "file" not in m:  # planned, not archived: no file (the caller counts it unfinished)
+            return os.path.join(sdir, "runs", name + ".h5")
         try:
             return archive.path(name, m)
         except ArchiveError as e:
