@@ -89,6 +89,14 @@ target_link_libraries(hostile_publisher PRIVATE dynhet_lcmtypes dynhet_common)
 add_test(NAME hostile_messages
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/hostile.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR} $<TARGET_FILE:hostile_publisher>)
 set_tests_properties(hostile_messages PROPERTIES LABELS process TIMEOUT 300)
+# State only moves forward (hostile.sh state): the run's own state messages
+# replayed without the key (those of equilibration in production, each
+# node's halfway and after its "done", the sim's after its "done") while
+# the recorder is slowed to fall a pacing window behind: complete, equal to
+# a clean run bit for bit, every copy counted stale, nothing genuine lost.
+add_test(NAME hostile_state_forward
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/hostile.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR} $<TARGET_FILE:hostile_publisher> state)
+set_tests_properties(hostile_state_forward PROPERTIES LABELS process TIMEOUT 300)
 
 # Mutated scenes (tests/fuzz_scenes.py, 400 with a fixed seed): each is
 # refused by sim_node --check with a message or runs (private bus).
