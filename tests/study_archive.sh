@@ -30,6 +30,13 @@ check 'diff <(grep "^| " "$tmp/study/tiny/reproduction.md") <(grep "^| " "$tmp/f
   "reproduction.md: every table row the same from the archive"
 check '[[ ! -e $tmp/results/tiny/study.h5 && ! -d $tmp/results/tiny/figures ]]' "the analysis of an archive writes nothing into it"
 
+# study.py archive: an existing study directory into an archive of its own.
+/usr/bin/python3 "$root/launch_scripts/study.py" archive "$tmp/study/tiny" --to "$tmp/arch2" >"$tmp/a2.out" 2>&1 || { cat "$tmp/a2.out"; fail=1; }
+check 'grep -q "4 runs archived now, 0 already, 0 not complete; 4 runs in" "$tmp/a2.out"' "study.py archive: 4 runs of a study directory archived"
+/usr/bin/python3 "$root/tests/check_archive.py" entries "$tmp/arch2" "$tmp/study/tiny" || fail=1
+/usr/bin/python3 "$root/launch_scripts/study.py" archive "$tmp/study/tiny" --to "$tmp/arch2" >"$tmp/a3.out" 2>&1 || fail=1
+check 'grep -q "0 runs archived now, 4 already" "$tmp/a3.out"' "archiving again adds nothing"
+
 # The machine is replaced: the run directories and pilots are gone. The same
 # command resumes from the archive: nothing runs, the analysis reads the archive.
 rm -rf "$tmp/study/tiny/runs" "$tmp/study/tiny/pilots" "$tmp/study/tiny/states" "$tmp/study/tiny/study.h5"
@@ -60,12 +67,5 @@ cp "$entry" "$tmp/results/tiny/runs/unlisted.h5"
 "${analyse[@]}" "$tmp/results/tiny" --out "$tmp/again" >"$tmp/again.out" 2>&1 || { cat "$tmp/again.out"; fail=1; }
 /usr/bin/python3 "$root/tests/check_archive.py" same-analysis "$tmp/from_archive/study.h5" "$tmp/again/study.h5" || fail=1
 
-# study.py archive: an existing study directory into an archive of its own.
-"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/t" --jobs 2 >"$tmp/t.out" 2>&1 || { cat "$tmp/t.out"; exit 1; }
-/usr/bin/python3 "$root/launch_scripts/study.py" archive "$tmp/t" --to "$tmp/arch2" >"$tmp/a2.out" 2>&1 || { cat "$tmp/a2.out"; fail=1; }
-check 'grep -q "4 runs archived now, 0 already, 0 not complete; 4 runs in" "$tmp/a2.out"' "study.py archive: 4 runs of a study directory archived"
-/usr/bin/python3 "$root/tests/check_archive.py" entries "$tmp/arch2" "$tmp/t" || fail=1
-/usr/bin/python3 "$root/launch_scripts/study.py" archive "$tmp/t" --to "$tmp/arch2" >"$tmp/a3.out" 2>&1 || fail=1
-check 'grep -q "0 runs archived now, 4 already" "$tmp/a3.out"' "archiving again adds nothing"
 ((fail == 0)) || { echo "--- outputs"; tail -n 30 "$tmp"/*.out; }
 exit $fail
