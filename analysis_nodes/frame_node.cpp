@@ -103,6 +103,8 @@ void FrameNode::note_unauthenticated(const std::string& channel, const std::stri
 }
 
 void FrameNode::drain_unauthenticated() {
+  const auto drops = bus_.drops();
+  std::copy(drops.begin(), drops.end(), status_.bus_drops);
   if (const int64_t d = unauthenticated_new_.exchange(0))
     status_.messages_unauthenticated =
         static_cast<int32_t>(std::min<int64_t>(int64_t{status_.messages_unauthenticated} + d, INT32_MAX));

@@ -35,12 +35,13 @@ public:
   // forgeries cannot crowd genuine frames out of it.
   Receiver(lcm::LCM& in, Inbox& inbox, bool replay, FrameNode& node)
       : in_(in), inbox_(inbox), replay_(replay), node_(node) {
-    in_.subscribe(kChanRun, &Receiver::on_message, this);
-    // LCM's own queue between its socket thread and handle(): deep, though
-    // this thread empties it at once.
+    // LCM's own queues between its socket thread and handle(): deep, though
+    // this thread empties them at once (checking a frame's tags takes ms,
+    // and LCM drops what a full queue cannot take before any check).
+    in_.subscribe(kChanRun, &Receiver::on_message, this)->setQueueCapacity(1 << 14);
     in_.subscribe(kChanFrame, &Receiver::on_message, this)->setQueueCapacity(100000);
-    in_.subscribe(kChanSimStatus, &Receiver::on_message, this);
-    in_.subscribe(kChanCheckpoint, &Receiver::on_message, this);
+    in_.subscribe(kChanSimStatus, &Receiver::on_message, this)->setQueueCapacity(1 << 14);
+    in_.subscribe(kChanCheckpoint, &Receiver::on_message, this)->setQueueCapacity(1 << 14);
     thread_ = std::thread([this] { loop(); });
   }
   ~Receiver() { stop(); }
@@ -71,7 +72,8 @@ private:
     int size = 0;
     std::string why;
     if (!node_.bus().open(ch, rb->data, rb->data_size, size, why)) return node_.note_unauthenticated(ch, why);
-    inbox_.push(Inbox::Message{ch, std::vector<uint8_t>(p, p + size), rb->recv_utime}, ch == kChanFrame, replay_);
+    if (!inbox_.push(Inbox::Message{ch, std::vector<uint8_t>(p, p + size), rb->recv_utime}, ch == kChanFrame, replay_))
+      node_.bus().count_drop(BusDrop::queue_full);
   }
 
   lcm::LCM& in_;

@@ -1,5 +1,6 @@
 // Keys, tags and their checks for the authenticated bus (bus_auth.hpp).
 #include "dynhet/bus_auth.hpp"
+#include "dynhet/lcm_url.hpp"
 
 #include <sodium.h>
 
@@ -60,6 +61,27 @@ std::optional<std::uint64_t> bus_epoch_of(const void* data, std::size_t n) {
   const auto* b = static_cast<const unsigned char*>(data);
   if (lcm_bytes_of(data, n) == n) return std::nullopt;
   return get_u64(b + n - kBusTagBytes + 4);
+}
+
+bool carries_state(const std::string& channel) {
+  auto in = [&](const char* family) { // the family's own channel, or one of its sources' (FAMILY_...)
+    const std::size_t n = std::strlen(family);
+    return channel.compare(0, n, family) == 0 && (channel.size() == n || channel[n] == '_');
+  };
+  return channel == kChanRun || channel == kChanSimStatus || in(kChanNodeStatus) || in(kChanCheckpoint);
+}
+
+const char* bus_drop_name(BusDrop d) {
+  switch (d) {
+  case BusDrop::untagged: return "untagged";
+  case BusDrop::bad_tag: return "bad_tag";
+  case BusDrop::other_launch: return "other_launch";
+  case BusDrop::replayed: return "replayed";
+  case BusDrop::stale: return "stale";
+  case BusDrop::lost: return "lost";
+  case BusDrop::queue_full: return "queue_full";
+  }
+  return "?";
 }
 
 BusKey::~BusKey() { sodium_memzero(key_.data(), key_.size()); }
@@ -124,7 +146,7 @@ void BusSigner::tag(const std::string& channel, std::uint8_t* message, std::size
   std::uint64_t seq;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    seq = ++sequence_;
+    seq = ++sequence_[channel];
   }
   unsigned char* head = message + n;
   std::memcpy(head, kMagic, 4);
@@ -153,6 +175,8 @@ const char* BusVerifier::what(Verdict v) {
   case Verdict::other_epoch:
     return "unauthenticated: of another launch of the run (a message of an earlier segment, replayed)";
   case Verdict::replayed: return "unauthenticated: a replay (this sender's sequence number was seen before)";
+  case Verdict::stale:
+    return "unauthenticated: a replay of older state (its sender's later state on this channel was already taken)";
   }
   return "?";
 }
@@ -160,31 +184,64 @@ const char* BusVerifier::what(Verdict v) {
 BusVerifier::Verdict BusVerifier::verify(const std::string& channel, const void* data, std::size_t n,
                                          std::size_t& payload) {
   payload = 0;
-  if (n < kBusTagBytes) return Verdict::untagged;
+  if (n < kBusTagBytes) return counted(Verdict::untagged);
   const auto* bytes = static_cast<const unsigned char*>(data);
   const std::size_t at = n - kBusTagBytes;
   const unsigned char* head = bytes + at;
-  if (std::memcmp(head, kMagic, 4) != 0) return Verdict::untagged;
+  if (std::memcmp(head, kMagic, 4) != 0) return counted(Verdict::untagged);
   unsigned char tag[32];
   compute_tag(*key_, channel, head, bytes, at, tag);
-  if (crypto_verify_32(tag, head + kHead) != 0) return Verdict::bad_tag; // constant time
+  if (crypto_verify_32(tag, head + kHead) != 0) return counted(Verdict::bad_tag); // constant time
+  bool other_epoch;
   {
     std::lock_guard<std::mutex> lock(mutex_);
-    if (!any_epoch_ && get_u64(head + 4) != epoch_) return Verdict::other_epoch;
+    other_epoch = !any_epoch_ && get_u64(head + 4) != epoch_;
   }
-  if (!take(get_u64(head + 12), get_u64(head + 20))) return Verdict::replayed;
+  if (other_epoch) return counted(Verdict::other_epoch);
+  const Verdict v = take(get_u64(head + 12), channel, get_u64(head + 20));
+  if (v != Verdict::ok) return counted(v);
   payload = at;
   return Verdict::ok;
 }
 
-bool BusVerifier::take(std::uint64_t sender, std::uint64_t seq) {
+BusVerifier::Verdict BusVerifier::counted(Verdict v) {
+  static constexpr BusDrop kReason[] = {BusDrop::lost, BusDrop::untagged, BusDrop::bad_tag, BusDrop::other_launch,
+                                        BusDrop::replayed, BusDrop::stale}; // by Verdict (ok: unused)
+  count_drop(kReason[static_cast<int>(v)]);
+  return v;
+}
+
+void BusVerifier::count_drop(BusDrop d) {
   std::lock_guard<std::mutex> lock(mutex_);
-  Window& w = windows_[sender];
+  ++drops_[static_cast<int>(d)];
+}
+
+std::array<std::int64_t, kBusDropReasons> BusVerifier::drops() const {
+  std::lock_guard<std::mutex> lock(mutex_);
+  return drops_;
+}
+
+// Takes `seq` of the stream (sender, channel) once: a number above the top
+// moves the window (the numbers skipped are holes: lost, until one comes);
+// below it, a number in the window not yet taken fills a hole, except on a
+// channel that carries state, where only a number above the top is taken.
+BusVerifier::Verdict BusVerifier::take(std::uint64_t sender, const std::string& channel, std::uint64_t seq) {
+  if (seq == 0) return Verdict::replayed; // sequences count from 1
+  std::string stream(8, '\0');
+  std::memcpy(stream.data(), &sender, 8);
+  stream += channel;
+  std::lock_guard<std::mutex> lock(mutex_);
+  Window& w = windows_[stream];
+  const bool first = w.first == 0;
+  if (first) w.first = seq;
   auto bit = [&](std::uint64_t s) -> std::pair<std::uint64_t&, std::uint64_t> {
     return {w.seen[(s % kWindow) / 64], std::uint64_t{1} << (s % 64)};
   };
-  if (seq == 0) return false; // sequences count from 1
+  auto& lost = drops_[static_cast<int>(BusDrop::lost)];
   if (seq > w.top) {
+    // The first message heard of a stream may follow others sent before
+    // this receiver listened: those are not holes.
+    if (!first) lost += static_cast<std::int64_t>(seq - w.top - 1);
     // Forget what leaves the window: the slots of top+1 .. seq.
     const std::uint64_t steps = seq - w.top;
     if (steps >= kWindow) w.seen.fill(0);
@@ -196,13 +253,15 @@ bool BusVerifier::take(std::uint64_t sender, std::uint64_t seq) {
     w.top = seq;
     auto [word, mask] = bit(seq);
     word |= mask;
-    return true;
+    return Verdict::ok;
   }
-  if (w.top - seq >= kWindow) return false; // too old to tell: dropped
+  if (carries_state(channel)) return Verdict::stale;
+  if (w.top - seq >= kWindow) return Verdict::replayed; // too old to tell: dropped
   auto [word, mask] = bit(seq);
-  if (word & mask) return false;
+  if (word & mask) return Verdict::replayed;
   word |= mask;
-  return true;
+  if (seq > w.first && lost > 0) --lost; // a hole filled: that message was late, not lost
+  return Verdict::ok;
 }
 
 } // namespace dynhet

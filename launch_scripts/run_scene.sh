@@ -394,8 +394,10 @@ fi
 wait_run=(); [[ $role == analysis ]] && wait_run=(--wait-run 900)
 authorship=(); [[ -z $author ]] || authorship+=(--author "$author")
 [[ -z $author_email ]] || authorship+=(--author-email "$author_email")
+# (tests: DYNHET_TEST_RECORDER_DELAY seconds of sleep per message, a recorder that falls behind the bus)
+recorder_delay=(); [[ -z ${DYNHET_TEST_RECORDER_DELAY:-} ]] || recorder_delay=(--test-message-delay "$DYNHET_TEST_RECORDER_DELAY")
 start recorder "$bin/recorder" --out "$out/run.h5" --run-id "$run_id" "${key[@]}" "${wait_run[@]}" "${authorship[@]}" \
-  "${cut_args[@]}" "${resume_cut[@]}"
+  "${cut_args[@]}" "${resume_cut[@]}" "${recorder_delay[@]}"
 node_delay=(); [[ -z $test_node_delay ]] || node_delay=(--test-frame-delay "$test_node_delay")
 for n in $nodes; do start "$n" "$bin/$n" --run-id "$run_id" "${key[@]}" "${wait_run[@]}" "${cut_args[@]}" "${resume_cut[@]}" "${node_delay[@]}"; done
 if [[ -n $record ]]; then

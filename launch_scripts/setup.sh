@@ -13,7 +13,8 @@ packages=(build-essential cmake pkg-config git
   liblcm-dev liblcm-bin liblcm-java libglib2.0-dev default-jdk-headless default-jre libjchart2d-java
   libeigen3-dev libfftw3-dev libhdf5-dev hdf5-tools libgtest-dev
   libtomlplusplus-dev libcli11-dev zlib1g-dev libcgal-dev libsodium-dev
-  python3-matplotlib python3-h5py python3-numpy python3-scipy python3-pytest iproute2 util-linux xvfb xauth
+  python3-matplotlib python3-h5py python3-numpy python3-scipy python3-pytest
+  python3-gsd python3-mdanalysis python3-xarray iproute2 util-linux xvfb xauth
   slurmctld slurmd slurm-client munge)
 missing=()
 for p in "${packages[@]}"; do

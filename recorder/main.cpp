@@ -100,6 +100,8 @@ int main(int argc, char **argv) {
   app.add_option("--resume-cut", o.resume_cut, "rebuild the file from the journal up to this cut and go on");
   app.add_option("--cut-wait", o.cut_wait, "after SIGTERM/SIGINT, wait at most this long (s) for the next cut")
       ->capture_default_str();
+  app.add_option("--test-message-delay", o.test_message_delay,
+                 "tests: sleep this long (s) for each message taken from the bus, a recorder that falls behind");
   app.add_option("--list-nodes", list_log,
                  "print the analysis nodes the run in this lcm-logger log needs, and exit");
   CLI11_PARSE(app, argc, argv);

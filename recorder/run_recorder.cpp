@@ -163,6 +163,7 @@ bool RunRecorder::on_sim_status(const sim_status_t &m) {
     frames_published_ = std::max(frames_published_, std::min(m.frames_published, info_->n_frames));
   completion_.sim_phase(m.phase, m.message);
   sim_unauthenticated_ = m.messages_unauthenticated;
+  std::copy(std::begin(m.bus_drops), std::end(m.bus_drops), sim_bus_drops_.begin());
   return true;
 }
 
@@ -349,6 +350,8 @@ void RunRecorder::write_summary(const std::vector<std::string> &missing) {
     writer_->set_attribute("", "messages_unauthenticated_recorder", unauthenticated_);
     writer_->set_attribute("", "last_unauthenticated_recorder", last_unauthenticated_);
     writer_->set_attribute("", "messages_unauthenticated_sim", sim_unauthenticated_);
+    write_bus_drops("", "_recorder", bus_drops_.data());
+    write_bus_drops("", "_sim", sim_bus_drops_.data());
     for (const auto &[key, n] : nodes_) {
       const node_status_t &s = n.latest;
       const std::string g = "observables/nodes/" + key;
@@ -363,8 +366,17 @@ void RunRecorder::write_summary(const std::vector<std::string> &missing) {
       writer_->set_attribute(g, "chunks_rejected", s.chunks_rejected);
       writer_->set_attribute(g, "last_rejection", s.last_rejection);
       writer_->set_attribute(g, "messages_unauthenticated", s.messages_unauthenticated);
+      write_bus_drops(g, "", s.bus_drops);
     }
   });
+}
+
+// bus_dropped_<reason><suffix>: every message a process dropped on its
+// side of the bus, one attribute per reason (BusDrop).
+void RunRecorder::write_bus_drops(const std::string &group, const std::string &suffix, const int64_t *drops) {
+  for (int r = 0; r < kBusDropReasons; ++r)
+    writer_->set_attribute(group, std::string("bus_dropped_") + bus_drop_name(static_cast<BusDrop>(r)) + suffix,
+                           drops[r]);
 }
 
 } // namespace dynhet

@@ -32,6 +32,9 @@
 //   overlap_cr/, chi4_cr/, msd_cr/, displacement_cr/  the same of the
 //     cage-relative displacements (attribute displacements), in the same layout
 #pragma once
+#include <array>
+
+#include "dynhet/bus_auth.hpp"
 
 #include <cstdint>
 #include <map>
@@ -97,6 +100,8 @@ public:
     last_unauthenticated_ = channel + ": " + why;
   }
   int64_t messages_unauthenticated() const { return unauthenticated_; }
+  // The recorder's own drops by reason (BusDrop), written at finish.
+  void bus_drops(const std::array<int64_t, kBusDropReasons> &d) { bus_drops_ = d; }
   // Each write is flushed (results survive a kill); a journal replayed on
   // resume is written whole first and flushed once (flush_each(true) after
   // it flushes what was written): a flush per message made a 64 MB journal
@@ -138,6 +143,8 @@ private:
   int64_t rejected_ = 0, unauthenticated_ = 0;
   std::string last_unauthenticated_;
   int32_t sim_unauthenticated_ = 0; // the sim's own count, from its last status
+  std::array<int64_t, kBusDropReasons> bus_drops_{}, sim_bus_drops_{};
+  void write_bus_drops(const std::string &group, const std::string &suffix, const int64_t *drops);
   // Free space the recorder keeps on the file system of its file, so that
   // it can still mark the file incomplete and close it when the disk fills.
   static constexpr int64_t kDiskReserve = int64_t{4} << 20;

@@ -27,53 +27,48 @@ std::string channel_of(const dynhet::displacement_t &m) {
 
 
 // Run info and sim status come from the log when one is given, results
-// always from the bus. Queues are deep: results and chunks come in bursts.
+// always from the bus. Every queue holds what the run can send while the
+// recorder is behind (writing kept frames, a slow disk: as far behind as
+// the sim's pacing window lets it fall, or further when not paced), so
+// that LCM drops nothing before the check: kQueueSmall messages of each
+// family of small messages (statuses, results, answers: a few hundred
+// bytes to a few kB each, held only while the recorder is behind) and
+// kQueueChunks frame chunks. What is lost all the same shows as a hole in
+// its sender's numbers and is counted (bus_dropped_lost_recorder).
+constexpr int kQueueSmall = 1 << 17, kQueueChunks = 1 << 14;
+
 void Session::subscribe() {
   if (!opt_.from_log.empty()) {
     log_ = std::make_unique<lcm::LogFile>(opt_.from_log, "r");
     if (!log_->good()) fatal_ = "cannot read the log " + opt_.from_log;
   } else {
     lcm_.subscribe(dynhet::kChanRun, &Session::raw<dynhet::run_info_t, &Session::take_run>, this)
-        ->setQueueCapacity(100);
+        ->setQueueCapacity(kQueueSmall);
     lcm_.subscribe(dynhet::kChanSimStatus, &Session::raw<dynhet::sim_status_t, &Session::take_sim>, this)
-        ->setQueueCapacity(1000);
+        ->setQueueCapacity(kQueueSmall);
     // Frames from the start: the first ones can follow the run info
     // closely, and LCM drops what arrives on a channel nobody subscribes.
     frames_ = lcm_.subscribe(dynhet::kChanFrame, &Session::raw<dynhet::frame_chunk_t, &Session::take_frame>, this);
-    frames_->setQueueCapacity(10000);
+    frames_->setQueueCapacity(kQueueChunks);
   }
   // Every channel of each family (a cutoff's, a node's), and names outside
   // the scheme that start like it, to be dropped and counted.
   using R = dynhet::RunRecorder;
   using dynhet::channel_family;
-  lcm_.subscribe(channel_family(dynhet::kChanNodeStatus),
-                 &Session::raw<dynhet::node_status_t, &Session::take_node>, this)
-      ->setQueueCapacity(1000);
-  lcm_.subscribe(channel_family(dynhet::kChanOverlap),
-                 &Session::raw<dynhet::overlap_t, &Session::take_result<dynhet::overlap_t, &R::on_overlap>>, this)
-      ->setQueueCapacity(10000);
-  lcm_.subscribe(channel_family(dynhet::kChanChi4),
-                 &Session::raw<dynhet::chi4_t, &Session::take_result<dynhet::chi4_t, &R::on_chi4>>, this)
-      ->setQueueCapacity(10000);
-  lcm_.subscribe(channel_family(dynhet::kChanMsd),
-                 &Session::raw<dynhet::msd_t, &Session::take_result<dynhet::msd_t, &R::on_msd>>, this)
-      ->setQueueCapacity(10000);
-  lcm_.subscribe(channel_family(dynhet::kChanS4),
-                 &Session::raw<dynhet::s4_t, &Session::take_result<dynhet::s4_t, &R::on_s4>>, this)
-      ->setQueueCapacity(1000);
-  lcm_.subscribe(channel_family(dynhet::kChanClusters),
-                 &Session::raw<dynhet::clusters_t, &Session::take_result<dynhet::clusters_t, &R::on_clusters>>, this)
-      ->setQueueCapacity(10000);
-  lcm_.subscribe(
-         channel_family(dynhet::kChanDisplacement),
-         &Session::raw<dynhet::displacement_t, &Session::take_result<dynhet::displacement_t, &R::on_displacement>>,
-         this)
-      ->setQueueCapacity(1000);
-  lcm_.subscribe(
-         channel_family(dynhet::kChanBondBreaking),
-         &Session::raw<dynhet::bond_breaking_t, &Session::take_result<dynhet::bond_breaking_t, &R::on_bond_breaking>>,
-         this)
-      ->setQueueCapacity(10000);
+  auto family = [&](const char *name, auto handler) {
+    lcm_.subscribe(channel_family(name), handler, this)->setQueueCapacity(kQueueSmall);
+  };
+  family(dynhet::kChanNodeStatus, &Session::raw<dynhet::node_status_t, &Session::take_node>);
+  family(dynhet::kChanOverlap, &Session::raw<dynhet::overlap_t, &Session::take_result<dynhet::overlap_t, &R::on_overlap>>);
+  family(dynhet::kChanChi4, &Session::raw<dynhet::chi4_t, &Session::take_result<dynhet::chi4_t, &R::on_chi4>>);
+  family(dynhet::kChanMsd, &Session::raw<dynhet::msd_t, &Session::take_result<dynhet::msd_t, &R::on_msd>>);
+  family(dynhet::kChanS4, &Session::raw<dynhet::s4_t, &Session::take_result<dynhet::s4_t, &R::on_s4>>);
+  family(dynhet::kChanClusters,
+         &Session::raw<dynhet::clusters_t, &Session::take_result<dynhet::clusters_t, &R::on_clusters>>);
+  family(dynhet::kChanDisplacement,
+         &Session::raw<dynhet::displacement_t, &Session::take_result<dynhet::displacement_t, &R::on_displacement>>);
+  family(dynhet::kChanBondBreaking,
+         &Session::raw<dynhet::bond_breaking_t, &Session::take_result<dynhet::bond_breaking_t, &R::on_bond_breaking>>);
   // The launch scripts wait for this line before starting the sim.
   std::fprintf(stderr, "recorder: ready, waiting for run info%s%s (bus %s)\n", log_ ? " in " : "",
                log_ ? opt_.from_log.c_str() : "", bus_.describe());
@@ -227,7 +222,7 @@ int Session::run() {
   }
   if (cuts_)
     lcm_.subscribe(dynhet::channel_family(dynhet::kChanCheckpoint), &Session::take_checkpoint, this)
-        ->setQueueCapacity(1000);
+        ->setQueueCapacity(kQueueSmall);
   subscribe();
   for (;;) {
     if (log_ && !log_done_ && fatal_.empty()) {
@@ -305,12 +300,26 @@ void Session::publish_own_status(const std::string &state, const std::string &me
   own_.messages_rejected = static_cast<int32_t>(std::min<int64_t>(rec_.messages_rejected(), INT32_MAX));
   own_.messages_unauthenticated =
       static_cast<int32_t>(std::min<int64_t>(rec_.messages_unauthenticated(), INT32_MAX));
+  const auto drops = bus_.drops();
+  std::copy(drops.begin(), drops.end(), own_.bus_drops);
   own_.message = message;
   bus_.publish(lcm_, dynhet::node_status_channel(dynhet::kRecorderNode), own_);
   last_own_status_ = Clock::now();
 }
 
+// What is already queued when the recorder ends goes through the checks
+// too (a copy of an old status sent after a node's "done" is counted, not
+// left unread): until the queues are empty, for at most a few seconds.
+void Session::drain() {
+  if (log_) return;
+  const auto t0 = Clock::now();
+  while (since(t0) < 3.0 && dynhet::handle_timeout(lcm_, 50) > 0) {
+  }
+}
+
 int Session::finish(const std::string &reason) {
+  drain();
+  rec_.bus_drops(bus_.drops());
   const bool paced_run = paced();
   const std::vector<std::string> missing = rec_.finish(reason);
   if (paced_run) publish_own_status(missing.empty() ? "done" : "failed", missing.empty() ? "" : missing.front());

@@ -13,6 +13,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <thread>
 
 #include <lcm/lcm-cpp.hpp>
 
@@ -41,6 +42,7 @@ struct Options {
   std::string checkpoint_dir;
   int resume_cut = -1;
   double cut_wait = 300; // after a signal: how long to wait for the next cut
+  double test_message_delay = 0; // tests: seconds of sleep per message taken from the bus (a recorder behind)
   dynhet::BusOptions bus;
 };
 
@@ -109,6 +111,7 @@ private:
   void subscribe();
   bool read_log(int max_events);
   int step(); // -1: keep going, else the exit code
+  void drain(); // handles what is queued before the end
   int finish(const std::string &reason);
   bool sim_ended() const { return rec_.completion().sim_ended() || log_done_; }
 
@@ -138,6 +141,8 @@ private:
   template <class Msg, void (Session::*Take)(const Msg &)>
   void take_bytes(const void *data, int size, const std::string &ch) {
     if (!replaying_) count_received(ch);
+    if (opt_.test_message_delay > 0 && !replaying_)
+      std::this_thread::sleep_for(std::chrono::duration<double>(opt_.test_message_delay));
     if (cuts_ && !replaying_) cuts_->journal().append(ch, data, static_cast<uint32_t>(size));
     Msg m;
     std::string why;

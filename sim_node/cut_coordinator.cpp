@@ -28,6 +28,7 @@ CutCoordinator::CutCoordinator(lcm::LCM& lcm, Bus bus, std::string dir, int64_t 
     }
   // Answers of every process (LCM patterns match whole names).
   sub_ = lcm_.subscribe(std::string(kChanCheckpoint) + "_.*", &CutCoordinator::on_answer, this);
+  sub_->setQueueCapacity(1 << 14);
   sub_->setQueueCapacity(1000);
 }
 

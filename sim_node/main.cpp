@@ -201,6 +201,15 @@ int main(int argc, char** argv) {
                  scene.kick_pairs == "any" ? "any two particles"
                                            : ("neighbours within " + std::to_string(scene.kick_reach)).c_str());
 
+    // The pacer listens from here on (pacer.hpp), drained while the sim
+    // compresses and equilibrates.
+    std::vector<std::string> paced;
+    if (pace) {
+      for (const auto& n : dynhet::nodes_for(scene.observables)) paced.push_back(n.substr(0, n.size() - 5));
+      if (scene.keep_frames) paced.push_back(dynhet::kRecorderNode); // it writes every frame
+    }
+    Pacer pacer(lcm, bus, run_id, paced, eng.size());
+
     // The run info first, and again every 2 s, also while compressing (which
     // takes minutes at N = 10^5 and more): nodes and recorder then know the
     // run from the start and watch the sim's status instead of waiting blind.
@@ -243,6 +252,7 @@ int main(int argc, char** argv) {
       rep.msg().phase_end_time = 0;
       eng.prepare([&](double) {
         rep.update(eng, -1);
+        pacer.poll();
         if (seconds_since(last_info) > 2.0) publish_info();
         if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
       });
@@ -284,6 +294,7 @@ int main(int argc, char** argv) {
       parts.push_back(dynhet::kRecorderNode);
       cuts = std::make_unique<dynhet::CutCoordinator>(lcm, bus, cut_root, run_id, scene.text, parts);
     }
+    rep.count_unauthenticated([&] { return pacer.unauthenticated() + (cuts ? cuts->unauthenticated() : 0); });
     // At a synchronised time: a cut after the last frame published.
     auto take_cut = [&](bool stop) {
       const auto t0 = Clock::now();
@@ -326,6 +337,7 @@ int main(int argc, char** argv) {
           rep.update(eng, t_end - eng.time());
           if (tcpq && dynhet::bus_lost(lcm)) throw std::runtime_error(dynhet::kBusLost);
           if (seconds_since(last_info) > 2.0) publish_info();
+          pacer.poll();
           if (cuts) cuts->poll();
           if (g_signal && checkpoint_path.empty() && !cuts)
             throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
@@ -387,13 +399,7 @@ int main(int argc, char** argv) {
     chunk.run_id = run_id;
     chunk.n_particles = static_cast<int32_t>(eng.size());
     chunk.chunk_count = static_cast<int32_t>(ranges.size());
-    std::vector<std::string> paced;
-    if (pace) {
-      for (const auto& n : dynhet::nodes_for(scene.observables)) paced.push_back(n.substr(0, n.size() - 5));
-      if (scene.keep_frames) paced.push_back(dynhet::kRecorderNode); // it writes every frame
-    }
-    Pacer pacer(lcm, bus, run_id, paced, eng.size());
-    rep.count_unauthenticated([&] { return pacer.unauthenticated() + (cuts ? cuts->unauthenticated() : 0); });
+    pacer.start_production();
     // Where the production's wall time goes (the last lines of the log;
     // bench/bench_bus.py reads them): simulating, waiting for paced nodes,
     // publishing frames.

@@ -29,6 +29,12 @@ namespace dynhet {
 // node that failed or finished is not waited for; one silent for kGiveUp
 // seconds (the recorder: kGiveUpRecorder) is dropped from the pacing with a
 // warning (its losses are then its own, and counted).
+//
+// The pacer listens from the sim's start, before compression and
+// equilibration (poll() drains it meanwhile): the bus then knows every
+// number each node has used in this launch, and a node's status from
+// equilibration replayed in production is dropped as stale, not taken as
+// a first copy.
 class Pacer {
 public:
   Pacer(lcm::LCM& lcm, Bus bus, int64_t run_id, std::vector<std::string> nodes, long n_particles)
@@ -37,9 +43,20 @@ public:
     window_ = pacing_window_frames(n_particles);
     // Each node's own channel (DYNHET_NODE_STATUS_<node>; node names hold
     // no regex characters).
-    for (auto& [name, n] : nodes_)
+    for (auto& [name, n] : nodes_) {
       subs_.push_back(lcm_.subscribe(node_status_channel(name), &Pacer::on_status, this));
+      subs_.back()->setQueueCapacity(1 << 14); // statuses pile up while the sim computes between polls
+    }
   }
+  // Handles every status queued (while the sim compresses, equilibrates or
+  // computes a frame: nothing may pile up to where LCM drops it).
+  void poll() {
+    if (nodes_.empty()) return;
+    while (handle_timeout(lcm_, 0) > 0) {
+    }
+  }
+  // Production starts: a node's silence is counted from here.
+  void start_production() { start_ = Clock::now(); }
   ~Pacer() {
     for (lcm::Subscription* s : subs_) lcm_.unsubscribe(s);
   }

@@ -76,6 +76,8 @@ public:
     if (dpub > 0 && remaining_sim_time >= 0) msg_.eta_seconds = remaining_sim_time / (dpub / dt);
     if (unauthenticated_)
       msg_.messages_unauthenticated = static_cast<int32_t>(std::min<long>(unauthenticated_(), INT32_MAX));
+    const auto drops = bus_.drops();
+    std::copy(drops.begin(), drops.end(), msg_.bus_drops);
     bus_.publish(lcm_, kChanSimStatus, msg_);
     print();
     last_ = Clock::now();

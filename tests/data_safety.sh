@@ -102,7 +102,7 @@ check '[[ $rc == 2 && $(sum "$tmp/s1/run.h5") == "$h" && ! -e $tmp/s1/study.toml
   "run_study: a directory that is not a study is refused (exit $rc), unchanged"
 mkrun "$tmp/rp/quick"
 h=$(sum "$tmp/rp/quick/run.h5")
-run "$tmp/rp.out" bash "$root/launch_scripts/reproduce.sh" --runs "$tmp/rp" --only quick --no-build
+run "$tmp/rp.out" bash "$root/launch_scripts/reproduce.sh" --runs "$tmp/rp" --results "$tmp/results" --only quick --no-build
 check '[[ $rc == 2 && $(sum "$tmp/rp/quick/run.h5") == "$h" && ! -e $tmp/rp/quick/study.toml ]] && grep -q "is not a study directory" "$tmp/rp.out"' \
   "reproduce: a study directory holding something else is refused (exit $rc), unchanged"
 

@@ -30,8 +30,22 @@
 #    clean run bit for bit, and each drops the other's messages;
 # 6. a recorder killed (SIGKILL) mid-run leaves a readable run.h5 that says
 #    incomplete, and run_scene.sh exits non-zero.
+#
+# With a fourth argument "state" it runs this instead (state only moves
+# forward, nothing genuine lost uncounted; docs/bus.md):
+# 7. a run of 40 origins (longer than the sim's pacing window, 431 frames
+#    at N = 300) clean, then again with the recorder slowed on purpose (a
+#    sleep per message: it falls behind by the whole pacing window, and
+#    the sim waits for it) while hostile_publisher --replay-state, without
+#    the key, sends the run's own state messages again: those of
+#    equilibration once production starts, each node's earlier statuses
+#    halfway through and after its "done", the sim's after its "done".
+#    Both runs complete with equal results bit for bit; the clean one drops
+#    nothing for any reason anywhere; in the attacked one every replay is
+#    dropped and counted as stale by the recorder, the sim and the nodes
+#    count theirs, and nothing genuine is lost or queued out.
 set -euo pipefail
-root=$1 build=$2 hostile=$3
+root=$1 build=$2 hostile=$3 mode=${4:-all}
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then exec "$root/launch_scripts/netns.sh" bash "$0" "$@"; fi
 export BUILD_DIR=$build
 export LCM_DEFAULT_URL='udpm://239.255.76.67:7695?ttl=0'
@@ -41,14 +55,71 @@ run=(bash "$root/launch_scripts/run_scene.sh" --no-build --no-plots) # results, 
 fail=0
 check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
 py=/usr/bin/python3
-same() { # run.h5 A, run.h5 B: the final results equal bit for bit
+same() { # run.h5 A, run.h5 B [MIN]: the final results (more than MIN, default 50) equal bit for bit
   PYTHONPATH="$root/tests" $py -c "
 import sys
 from compare_runs import final_results, same
 (a, la), (b, lb) = final_results(sys.argv[1]), final_results(sys.argv[2])
-sys.exit(0 if same(a, b) and la == lb == 0 and len(a) > 50 else 1)" "$1" "$2"
+sys.exit(0 if same(a, b) and la == lb == 0 and len(a) > int(sys.argv[3]) else 1)" "$1" "$2" "${3:-50}"
 }
 complete() { $py -c "import h5py, sys; sys.exit(0 if int(h5py.File(sys.argv[1], 'r').attrs['complete']) == 1 else 1)" "$1"; }
+
+drops() { # run.h5 REASON -> that reason's drops: recorder sim, then each node's (name=count)
+  $py -c "
+import h5py, sys
+f, r = h5py.File(sys.argv[1], 'r'), sys.argv[2]
+n = f['observables/nodes']
+print(int(f.attrs['bus_dropped_' + r + '_recorder']), int(f.attrs['bus_dropped_' + r + '_sim']),
+      *(k + '=' + str(int(n[k].attrs['bus_dropped_' + r])) for k in sorted(n)))" "$1" "$2"
+}
+all_zero() { # run.h5 REASON...: every count of these reasons is 0, everywhere
+  local r
+  for r in "${@:2}"; do [[ $(drops "$1" "$r" | tr ' ' '\n' | sed 's/.*=//' | sort -u) == 0 ]] || return 1; done
+}
+state_forward() {
+  local reasons=(untagged bad_tag other_launch replayed stale lost queue_full)
+  # One analysis node (overlap, with msd) and one cutoff: the run is long
+  # in frames, short in time.
+  sed -e 's/^origins = 4/origins = 40/' -e 's/^compute = .*/compute = ["overlap", "msd"]/' \
+    -e 's/^cutoff_a = .*/cutoff_a = [0.6]/' "$root/scenes/tiny.toml" >"$tmp/long40.toml"
+  "${run[@]}" "$tmp/long40.toml" --out "$tmp/fwd_clean" --run-id 7001 >"$tmp/fwd_clean.log" 2>&1 ||
+    { tail -20 "$tmp/fwd_clean.log"; exit 1; }
+  frames=$($py -c "import h5py, sys; print(len(h5py.File(sys.argv[1], 'r')['observables/schedule/frame_time']))" "$tmp/fwd_clean/run.h5")
+  check 'complete "$tmp/fwd_clean/run.h5"' "40 origins ($frames frames), no attacker: complete"
+  for r in "${reasons[@]}"; do echo "clean run, $r: $(drops "$tmp/fwd_clean/run.h5" "$r")"; done
+  check 'all_zero "$tmp/fwd_clean/run.h5" "${reasons[@]}"' \
+    "no attacker: nothing dropped for any reason (lost, queue full, stale, ...) by the recorder, the sim or any node"
+  "$hostile" "$LCM_DEFAULT_URL" 7002 240 --replay-state >"$tmp/fwd.hostile.log" 2>&1 &
+  local hp=$!
+  sleep 0.5
+  DYNHET_TEST_RECORDER_DELAY=${FORWARD_RECORDER_DELAY:-0.004} \
+    "${run[@]}" "$tmp/long40.toml" --out "$tmp/fwd" --run-id 7002 >"$tmp/fwd.log" 2>&1 && rc=0 || rc=$?
+  kill $hp 2>/dev/null || true
+  wait $hp 2>/dev/null || true
+  cat "$tmp/fwd.hostile.log"
+  read -r forged eq half after late < <(sed -n 's/.*replayed \([0-9]*\) state messages (\([0-9]*\) of equilibration in production, \([0-9]*\) halfway, \([0-9]*\) after a done, \([0-9]*\) of them the recorder.s own after its done).*/\1 \2 \3 \4 \5/p' "$tmp/fwd.hostile.log")
+  for r in "${reasons[@]}"; do echo "attacked run, $r: $(drops "$tmp/fwd/run.h5" "$r" 2>/dev/null)"; done
+  read -r stale_rec stale_sim stale_nodes < <(drops "$tmp/fwd/run.h5" stale 2>/dev/null || echo "-1 -1")
+  check '[[ $rc == 0 ]] && complete "$tmp/fwd/run.h5"' \
+    "replayed state, the recorder behind: run_scene.sh exits 0 (got $rc), run.h5 complete"
+  check 'grep -q "waiting for slow nodes.*recorder" "$tmp/fwd/sim_node.log"' \
+    "the slowed recorder fell behind by the whole pacing window (the sim waited for it)"
+  check 'same "$tmp/fwd_clean/run.h5" "$tmp/fwd/run.h5" 10' \
+    "replayed state: results (overlap, chi4... of one node: 15) equal the clean run's bit for bit"
+  # The recorder's own statuses replayed after its "done" reach no one
+  # (the recorder has ended, and the sim with it): all the others count.
+  check '(( ${forged:-0} > 100 && ${eq:-0} > 0 && ${half:-0} > 0 && ${after:-0} > 0 && stale_rec == forged - late ))' \
+    "replayed state: every one of the $((${forged:-0} - ${late:-0})) copies sent while the recorder ran dropped and counted as stale by it ($stale_rec)"
+  check '(( stale_sim > 0 )) && [[ $(echo $stale_nodes | tr " " "\n" | sed "s/.*=//" | grep -c "^0$") == 0 ]]' \
+    "replayed state: the sim (equilibration statuses in production: $stale_sim) and every node ($stale_nodes) drop theirs as stale"
+  check 'all_zero "$tmp/fwd/run.h5" untagged bad_tag other_launch replayed lost queue_full' \
+    "replayed state, the recorder behind: no genuine message lost or queued out, none refused but as stale"
+}
+if [[ $mode == state ]]; then
+  state_forward
+  ((fail == 0)) || tail -n 5 "$tmp"/*.log
+  exit $fail
+fi
 
 "${run[@]}" "$root/scenes/tiny.toml" --out "$tmp/clean" --run-id 4242 >"$tmp/clean.log" 2>&1 ||
   { tail -20 "$tmp/clean.log"; exit 1; }

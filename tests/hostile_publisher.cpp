@@ -40,6 +40,15 @@
 // the run has been resumed (a later launch, another epoch): each must be
 // dropped as a message of another launch.
 //
+// With --replay-state (no key) it sends the run's own state messages
+// again, byte for byte, at the moments they could move the run backwards:
+// every state message of compression and equilibration (run info, sim and
+// node statuses) once production starts; each node's earlier statuses when
+// it is halfway through its frames; each node's earlier statuses once it
+// says "done", and the sim's (with its run info) once it says "done". Each
+// copy must be dropped as stale by every receiver (whatever its replay
+// window holds), the run must complete, its results equal a clean run's.
+//
 // Without a key it also sends, every round, well-formed statuses of every
 // node and the recorder of this run saying they are far ahead (a million
 // frames whole): the sim must not take them.
@@ -50,6 +59,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <map>
 #include <optional>
 #include <random>
 #include <set>
@@ -278,6 +288,72 @@ private:
   bool recorder_done_ = false;
 };
 
+// Sends the run's state messages again (--replay-state; see the top).
+class StateReplay {
+public:
+  explicit StateReplay(lcm::LCM& lcm) : lcm_(lcm) {
+    lcm_.subscribe("DYNHET_.*", &StateReplay::on_message, this)->setQueueCapacity(100000);
+  }
+  long forged() const { return forged_; }
+  void report() const {
+    std::printf("hostile_publisher: replayed %ld state messages (%ld of equilibration in production, %ld halfway, "
+                "%ld after a done, %ld of them the recorder's own after its done)\n",
+                forged_, equilibration_, halfway_, after_done_, recorder_after_done_);
+  }
+
+private:
+  void on_message(const lcm::ReceiveBuffer* rb, const std::string& ch) {
+    const auto* p = static_cast<const uint8_t*>(rb->data);
+    const size_t n = rb->data_size;
+    if (!dynhet::carries_state(ch) || !dynhet::bus_epoch_of(p, n)) return;
+    const std::string bytes(reinterpret_cast<const char*>(p), n);
+    if (!seen_.insert(bytes).second) return; // its own copies, back over the bus
+    const int lcm_bytes = static_cast<int>(n - dynhet::kBusTagBytes);
+    if (ch == "DYNHET_SIM_STATUS") {
+      dynhet::sim_status_t m;
+      if (m.decode(p, 0, lcm_bytes) <= 0) return;
+      if (m.phase == "production" && !production_) {
+        production_ = true;
+        equilibration_ += replay_all(); // everything before production, now
+      }
+      if (m.phase == "done" && !sim_done_) {
+        sim_done_ = true;
+        after_done_ += replay("DYNHET_SIM_STATUS") + replay("DYNHET_RUN");
+      }
+    } else if (ch.rfind("DYNHET_NODE_STATUS_", 0) == 0) {
+      dynhet::node_status_t m;
+      if (m.decode(p, 0, lcm_bytes) <= 0) return;
+      if (m.frames_expected > 0 && 2 * m.frames_whole >= m.frames_expected && halfway_done_.insert(ch).second)
+        halfway_ += replay(ch);
+      if (m.state == "done" && done_.insert(ch).second) {
+        const long k = replay(ch);
+        after_done_ += k;
+        if (m.node == "recorder") recorder_after_done_ += k; // sent when no one is left to hear them
+      }
+    }
+    held_[ch].push_back(bytes);
+  }
+  long replay(const std::string& ch) { // every message held of ch, in order
+    long k = 0;
+    for (const std::string& b : held_[ch]) {
+      lcm_.publish(ch, b.data(), static_cast<unsigned>(b.size()));
+      ++k;
+    }
+    forged_ += k;
+    return k;
+  }
+  long replay_all() {
+    long k = 0;
+    for (const auto& [ch, list] : held_) k += replay(ch);
+    return k;
+  }
+  lcm::LCM& lcm_;
+  std::map<std::string, std::vector<std::string>> held_;
+  std::set<std::string> seen_, halfway_done_, done_;
+  bool production_ = false, sim_done_ = false;
+  long forged_ = 0, equilibration_ = 0, halfway_ = 0, after_done_ = 0, recorder_after_done_ = 0;
+};
+
 } // namespace
 
 int main(int argc, char** argv) {
@@ -290,7 +366,7 @@ int main(int argc, char** argv) {
   if (!lcm.good()) return 3;
   const int64_t run = std::stoll(argv[2]);
   const double seconds = std::stod(argv[3]);
-  bool forge_done = false, relay = false, tamper = false, replay_only = false, hold = false;
+  bool forge_done = false, relay = false, tamper = false, replay_only = false, hold = false, replay_state = false;
   std::string key_file;
   for (int i = 4; i < argc; ++i) {
     const std::string a = argv[i];
@@ -299,6 +375,7 @@ int main(int argc, char** argv) {
     else if (a == "--tamper") tamper = true;
     else if (a == "--replay-only") replay_only = true;
     else if (a == "--hold") hold = true;
+    else if (a == "--replay-state") replay_state = true;
     else if (a == "--key-file" && i + 1 < argc) key_file = argv[++i];
     else {
       std::fprintf(stderr, "hostile_publisher: unknown argument %s\n", a.c_str());
@@ -326,6 +403,16 @@ int main(int argc, char** argv) {
       return 1;
     }
     g_signer = std::make_unique<dynhet::BusSigner>(dynhet::BusKey::load(key_file), *epoch.e);
+  }
+  if (replay_state) {
+    std::signal(SIGTERM, on_signal);
+    std::signal(SIGINT, on_signal);
+    StateReplay r(lcm);
+    const auto t0 = std::chrono::steady_clock::now();
+    while (!g_stop && std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() < seconds)
+      lcm.handleTimeout(100);
+    r.report();
+    return 0;
   }
   if (relay || tamper) {
     std::signal(SIGTERM, on_signal);

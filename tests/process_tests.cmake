@@ -48,6 +48,20 @@ add_test(NAME study_local_tiny
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/study_local.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(study_local_tiny PROPERTIES LABELS process TIMEOUT 400)
 
+# Kept frames for the field's tools: run.frames() and the GSD export, read
+# back by MDAnalysis (tests/frames_export.sh).
+add_test(NAME frames_to_mdanalysis
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/frames_export.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(frames_to_mdanalysis PROPERTIES LABELS process TIMEOUT 120)
+
+# The results archive on studies/tiny.toml: entries written as runs complete,
+# checked against the runs; the same analysis from the archive as from the
+# study directory; a study resumed from its archive alone; corrupted,
+# unlisted and half-written entries never read (tests/study_archive.sh).
+add_test(NAME study_archive_tiny
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/study_archive.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
+set_tests_properties(study_archive_tiny PROPERTIES LABELS process TIMEOUT 400)
+
 # The study runner, Slurm executor, against a real throwaway single-host
 # Slurm cluster in a private network namespace (tests/slurm_study.sh): every
 # run equals the local executor's bit for bit.
@@ -83,6 +97,14 @@ target_link_libraries(hostile_publisher PRIVATE dynhet_lcmtypes dynhet_common)
 add_test(NAME hostile_messages
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/hostile.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR} $<TARGET_FILE:hostile_publisher>)
 set_tests_properties(hostile_messages PROPERTIES LABELS process TIMEOUT 300)
+# State only moves forward (hostile.sh state): the run's own state messages
+# replayed without the key (those of equilibration in production, each
+# node's halfway and after its "done", the sim's after its "done") while
+# the recorder is slowed to fall a pacing window behind: complete, equal to
+# a clean run bit for bit, every copy counted stale, nothing genuine lost.
+add_test(NAME hostile_state_forward
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/hostile.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR} $<TARGET_FILE:hostile_publisher> state)
+set_tests_properties(hostile_state_forward PROPERTIES LABELS process TIMEOUT 300)
 
 # Mutated scenes (tests/fuzz_scenes.py, 400 with a fixed seed): each is
 # refused by sim_node --check with a message or runs (private bus).

@@ -76,7 +76,8 @@ def sign(key, channel, payload, sender, sequence, epoch=0):
 
 def verdict(key, channel, data, seen):
     """'ok', 'untagged', 'bad_tag' or 'replayed' for one message; seen: the
-    set of (epoch, sender, sequence) taken so far (updated when 'ok')."""
+    set of (epoch, sender, channel, sequence) taken so far (updated when
+    'ok'): a sender numbers its messages on each channel from 1."""
     n = len(data)
     if n < TAG_BYTES or data[n - TAG_BYTES:n - TAG_BYTES + 4] != MAGIC:
         return "untagged"
@@ -85,9 +86,9 @@ def verdict(key, channel, data, seen):
     if not hmac.compare_digest(tag_of(key, channel, head, data[:at]), bytes(data[at + HEAD:])):
         return "bad_tag"
     epoch, sender, seq = struct.unpack("<QQQ", head[4:])
-    if (epoch, sender, seq) in seen:
+    if (epoch, sender, channel, seq) in seen:
         return "replayed"
-    seen.add((epoch, sender, seq))
+    seen.add((epoch, sender, channel, seq))
     return "ok"
 
 

@@ -88,6 +88,8 @@ class Observable:
         d = self._g[name]
         if not isinstance(d, h5py.Group):
             raise ValueError(f"{self.name}/{name} is fixed, not a series")
+        if "time" not in d:  # a results archive's entry keeps the final record, its time an attribute
+            return np.atleast_1d(d.attrs.get("time", np.nan)), d["value"][()]
         return d["time"][()], d["value"][()]
 
     def __repr__(self):
@@ -179,6 +181,18 @@ class Run:
     def has_frames(self):
         """Whether the run kept its frames (observables.keep_frames)."""
         return "particles" in self._f and "position" in self._f["particles/all"]
+
+    def frames(self, start=0, stop=None, step=1):
+        """The kept frames [start:stop:step] (observables.keep_frames), one
+        dynhet.frames.Frame each: time, box, positions, images, radii,
+        species. export_gsd(path) writes them for MDAnalysis, OVITO, HOOMD."""
+        from .frames import frames
+        return frames(self, start, stop, step)
+
+    def export_gsd(self, path, start=0, stop=None, step=1):
+        """The kept frames as a GSD file (dynhet.frames.export_gsd); returns the frames written."""
+        from .frames import export_gsd
+        return export_gsd(self, path, start, stop, step)
 
     def tau_alpha(self, a=A_DEFAULT):
         """tau_alpha of cutoff a with its error: (value, error)."""

@@ -7,7 +7,9 @@
 
 #include <cstdint>
 #include <cstdlib>
+#include <array>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -84,8 +86,22 @@ public:
     thread_local std::vector<std::uint8_t> buf;
     buf.resize(static_cast<std::size_t>(n) + kBusTagBytes);
     if (m.encode(buf.data(), 0, n) != n) return -1;
+    // Numbered and sent in one step: a stream's messages leave in the order
+    // of their numbers (receivers take state only forward), whichever
+    // threads publish.
+    std::lock_guard<std::mutex> lock(*publishing_);
     signer_->tag(channel, buf.data(), static_cast<std::size_t>(n));
     return lcm.publish(channel, buf.data(), static_cast<unsigned int>(buf.size()));
+  }
+
+  // Messages this process's receivers dropped, by reason (BusDrop), and
+  // one more counted by the caller (a queue of its own full). Zeros on an
+  // unauthenticated bus.
+  std::array<std::int64_t, kBusDropReasons> drops() const {
+    return verifier_ ? verifier_->drops() : std::array<std::int64_t, kBusDropReasons>{};
+  }
+  void count_drop(BusDrop d) const {
+    if (verifier_) verifier_->count_drop(d);
   }
 
   // The LCM bytes of a received message: true, with their length in size;
@@ -110,6 +126,7 @@ private:
   Bus() = default;
   std::shared_ptr<BusSigner> signer_;
   std::shared_ptr<BusVerifier> verifier_;
+  std::shared_ptr<std::mutex> publishing_ = std::make_shared<std::mutex>();
   std::uint64_t epoch_ = 0;
   bool any_epoch_ = false;
 };

@@ -63,7 +63,7 @@ def appendix_results(A):
     ax[0].set_xlabel("φ")
     ax[0].set_ylabel("χ at the s4 node's t_s4 (= its τ_α)")
     ax[0].legend(fontsize=8)
-    ax[0].set_title("Fig. fitting")
+    ax[0].set_title("χ0 of the OZ fits against χ4 (paper, appendix)")
     rat = np.array(rat)
     for k, qm in enumerate(qms):
         ax[1].plot(x, rat[:, k], "o-", ms=3, label=f"q_m = {qm:g}")

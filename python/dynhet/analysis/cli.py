@@ -40,7 +40,35 @@ from .restitution import restitution_results
 from .appendix import appendix_results
 from .driving import driving_results, driving_rows
 from .finite_size import write_finite_size
+from .restate import exists as restate_exists
 from .output import write_h5, write_table
+
+
+def stated_args(args):
+    """The command line as the documents state it: without --out and its
+    directory (where the scratch output went is not what made the numbers)."""
+    out, skip = [], False
+    for x in args:
+        if skip:
+            skip = False
+        elif x == "--out":
+            skip = True
+        elif not x.startswith("--out="):
+            out.append(x)
+    return out
+
+
+def out_dir(study_dir, out):
+    """Where the analysis writes: --out, else the study directory, else (a
+    results archive, which holds runs only) runs/analysis-<study> of the
+    repository."""
+    from ..archive import is_archive
+    if out:
+        return out
+    if not is_archive(study_dir):
+        return study_dir
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+    return os.path.join(root, "runs", "analysis-" + os.path.basename(os.path.abspath(study_dir).rstrip("/")))
 
 
 DOC = __doc__.rstrip("\n") + "\n\nConventions " + CONVENTIONS
@@ -83,7 +111,10 @@ def free_outputs(paths, fresh):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=DOC.split("\n\n")[0], formatter_class=argparse.RawDescriptionHelpFormatter,
                                  epilog=DOC.split("\n\n", 1)[1])
-    ap.add_argument("study_dir")
+    ap.add_argument("study_dir", help="a study directory (run_study.sh --out) or a results archive (results/<study>)")
+    ap.add_argument("--out", metavar="DIR",
+                    help="write study.h5, reproduction.md, finite_size.md and figures/ here (default: the study "
+                         "directory; for a results archive, runs/analysis-<study> beside the repository's results/)")
     ap.add_argument("--table", help="also write the reproduction table here (e.g. docs/reproduction.md)")
     ap.add_argument("--finite-size", metavar="FILE",
                     help="also write the finite-size report here (e.g. docs/finite_size.md)")
@@ -94,8 +125,11 @@ def main(argv=None):
     ap.add_argument("--largest-n", action="store_true",
                     help="at each density of the study, take the point of the largest N over it and the --also "
                          "studies for every row and fit (the table says which N each density has)")
+    ap.add_argument("--command", metavar="TEXT",
+                    help="the command the documents state as having made them (default: this one, without --out); "
+                         "launch_scripts/reproduce.sh names itself")
     ap.add_argument("--restate", metavar="OLD_TABLE",
-                    help="an earlier reproduction.md: append, for each row it judged \"differs\", the verdict now")
+                    help="an earlier reproduction.md (a file, or COMMIT:PATH from git history): append, for each row it judged \"differs\", the verdict now")
     ap.add_argument("--restate-via", action="append", default=[], metavar="LABEL=TABLE",
                     help="a table made between --restate's and this one (repeatable, in order): a column of its "
                          "verdicts, and the change column says at which step each verdict moved")
@@ -103,14 +137,14 @@ def main(argv=None):
                     help="a --table or --finite-size path that holds something else is moved aside to "
                          "FILE.old-<time> (without it, refused)")
     a = ap.parse_args(argv)
-    if a.restate and not os.path.isfile(a.restate):
+    if a.restate and not restate_exists(a.restate):
         refuse(f"--restate {a.restate}: no such file")
     via = []
     for v in a.restate_via:
         label, eq, path = v.rpartition("=")  # the last "=": a label may hold one (N = 4096)
         if not eq or not label or not path:
             refuse(f"--restate-via {v}: give LABEL=TABLE (e.g. \"other seeds=old.md\")")
-        if not os.path.isfile(path):
+        if not restate_exists(path):
             refuse(f"--restate-via {v}: no such file {path}")
         via.append((label, path))
     if via and not a.restate:
@@ -119,10 +153,11 @@ def main(argv=None):
         refuse("--largest-n takes the largest N over the --also studies: give at least one")
     for d in [a.study_dir] + a.also:
         if not os.path.isfile(os.path.join(d, "index.toml")):
-            refuse(f"{d} is not a study directory: no index.toml (run_study.sh --out DIR writes it)")
+            refuse(f"{d} is not a study directory nor a results archive: no index.toml (run_study.sh --out DIR writes it)")
     free_outputs([a.table, a.finite_size], a.fresh)
     t0 = time.time()
-    A = Analysis(a.study_dir, a.also)
+    A = Analysis(a.study_dir, a.also, out_dir(a.study_dir, a.out))
+    os.makedirs(A.out, exist_ok=True)
     if a.largest_n:
         say("analyse_study: largest N: " + (", ".join(f"φ {p.phi:g} ({p.pairs}, ε {p.eps:g}): N = {p.N} from "
                                                        f"{p.study} ({len(p.runs)} seed{'s' if len(p.runs) > 1 else ''})"
@@ -193,13 +228,13 @@ def main(argv=None):
     A.driving = ({}, "")
     step("driving rules", driving_results)
     driving_rows(A)
-    write_h5(A, os.path.join(A.dir, "study.h5"))
-    cmd = "launch_scripts/analyse_study.sh " + " ".join(argv if argv is not None else sys.argv[1:])
-    write_table(A, os.path.join(A.dir, "reproduction.md"), cmd, a.discussion, a.restate, via)
+    write_h5(A, os.path.join(A.out, "study.h5"))
+    cmd = a.command or "launch_scripts/analyse_study.sh " + " ".join(stated_args(argv if argv is not None else sys.argv[1:]))
+    write_table(A, os.path.join(A.out, "reproduction.md"), cmd, a.discussion, a.restate, via)
     if a.table:
         write_table(A, a.table, cmd, a.discussion, a.restate, via)
     try:
-        densities = write_finite_size(A, os.path.join(A.dir, "finite_size.md"), cmd)
+        densities = write_finite_size(A, os.path.join(A.out, "finite_size.md"), cmd)
         if a.finite_size:
             write_finite_size(A, a.finite_size, cmd)
         say(f"  finite size: {densities} densities run at several N")
@@ -209,7 +244,7 @@ def main(argv=None):
         failed.append("finite-size report")
     differ = [r["item"] for r in A.rows if r["verdict"].startswith("differs")]
     say(f"analyse_study: {len(A.rows)} rows, {len(differ)} differ from the paper; {len(A.fits)} fits; "
-        f"study.h5, reproduction.md and {(len(os.listdir(A.figdir)) if os.path.isdir(A.figdir) else 0)} figures in {A.dir} ({time.time() - t0:.1f} s)")
+        f"study.h5, reproduction.md and {(len(os.listdir(A.figdir)) if os.path.isdir(A.figdir) else 0)} figures in {A.out} ({time.time() - t0:.1f} s)")
     if failed:
         say(f"analyse_study: FAILED: {', '.join(failed)} (the rest is written)")
         return 1

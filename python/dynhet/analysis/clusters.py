@@ -31,7 +31,7 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
         ax[0].set_xlabel("N_c")
         ax[0].set_ylabel("R_g")
         ax[0].legend(fontsize=8)
-        ax[0].set_title("Fig. clusters-VF805: R_g(N_c)")
+        ax[0].set_title("slow clusters: R_g against N_c (paper, sec. 3.3)")
     x, y, e = series_arrays(pts, dfs)
     errorbar(ax[1], x, y, e, fmt="o", color="C3", label="slow")
     x2, y2, e2 = series_arrays(pts, dff)
@@ -39,7 +39,7 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
     ax[1].set_xlabel("φ")
     ax[1].set_ylabel("d_f")
     ax[1].legend(fontsize=8)
-    ax[1].set_title("inset of fig. clusters-VF805: d_f(φ)")
+    ax[1].set_title("d_f of slow and fast clusters against φ (paper, sec. 3.3)")
     for p, col in zip(pts, colours(len(pts))):
         cv = collapse_curves([p])
         if not cv:
@@ -52,7 +52,7 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
     ax[2].set_xlabel("N_c")
     ax[2].set_ylabel("P(N_c), slow")
     ax[2].legend(fontsize=6, ncol=2)
-    ax[2].set_title("Fig. dist(a)")
+    ax[2].set_title("P(N_c) of slow clusters (paper, sec. 3.3)")
     f1 = A.save(fig, "clusters.png")
     lo, hi = (pts[0], pts[-1]) if pts else (None, None)
     if lo:
@@ -123,10 +123,10 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
     ax[1].semilogx(u, np.exp(-np.log(u) ** 2), "k-", lw=0.8, label="exp(-ln²(N_c/N_σ))")
     ax[0].set_xlabel("N_c / N*  (N* = <N_c³>/<N_c²>, the collapse's)")
     ax[0].set_ylabel(f"P(N_c) N_c^κ, κ = {k_fig:.3g}" + (" (the collapse's)" if fc.ok else " (the slopes')"))
-    ax[0].set_title(f"Fig. dist-collapse; N* ∝ (φc-φ)^(-1/ρ), ρ = {rho:.3g}")
+    ax[0].set_title(f"P(N_c) collapse (paper, sec. 3.3); N* ∝ (φc-φ)^(-1/ρ), ρ = {rho:.3g}")
     ax[1].set_xlabel("N_c / N_σ")
     ax[1].set_ylabel("[P(N_c)/P_0]^(2σ²)")
-    ax[1].set_title("Fig. lognormal-scaled (fast clusters)")
+    ax[1].set_title("fast clusters: log-normal collapse (paper, sec. 3.3)")
     for a_ in ax:
         a_.legend(fontsize=6, ncol=2)
     f2 = A.save(fig, "clusters_collapse.png")

@@ -1,4 +1,5 @@
 """The study analysis' conventions: the paper's cutoff and restitution, the densities and ranges it names."""
+import os
 
 CONVENTIONS = """(docs/analysis.md, "Study analysis"):
 - A point is (driving.pairs, restitution, packing fraction, N); its value is
@@ -41,3 +42,13 @@ A_THREE = (0.6, 1.4, 3.0)        # the paper's fig. diff-a cutoffs
 
 def say(*a):
     print(*a, flush=True)
+
+
+def shown_path(d):
+    """A study's directory as the documents name it: relative to the
+    repository where it lies inside it (results/quick), so that a document's
+    text does not depend on where it is written or which machine wrote it;
+    else as given."""
+    root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+    rel = os.path.relpath(os.path.abspath(d), root)
+    return d if rel.startswith("..") else rel

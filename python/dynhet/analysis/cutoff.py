@@ -54,7 +54,7 @@ def cutoff_results(A):
     ax[0].set_ylabel("ξ: at τ_α(a) (solid), at τ_α(0.6) (dashed)")
     ax[0].set_yscale("log")
     ax[0].legend(fontsize=6, ncol=2, title="φ", title_fontsize=7)
-    ax[0].set_title("Fig. xi-vs-a")
+    ax[0].set_title("ξ(τ_α(a)) against the cutoff a (paper, sec. 3.4)")
     mid = A.nearest(pts, 0.78)
     for a, col in zip(cuts, colours(len(cuts))):
         c = cut(mid.runs[0], a)
@@ -64,7 +64,7 @@ def cutoff_results(A):
     ax[1].set_xlabel("t")
     ax[1].set_ylabel("χ4(t)")
     ax[1].legend(fontsize=7)
-    ax[1].set_title(f"Fig. chi4-diff-a (φ = {mid.phi:g}; lags to {reach(mid):.3g} τ_α(0.6))")
+    ax[1].set_title(f"χ4(t) for several cutoffs a (φ = {mid.phi:g}; lags to {reach(mid):.3g} τ_α(0.6))")
     outs = []
     for a, m in zip(A_THREE, ("o", "s", "^")):
         if a not in cuts:
@@ -84,11 +84,11 @@ def cutoff_results(A):
     ax[2].set_xlabel("φ")
     ax[2].set_ylabel("ξ(τ_α(a))")
     ax[2].legend()
-    ax[2].set_title("Fig. diff-a(a)")
+    ax[2].set_title("τ_α(a) against a (paper, sec. 3.4)")
     ax[3].set_xlabel("ξ(τ_α(a))")
     ax[3].set_ylabel("χ4(τ_α(a))")
     ax[3].legend(fontsize=8)
-    ax[3].set_title("Fig. diff-a(b)")
+    ax[3].set_title("χ4 against ξ for each cutoff a (paper, sec. 3.4)")
     f = A.save(fig, "cutoff.png")
     short = [f"{a:g}" for a in cuts if reached.get(a, 0) < len(pts)]
     lags = min(reach(p) for p in pts)

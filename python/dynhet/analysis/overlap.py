@@ -29,8 +29,8 @@ def overlap_results(A):
     ax[0].set_xlabel("t")
     ax[1].set_xlabel("t / τ_α")
     ax[0].legend(fontsize=7, ncol=2)
-    ax[0].set_title("Fig. Q-t: Q(t), ε = 0.9, a = 0.6")
-    ax[1].set_title("Fig. Qoftovertaualpha: against t/τ_α")
+    ax[0].set_title("Q(t), ε = 0.9, a = 0.6 (paper, sec. 3.1)")
+    ax[1].set_title("Q against t/τ_α (paper, sec. 3.1)")
     allp = [p for k, p in A.points.items() if k[0] == "neighbours"]
     xs = np.linspace(-6, 6, 200)
     for p in allp:
@@ -46,7 +46,7 @@ def overlap_results(A):
     ax[2].set_ylim(1e-3, 1.2)
     ax[2].set_xlabel("x = β ln(t/τ0)")
     ax[2].set_ylabel("Q")
-    ax[2].set_title("Fig. Qofbetalntovertau0: all φ and ε (colour: ε)")
+    ax[2].set_title("Q against β ln(t/τ0), all φ and ε (colour: ε; paper, sec. 3.1)")
     ax[2].legend(fontsize=8)
     fq = A.save(fig, "overlap.png")
     # beta(tau0), tau_alpha(tau0) (inset of the collapse figure), eps = 0.9
@@ -113,7 +113,7 @@ def tau_results(A, joint=None):
     ax.set_xlabel("φ")
     ax.set_ylabel("τ_α")
     ax.legend(fontsize=8)
-    ax.set_title("Fig. taueps09")
+    ax.set_title("τ_α(φ), ε = 0.9, with the power-law and VFT fits (paper, sec. 3.1)")
     f = A.save(fig, "tau_alpha_phi.png")
     A.row("τ_α(φ) power law: φ_c", "3.1, fig. taueps09", "0.82", fmt(fp.p["xc"], fp.error("xc"), 4), fit_verdict(fp, "xc", 0.82), f, pts, fp.note)
     A.row("τ_α(φ) power law: γ", "3.1, fig. taueps09", "not given", fmt(fp.p["g"], fp.error("g")), "—", f, pts, fp.note)
@@ -165,7 +165,7 @@ def ageing_results(A):
     ax.set_xlabel("t0")
     ax.set_ylabel("τ_α(t0)")
     ax.legend(fontsize=6, ncol=2)
-    ax.set_title("inset of fig. Q-t-t0: no ageing")
+    ax.set_title("τ_α(t0) against the waiting time: no ageing (paper, sec. 3.1)")
     f = A.save(fig, "tau_alpha_t0.png")
     for p, s, se, note in out:
         A.row(f"τ_α(t0) at φ = {p.phi:g}: slope d(τ_α/τ̄_α)/d(t0/τ̄_α)", "3.1, inset of fig. Q-t-t0", "0 (no ageing)",

@@ -3,13 +3,38 @@ reproduction.md judged "differs", what the table says now (same verdict,
 another verdict, not judged, or no such row), so a change of method shows
 its effect on each result (analyse_study.sh --restate OLD.md)."""
 import difflib
+import os
 import re
+import subprocess
+
+
+def table_lines(path):
+    """The lines of a table file, or of a file in git history: COMMIT:PATH
+    (e.g. 556a0f6:docs/reproduction.md, read with git show from the checkout
+    this package is in)."""
+    path = str(path)
+    if ":" in path and not os.path.exists(path):
+        root = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+        r = subprocess.run(["git", "-C", root, "show", path], capture_output=True, text=True)
+        if r.returncode != 0:
+            raise FileNotFoundError(f"{path}: not in this checkout's git history ({r.stderr.strip()})")
+        return r.stdout.splitlines(keepends=True)
+    with open(path, encoding="utf-8") as fh:
+        return fh.readlines()
+
+
+def exists(path):
+    try:
+        table_lines(path)
+        return True
+    except (OSError, FileNotFoundError):
+        return False
 
 
 def read_rows(path):
     """{result: (ours, verdict)} of a reproduction table (its first table)."""
     rows = {}
-    for line in open(path, encoding="utf-8"):
+    for line in table_lines(path):
         if not line.startswith("| ") or line.startswith("| result") or line.startswith("|---"):
             if rows and not line.startswith("|"):
                 break

@@ -38,7 +38,7 @@ def restitution_results(A):
     ax[0].set_xlabel("φ")
     ax[0].set_ylabel("τ_α")
     ax[0].legend(fontsize=8)
-    ax[0].set_title(f"Fig. tau (VFT over φ {common[0]:g}-{common[1]:g})" if common else "Fig. tau")
+    ax[0].set_title(f"τ_α(φ) for each ε (paper, sec. 3.4; VFT over φ {common[0]:g}-{common[1]:g})" if common else "τ_α(φ) for each ε (paper, sec. 3.4)")
     for k, (nm, m) in enumerate((("xc", "o"), ("x0", "s"))):
         xs = [e for e, fp, fv, _ in pc]
         f_ = [fp if nm == "xc" else fv for _, fp, fv, _ in pc]
@@ -48,13 +48,13 @@ def restitution_results(A):
     ax[1].set_xlabel("ε")
     ax[1].set_ylabel("φ_c, φ_0")
     ax[1].legend()
-    ax[1].set_title("inset of fig. tau")
+    ax[1].set_title("φ_c and φ_0 against ε (paper, sec. 3.4)")
     ax[2].set_xscale("log")
     ax[2].set_yscale("log")
     ax[2].set_xlabel("N (sub-box)")
     ax[2].set_ylabel("χ4^P at φ = 0.78")
     ax[2].legend(fontsize=8)
-    ax[2].set_title("Fig. chi_4-peak")
+    ax[2].set_title("χ4 peak against ξ for each ε (paper, sec. 3.4)")
     f = A.save(fig, "restitution.png")
     rng = f"φ {common[0]:g}-{common[1]:g}, the densities every ε has" if common else ""
     for eps, fp, fv, pts in pc:

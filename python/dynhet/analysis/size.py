@@ -44,7 +44,7 @@ def leading_protocol(A, phi, ps, lead_by="cr", planned_too=False):
     """The protocol whose runs a density's against-N table takes: the one
     whose studies run phi at the most N (their unfinished sizes counted:
     planned_sizes); among as many, with lead_by "cr" the one with the
-    cage-relative measures (studies/scale.toml: run lengths in units of
+    cage-relative measures (studies/size_cage.toml: run lengths in units of
     tau_alpha^CR), with "n" the one reaching the largest N (D against N:
     studies/d_size.toml to 10^6); then the most runs. Among the protocols
     with points in ps, or (planned_too) with sizes planned at phi at all."""
@@ -345,7 +345,7 @@ def tau_n_results(A):
     multi = points_by_phi_n(A)
     if not multi:
         A.row("τ_α against N (finite size)", "2 (N = 3.6 x 10^5 to 4 x 10^6)", "not studied",
-              "one N per density in this study (add one with --also, e.g. studies/finite_size.toml)", "not run", "", [])
+              "one N per density in this study (add one with --also, e.g. results/size_standard)", "not run", "", [])
         return
     fig, ax = plt.subplots(figsize=(6, 4.5))
     cells, used = [], []

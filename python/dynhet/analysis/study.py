@@ -6,6 +6,7 @@ import tomllib
 import matplotlib.pyplot as plt
 import numpy as np
 
+from ..archive import Archive, ArchiveError
 from ..study.model import RUN_LENGTH_DEFAULTS
 from .config import A_MAIN, EPS_MAIN
 from .runs import read_run
@@ -45,11 +46,46 @@ def study_protocol(sdir):
     return rl["unit"], float(rl["equilibration_tau"]), int(rl["origins"]), float(rl["origin_spacing_tau"])
 
 
+def planned_runs(sdir):
+    """{run name: its axes, state "not archived"} of every run the study file
+    of an archive plans (its study.toml and base_scene.toml)."""
+    from ..study.model import AXES, Study, StudyError
+    try:
+        st = Study(os.path.join(sdir, "study.toml"), os.path.join(sdir, "base_scene.toml"))
+    except StudyError as e:
+        raise SystemExit(f"analyse_study: {sdir}: its study file cannot be read: {e}") from None
+    return {st.run_name(p): dict({a: p[a] for a in AXES}, state="not archived") for p in st.points()}
+
+
+def run_file(sdir, name, m, archive):
+    """The run.h5 of index entry m: a study directory's run, or where its
+    directory no longer holds it, the archive entry its status names; an
+    archive's entry, verified against its hash (a corrupted or changed entry
+    is refused by name)."""
+    if archive is not None:
+        if "file" not in m:  # planned, not archived: no file (the caller counts it unfinished)
+            return os.path.join(sdir, "runs", name + ".h5")
+        try:
+            return archive.path(name, m)
+        except ArchiveError as e:
+            raise SystemExit(f"analyse_study: {e}") from None
+    path = os.path.join(sdir, m["path"], "run.h5")
+    if not os.path.exists(path) and m.get("archived"):
+        try:   # results/<study>/runs/<run>.h5: its archive is two levels up
+            return Archive(os.path.dirname(os.path.dirname(m["archived"]))).path(name)
+        except ArchiveError as e:
+            raise SystemExit(f"analyse_study: {e}") from None
+    return path
+
+
 class Analysis:
-    def __init__(self, d, also=()):
-        """d: the study; also: other study directories whose runs add points
-        (finite size, longer lags) without entering the study's own series."""
+    def __init__(self, d, also=(), out=None):
+        """d: the study (a study directory or a results archive); also: other
+        studies whose runs add points (finite size, longer lags) without
+        entering the study's own series; out: where study.h5, the tables and
+        figures/ go (default d; an archive holds runs only, so give one)."""
         self.dir = os.path.abspath(d)
+        self._out = os.path.abspath(out or d)
         self.points = {}      # the study's own points: (pairs, eps, phi, N) -> Point
         self.extra = {}       # the other studies' points: (study, pairs, eps, phi, N) -> Point
         self.skipped = []
@@ -67,20 +103,30 @@ class Analysis:
         self.promoted = []
         self.fits = {}
         self.rows = []
-        self.figdir = os.path.join(self.dir, "figures")  # made by the first figure saved
+        self.figdir = os.path.join(self.out, "figures")  # made by the first figure saved
+
+    @property
+    def out(self):
+        """Where the analysis writes (the study directory unless told otherwise)."""
+        return getattr(self, "_out", None) or self.dir
 
     def read_study(self, d, primary):
         sdir = os.path.abspath(d)
         idx = os.path.join(sdir, "index.toml")
         if not os.path.exists(idx):
-            raise SystemExit(f"analyse_study: {idx} does not exist: is {d} a study directory (run_study.sh --out)?")
+            raise SystemExit(f"analyse_study: {idx} does not exist: is {d} a study directory (run_study.sh --out) "
+                             "or a results archive (results/<study>)?")
         with open(idx, "rb") as fh:
-            runs = tomllib.load(fh).get("runs", {})
+            index = tomllib.load(fh)
+        runs = index.get("runs", {})
+        archive = Archive(sdir) if "archive" in index else None
+        if archive is not None:  # an archive lists complete runs only: the rest of its study's are unfinished
+            runs = dict(planned_runs(sdir), **runs)
         study = os.path.basename(sdir.rstrip("/"))
         self.protocols = getattr(self, "protocols", {})
         self.protocols[study] = study_protocol(sdir)
         for name, m in sorted(runs.items()):
-            path = os.path.join(sdir, m["path"], "run.h5")
+            path = run_file(sdir, name, m, archive)
             try:
                 key = (m.get("pairs", "neighbours"), float(m["restitution"]), float(m["packing_fraction"]),
                        int(m["n_particles"]))
@@ -119,7 +165,9 @@ class Analysis:
                 pt.study = study
                 pt.runs.append(r)
                 self.cpu[(study,) + key] = self.cpu.get((study,) + key, 0.0) + float(m.get("cpu_s", 0.0))
-        if primary:
+        if primary and archive is not None:
+            self.pilot_cpu += sum(float(s.get("cpu_s", 0.0)) for s in index.get("pilots", {}).values())
+        elif primary:
             for root, _, files in os.walk(os.path.join(sdir, "pilots")):
                 if "status.toml" in files:
                     with open(os.path.join(root, "status.toml"), "rb") as fh:
@@ -222,7 +270,7 @@ class Analysis:
                 ax.text(0.5, 0.5, "no data in this study", ha="center", transform=ax.transAxes)
         fig.savefig(path, dpi=110, bbox_inches="tight")
         plt.close(fig)
-        return os.path.relpath(path, self.dir)
+        return os.path.relpath(path, self.out)
 
     def row(self, item, section, paper, ours, verdict, figure, pts, note=""):
         mixed = self.sizes_note(item, pts)

@@ -35,7 +35,7 @@ def d_results(A):
     ax.set_xlabel("τ_α")
     ax.set_ylabel("D")
     ax.legend(fontsize=8)
-    ax.set_title("Fig. D-vs-tau (D: long-time MSD/4t, msd node)")
+    ax.set_title("D against τ_α (paper, sec. 3.2; D: long-time MSD/4t)")
     f = A.save(fig, "D_tau_alpha.png")
     sub_i = [p for p in pts if PHI_INTERMEDIATE[0] <= p.phi <= PHI_INTERMEDIATE[1]]
     sub_h = [p for p in pts if PHI_HIGH[0] <= p.phi <= PHI_HIGH[1]]
@@ -64,7 +64,7 @@ def pdx_results(A):
     ax.set_xlabel("Δx (small particles)")
     ax.set_ylabel("P(Δx, τ_α)")
     ax.legend(fontsize=8)
-    ax.set_title("Fig. tails(a): P(Δx) at τ_α")
+    ax.set_title("P(Δx) at τ_α (paper, sec. 3.2)")
     f = A.save(fig, "pdx.png")
     A.row("P(Δx) at τ_α for three densities: exponential tails", "3.2, fig. tails(a)", "figure only",
           ", ".join(f"φ = {p.phi:g}" for p in used), "figure", f, used)

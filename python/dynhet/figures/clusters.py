@@ -10,7 +10,7 @@ the same panels, open squares and dashed lines.
 import math
 import sys
 
-from .common import legend_below, save, tidy_log
+from .common import pm, legend_below, save, tidy_log
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -41,7 +41,7 @@ def plot_rg(ax, g):
         ok = np.isfinite(n) & np.isfinite(rg)
         d_f, d_f_err = float(g[f"{kind}_d_f"]), float(g[f"{kind}_d_f_err"])
         ax.errorbar(n[ok], rg[ok], yerr=np.nan_to_num(err[ok]), fmt="o", ms=3, capsize=2, color=colour,
-                    label=f"{kind}: d_f = {d_f:.3g} ± {d_f_err:.2g}")
+                    label=f"{kind}: d_f = {pm(d_f, d_f_err)}")
         if math.isfinite(d_f) and ok.sum() >= 2:
             c = np.mean(np.log(rg[ok]) - np.log(n[ok]) / d_f)  # the line through the bin means
             nn = np.geomspace(n[ok].min(), n[ok].max(), 20)
@@ -77,7 +77,7 @@ def plot_p(ax, g, cr=None):
     if math.isfinite(kappa) and sel.any():
         c = np.mean(np.log(p[sel]) + kappa * np.log(centre[sel]))  # amplitude for the picture
         nn = np.geomspace(centre[sel].min(), centre[sel].max(), 20)
-        ax.plot(nn, np.exp(c) * nn ** -kappa, "C3-", lw=1, label=f"kappa = {kappa:.3g} ± {kappa_err:.2g}")
+        ax.plot(nn, np.exp(c) * nn ** -kappa, "C3-", lw=1, label=f"kappa = {pm(kappa, kappa_err)}")
     p0, n_sigma, sigma = (float(g[k]) for k in ("fast_p0", "fast_n_sigma", "fast_sigma"))
     if all(map(math.isfinite, (p0, n_sigma, sigma))):
         ok = g["count_fast"] > 0

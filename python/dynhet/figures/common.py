@@ -36,6 +36,23 @@ def tidy_log(ax):
             axis.set_major_formatter(plain)
 
 
+def pm(v, err, digits=3):
+    """A fitted number with its error: "1.23 ± 0.04", or the number and
+    "(no error)" where the run quotes none."""
+    v, err = float(v), float(err)
+    if not np.isfinite(v):
+        return "—"
+    return f"{v:.{digits}g} ± {err:.2g}" if np.isfinite(err) else f"{v:.{digits}g} (no error)"
+
+
+def system_title(run):
+    """ (N = 4096, φ = 0.76, ε = 0.9): the run's system in words, for a title."""
+    p = run.parameters.get("system", {})
+    names = (("n_particles", "N = {}"), ("packing_fraction", "φ = {}"), ("restitution", "ε = {}"))
+    bits = [fmt.format(p[k]) for k, fmt in names if k in p]
+    return " (" + ", ".join(bits) + ")" if bits else ""
+
+
 def legend_below(ax, ncol=1, **kw):
     """The panel's legend under its x label, outside the data."""
     return ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), ncol=ncol, frameon=False, **kw)

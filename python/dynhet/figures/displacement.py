@@ -8,7 +8,7 @@ with the Gaussian fit (dash-dotted, D free) and the exponential-tail fit
 import math
 import sys
 
-from .common import save
+from .common import pm, save
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -36,7 +36,8 @@ def main(path, png):
                 if not math.isfinite(lag[l_]):
                     continue
                 ok = p[i] > 0
-                what = f"{mult[l_]:g} $\\tau_\\alpha$" if math.isfinite(mult[l_]) else "fixed"
+                what = (f"{lag[l_] / tau:.3g} $\\tau_\\alpha$, the lag nearest {mult[l_]:g} $\\tau_\\alpha$"
+                        if math.isfinite(mult[l_]) and math.isfinite(tau) and tau > 0 else "fixed")
                 err = np.nan_to_num(p_err[i][ok])
                 line = ax.errorbar(x[ok], p[i][ok], yerr=[np.minimum(err, 0.9 * p[i][ok]), err], fmt="o", ms=2.5,
                                    capsize=1.5, lw=0.8)
@@ -48,13 +49,13 @@ def main(path, png):
                 if math.isfinite(d):
                     h, = ax.plot(xx, np.exp(-xx ** 2 / (4 * d * t)) / np.sqrt(4 * math.pi * d * t), "-.",
                                  color=colour, lw=1)
-                    group.append((h, f"Gaussian: D = {d:.3g} ± {float(g['gauss_d_err'][i]):.2g}"))
+                    group.append((h, f"Gaussian: D = {pm(d, g['gauss_d_err'][i])}"))
                 if math.isfinite(x0):
                     lo, hi = float(g["tail_x_min"][i]), float(g["tail_x_max"][i])
                     for sign in (-1, 1):
                         xt = sign * np.linspace(lo, hi, 50)
                         h, = ax.plot(xt, amp * np.exp(-np.abs(xt) / x0), "-", color=colour, lw=1.6)
-                    group.append((h, f"exp. tail: $x_0$ = {x0:.3g} ± {float(g['tail_x0_err'][i]):.2g}\n"
+                    group.append((h, f"exp. tail: $x_0$ = {pm(x0, g['tail_x0_err'][i])}\n"
                                      f"    over |$\\Delta x$| in [{lo:.2g}, {hi:.2g}]"))
                 groups.append(group)
             ax.set_yscale("log")

@@ -9,7 +9,7 @@ and cage-relative, where the run has them.
 import math
 import sys
 
-from .common import legend_right, save, tidy_log
+from .common import pm, legend_right, save, tidy_log
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -81,7 +81,7 @@ def main(path, png):
         t0, t1 = float(g["fit_t_min"]), float(g["fit_t_max"])
         if math.isfinite(D):
             tt = np.geomspace(t0, t1, 50)
-            ax.plot(tt, 4 * D * tt, "k--", lw=1, label=f"4Dt, D = {D:.4g} (fit {t0:.3g}..{t1:.3g})")
+            ax.plot(tt, 4 * D * tt, "k--", lw=1, label=f"4Dt, D = {pm(D, g['diffusion_err'], 4)} (fit {t0:.3g}..{t1:.3g})")
         ax.set_xscale("log")
         ax.set_yscale("log")
         ax.set_xlabel("t")

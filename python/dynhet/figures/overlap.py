@@ -8,7 +8,7 @@ tau_alpha against the waiting time t0 (aging check).
 import math
 import sys
 
-from .common import legend_below, save, tidy_log
+from .common import pm, system_title, legend_below, save, tidy_log
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -29,7 +29,7 @@ def main(path, png):
             a = g.attrs.get("cutoff_a", name)
             label = f"a = {a}"
             if math.isfinite(tau):
-                label += rf", $\tau_\alpha$ = {tau:.4g}" + (f" ± {tau_err:.2g}" if math.isfinite(tau_err) else "")
+                label += rf", $\tau_\alpha$ = {pm(tau, tau_err, 4)}"
             line = ax.errorbar(t, q, yerr=np.nan_to_num(err), marker="o", ms=3, capsize=2, label=label)
             color = line[0].get_color()
             if math.isfinite(tau):
@@ -38,19 +38,21 @@ def main(path, png):
                 beta, tau0 = float(g["beta"]), float(g["tau0"])
                 tt = np.geomspace(t[0], t[-1], 200)
                 ax.plot(tt, 1 / ((tt / tau0) ** beta + 1), "--", color=color, lw=1,
-                        label=rf"fit $\beta$ = {beta:.3g}, $\tau_0$ = {tau0:.3g}")
+                        label=rf"fit $\beta$ = {pm(beta, g['beta_err'])}, $\tau_0$ = {pm(tau0, g['tau0_err'])}")
             if "overlap_cr" in run.observables() and name in run.cutoffs("overlap_cr"):
                 # The same of the cage-relative displacements (observables.cage_relative).
                 c = run.observable("overlap_cr", name)
-                tau_cr = float(c["tau_alpha"])
+                tau_cr, tau_cr_err = float(c["tau_alpha"]), float(c["tau_alpha_err"])
                 ax.errorbar(c["lag_time"][()], c["q"], yerr=np.nan_to_num(c["q_err"]), marker="o", ms=3, mfc="none",
                             capsize=2, color=color, ls="-.", lw=1,
                             label=f"a = {a}, cage-relative" +
-                            (rf", $\tau_\alpha$ = {tau_cr:.4g}" if math.isfinite(tau_cr) else ""))
+                            (rf", $\tau_\alpha$ = {pm(tau_cr, tau_cr_err)}" if math.isfinite(tau_cr) else ""))
             if "tau_alpha_t0" in g:
                 ax2.plot(g["t0"], g["tau_alpha_t0"], "o-", ms=3, color=color, label=label.split(",")[0])
-                if math.isfinite(tau):
+                if math.isfinite(tau):  # the run's tau_alpha with its error: where each origin's should lie
                     ax2.axhline(tau, color=color, ls=":", lw=1)
+                    if math.isfinite(tau_err):
+                        ax2.axhspan(tau - tau_err, tau + tau_err, color=color, alpha=0.12, lw=0)
         if "bond_breaking" in run.observables():  # C_B(t), the other correlator from 1 to 0
             b = run.observable("bond_breaking")
             tau_b = float(b["tau_b"])
@@ -63,17 +65,13 @@ def main(path, png):
         ax.set_xlabel("t")
         ax.set_ylabel("Q(t), $C_B(t)$" if "bond_breaking" in run.observables() else "Q(t)")
         ax.set_ylim(0, 1.05)
-        title = "overlap"
-        if "system" in run.parameters:
-            p = run.parameters["system"]
-            bits = [f"{k}={p[k]}" for k in ("n_particles", "packing_fraction", "restitution") if k in p]
-            title += " (" + ", ".join(bits) + ")"
-        ax.set_title(title)
+        ax.set_title("overlap" + system_title(run))
         tidy_log(ax)
         legend_below(ax, ncol=2)
         ax2.set_xlabel("waiting time $t_0$")
         ax2.set_ylabel(r"$\tau_\alpha(t_0)$")
-        ax2.set_title("aging check: flat if stationary")
+        ax2.set_title("aging check: flat if stationary\n(one origin each, no error of its own; band: "
+                      r"$\tau_\alpha$ ± its error)")
         ax2.legend()
         save(fig, run, png, 110)
     print(f"plot_overlap: wrote {png}", file=sys.stderr)

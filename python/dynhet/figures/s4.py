@@ -11,8 +11,9 @@ markers, with its OZ fit (dash-dot) and chi4 (open square); its xi(t) dashed.
 """
 import math
 import sys
+import textwrap
 
-from .common import legend_below, save, tidy_log
+from .common import pm, legend_below, save, tidy_log
 import matplotlib.pyplot as plt
 import numpy as np
 
@@ -36,7 +37,27 @@ def plot_cage_relative(ax, c, gi, qmin):
     if math.isfinite(xi) and math.isfinite(chi0):
         qq = np.geomspace(qmin / 2, q.max() if len(q) else 1.0, 100)
         ax.plot(qq, chi0 / (1 + (qq * xi) ** 2), "-.", color="C4",
-                label=rf"cage-relative OZ: $\xi$ = {xi:.3g} ± {xi_err:.2g}, $\chi_0$ = {chi0:.3g}")
+                label=rf"cage-relative OZ: $\xi$ = {pm(xi, xi_err)}, $\chi_0$ = {pm(chi0, c['oz_chi0_err'][gi])}")
+
+
+# What the s4 node's xi_lag_rule codes say (run.h5's xi_lag_rule attribute).
+RULES = {1: "fewer than 3 q shells with q ξ ≤ 1", 2: "ξ below the q range (q ξ < 0.5 at the largest q fitted)",
+         3: "the fit did not converge"}
+
+
+def no_fit_reason(g, gi):
+    """Why grid gi has no fit at t_s4, from what the run recorded: too few q
+    shells in a sub-box that small, the node's rule at the lags around t_s4,
+    or a jackknife error of ξ not below ξ (the rule the node applies at t_s4)."""
+    n = int(g["n_shells"][gi])
+    q_max = float(g.attrs.get("q_max", 1.0))
+    if n < 3:
+        return f"{n} q shell{'s' if n != 1 else ''} below q = {q_max:g} in a sub-box this small (3 needed)"
+    rules = g["xi_lag_rule"]
+    at = {int(rules[int(g[k]), gi]) for k in ("lag_lo", "lag_hi") if 0 <= int(g[k]) < len(rules)} - {0}
+    if at:
+        return "; ".join(RULES.get(r, f"rule {r}") for r in sorted(at)) + " (at the lags around $t_{s4}$)"
+    return r"the jackknife error of $\xi$ at $t_{s4}$ is not below $\xi$"
 
 
 def plot_grid(ax, g, gi, start, cr=None):
@@ -67,7 +88,7 @@ def plot_grid(ax, g, gi, start, cr=None):
         x2 = (qq * xi) ** 2
         extra = f", A = {a:.2g}" if form == "a2" else ""
         ax.plot(qq, chi0 / (1 + x2 + a * a * x2 * x2), "-" if form == "oz" else "--", color=color,
-                label=rf"{name}: $\xi$ = {xi:.3g} ± {xi_err:.2g}, $\chi_0$ = {chi0:.3g} ± {chi0_err:.2g}{extra}")
+                label=rf"{name}: $\xi$ = {pm(xi, xi_err)}, $\chi_0$ = {pm(chi0, chi0_err)}{extra}")
         ax.axvline(qf, color=color, lw=0.8, ls=":")
     if cr is not None and gi < len(cr["subbox_per_side"]):
         plot_cage_relative(ax, cr, gi, qmin)
@@ -77,7 +98,7 @@ def plot_grid(ax, g, gi, start, cr=None):
     ax.set_ylabel(r"$S_4(q, t_{s4})$")
     title = f"a = {g.attrs['cutoff_a']:g}: sub-boxes of N = {sizes[gi]:.0f} (m = {sides[gi]})"
     if missing:
-        title += "\nno fit: " + ", ".join(missing)
+        title += "\n" + textwrap.fill("no " + " or ".join(missing) + " fit: " + no_fit_reason(g, gi), 62)
     ax.set_title(title)
     tidy_log(ax)
     legend_below(ax)

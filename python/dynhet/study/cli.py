@@ -8,6 +8,10 @@ runs, reads their files and keeps their status on disk.
                           [--partition P] [--time T] [--mem M] [--sbatch ARG]...
   study.py task DIR NAME      one run of a study directory (what a Slurm task runs)
   study.py index DIR          write DIR/index.toml from the runs' status files
+  study.py results [DIR]      write DIR/README.md (default results/): a line per archived study
+  study.py archive DIR [--to ARCHIVE]
+                              reduce every complete run of study directory DIR into its results
+                              archive (the study's [study] archive, or ARCHIVE): dynhet.archive
 
 The study file format is in studies/README.md."""
 import argparse
@@ -43,6 +47,9 @@ def main():
     r.add_argument("--fresh", action="store_true",
                    help="the --out directory holds another study (or anything but a study): move it into "
                         "DIR/old-<time>/ and start this one (nothing is deleted)")
+    r.add_argument("--archive", metavar="DIR",
+                   help="the results archive each complete run is reduced into (default: the study file's "
+                        "[study] archive, relative to the repository; none if it names none)")
     r.add_argument("--partition")
     r.add_argument("--time")
     r.add_argument("--mem")
@@ -59,20 +66,33 @@ def main():
     i = sub.add_parser("index")
     i.add_argument("dir")
     i.add_argument("--analyse", action="store_true", help="then, if every run is complete, the study analysis")
+    ar = sub.add_parser("archive")
+    ar.add_argument("dir")
+    ar.add_argument("--to", metavar="ARCHIVE", help="the archive directory (default: the study's own)")
+    rs = sub.add_parser("results")
+    rs.add_argument("dir", nargs="?", default=os.path.join(ROOT, "results"))
     a = ap.parse_args()
+    if a.cmd == "results":
+        from ..archive import results_readme
+        write_atomic(os.path.join(a.dir, "README.md"), results_readme(a.dir))
+        print(f"wrote {os.path.join(a.dir, 'README.md')}")
+        return 0
     # A StudyError before anything runs (the study file, the directory, the
     # scenes) is a bad argument, exit 2; once runs start, a run-time failure, 1.
     running = False
     try:
         if a.cmd == "run":
             study = Study(a.study)
-            sd = StudyDir(study, a.out or os.path.join(ROOT, "runs", f"study-{study.name}"))
+            sd = StudyDir(study, a.out or os.path.join(ROOT, "runs", f"study-{study.name}"),
+                          os.path.abspath(a.archive) if a.archive else None)
             why = sd.refusal()
             if why and not a.fresh:
                 raise StudyError(why)
             if a.dry_run:
                 if why:
                     print(f"# --fresh: what {sd.dir} holds would move into {sd.dir}/old-<time>/")
+                elif os.path.exists(os.path.join(sd.dir, "study.toml")):
+                    sd.claim()  # (its own study: the archive it names is checked too)
                 check_scenes(sd)
                 dry_run(sd)
                 return 0
@@ -84,8 +104,11 @@ def main():
             if a.executor == "local":
                 return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2))
             return run_slurm(sd, a)
-        sd = StudyDir(Study(os.path.join(a.dir, "study.toml"), os.path.join(a.dir, "base_scene.toml")), a.dir)
+        sd = StudyDir(Study(os.path.join(a.dir, "study.toml"), os.path.join(a.dir, "base_scene.toml")), a.dir,
+                      os.path.abspath(a.to) if getattr(a, "to", None) else None)
         running = True
+        if a.cmd == "archive":
+            return archive_dir(sd)
         if a.cmd == "task":
             return task(sd, a.name)
         rows = write_index(sd)
@@ -99,6 +122,23 @@ def main():
     except StudyError as e:
         print(f"run_study: {e}", file=sys.stderr)
         return 1 if running else 2
+
+
+def archive_dir(sd):
+    """study.py archive: every complete run of a study directory into its archive."""
+    from ..archive import ArchiveError
+    from .archiving import archive_existing
+    if sd.archive is None:
+        raise StudyError(f"{sd.dir}: the study names no archive ([study] archive): give --to DIR")
+    try:
+        sd.archive.claim(sd.study)
+    except ArchiveError as e:
+        raise StudyError(str(e)) from None
+    added, kept, left = archive_existing(sd)
+    n = len(sd.archive.runs())
+    print(f"study {sd.study.name}: {added} runs archived now, {kept} already, {left} not complete; "
+          f"{n} runs in {sd.archive.dir}", flush=True)
+    return 0
 
 
 def check_scenes(sd):

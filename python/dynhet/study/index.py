@@ -16,7 +16,7 @@ def write_index(sd):
         row["path"] = os.path.relpath(sd.run_dir(p), sd.dir)
         row["state"] = st.get("state", "pending")
         for k in ("tau_estimate", "tau_source", "tau_alpha", "wall_s", "cpu_s", "cpu_unrecorded", "attempts", "requeues",
-                  "message"):
+                  "message", "archived"):
             if k in st:
                 row[k] = st[k]
         rows[sd.study.run_name(p)] = row
@@ -45,8 +45,21 @@ def plan(sd):
                 m = sd.study.run_length["pilot_margin"]
                 tau *= m
                 src += f" x {m:g}; a pilot will measure it" if m != 1.0 else "; a pilot will measure it"
-        out.append((p, sd.study.scene(p, tau), tau, src, st.get("state", "pending")))
+        out.append((p, sd.study.scene(p, tau, tau_eq=planned_tau_eq(sd, p, st, tau)), tau, src, st.get("state", "pending")))
     return out
+
+
+def planned_tau_eq(sd, p, st, tau):
+    """The tau the equilibration counts in, as known now (with
+    run_length.equilibration_unit other than unit): the run's own estimate,
+    its pilot's, or the study's tau_guess_cr times the margin."""
+    study = sd.study
+    if tau is None or not study.split_units():
+        return None
+    if st.get("tau_eq_estimate") and st.get("state") != "too_short":
+        return st["tau_eq_estimate"]
+    g, _ = sd.guess(p, finished=False, table="tau_guess_cr")
+    return study.run_length["pilot_margin"] * g
 
 
 def run_estimates(sd):

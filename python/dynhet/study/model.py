@@ -34,10 +34,16 @@ RUN_LENGTH_KEYS = {
     "pilot_margin": float,
     "max_attempts": int,
     "tau_guess": list,
+    # The equilibration's own unit ("" = unit): long enough for the structure
+    # (tau_alpha^CR) while production and lags count the standard tau_alpha,
+    # which falls with N. A second pilot measures it, at pilot_particles_cr.
+    "equilibration_unit": str,
+    "pilot_particles_cr": int,
+    "tau_guess_cr": list,
 }
 RUN_LENGTH_DEFAULTS = dict(tau_alpha="scene", unit="tau_alpha", equilibration_tau=10.0, lag_max_tau=4.0, lag_min_tau=0.02,
                            origin_spacing_tau=1.0, origins=8, pilot_particles=2048, pilot_margin=1.2, max_attempts=3,
-                           tau_guess=[])
+                           tau_guess=[], equilibration_unit="", pilot_particles_cr=4096, tau_guess_cr=[])
 
 
 def check_type(where, v, typ):
@@ -69,15 +75,23 @@ class Study:
                 self.errors.append(f"{k}: unknown key or table; known: {', '.join(sorted(known))}")
         st = data.get("study", {})
         for k in st:
-            if k not in ("name", "description", "scene", "prepared_states", "run_plots"):
+            if k not in ("name", "description", "scene", "prepared_states", "run_plots", "archive"):
                 self.errors.append(f"study.{k}: unknown key; known keys in [study]: name, description, scene, "
-                                   "prepared_states, run_plots")
+                                   "prepared_states, run_plots, archive")
         # Each run's own figures (run_scene.sh's PNGs); the study's analysis
         # draws its figures either way.
         self.run_plots = st.get("run_plots", True)
         if not isinstance(self.run_plots, bool):
             self.errors.append(f"study.run_plots: value {self.run_plots!r} must be true or false")
             self.run_plots = True
+        # The results archive each complete run is reduced into (dynhet.archive),
+        # relative to the repository: "results/<name>"; none if not given.
+        self.archive = st.get("archive")
+        if self.archive is not None and (not isinstance(self.archive, str) or not self.archive):
+            self.errors.append(f"study.archive: value {self.archive!r} must be a directory (a non-empty string, "
+                               "e.g. \"results/<name>\")")
+            self.archive = None
+        self.description = st.get("description", "")
         # true or "compressed": compression once per (N, phi, ratio, seed);
         # "equilibrated": also the equilibration, once per run dynamics
         # (extended, never repeated, when a run needs more); false: neither.
@@ -147,6 +161,10 @@ class Study:
         if rl["unit"] not in ("tau_alpha", "tau_alpha_cr"):
             self.errors.append(f"run_length.unit: value {rl['unit']!r} is not allowed; allowed: \"tau_alpha\", "
                                '"tau_alpha_cr" (the cage-relative tau_alpha, which does not fall with N)')
+        if rl["equilibration_unit"] not in ("", "tau_alpha", "tau_alpha_cr"):
+            self.errors.append(f"run_length.equilibration_unit: value {rl['equilibration_unit']!r} is not allowed; "
+                               'allowed: "tau_alpha", "tau_alpha_cr" (default: run_length.unit)')
+        rl["equilibration_unit"] = rl["equilibration_unit"] or rl["unit"]
         if not (1.0 <= rl["pilot_margin"] <= 10.0):
             self.errors.append(f"run_length.pilot_margin: value {rl['pilot_margin']} is not allowed; allowed: 1 to 10")
         for k in ("equilibration_tau", "lag_max_tau", "lag_min_tau", "origin_spacing_tau"):
@@ -157,14 +175,15 @@ class Study:
         for k, lo in (("origins", 1), ("pilot_particles", 100), ("max_attempts", 1)):
             if rl[k] < lo:
                 self.errors.append(f"run_length.{k}: value {rl[k]} must be >= {lo}")
-        guesses = []
-        for g in rl["tau_guess"]:
-            if (not isinstance(g, list) or len(g) != 2 or not all(isinstance(x, (int, float)) for x in g)
-                    or not g[1] > 0):
-                self.errors.append(f"run_length.tau_guess: entry {g!r} must be [phi, tau_alpha > 0]")
-                continue
-            guesses.append((float(g[0]), float(g[1])))
-        rl["tau_guess"] = sorted(guesses)
+        for table in ("tau_guess", "tau_guess_cr"):
+            guesses = []
+            for g in rl[table]:
+                if (not isinstance(g, list) or len(g) != 2 or not all(isinstance(x, (int, float)) for x in g)
+                        or not g[1] > 0):
+                    self.errors.append(f"run_length.{table}: entry {g!r} must be [phi, tau_alpha > 0]")
+                    continue
+                guesses.append((float(g[0]), float(g[1])))
+            rl[table] = sorted(guesses)
         self.run_length = rl
         self.overrides = []
         for i, o in enumerate(data.get("override", [])):
@@ -247,8 +266,15 @@ class Study:
     def series_key(self, p):  # points whose tau_alpha may be interpolated in phi
         return (p["restitution"], p["pairs"], p["n_particles"])
 
-    def scene(self, p, tau=None, pilot=False):
-        """The scene of run p as tables; with tau, run lengths in units of it."""
+    def split_units(self):
+        """Whether the equilibration counts another tau_alpha than production."""
+        return self.run_length["equilibration_unit"] != self.run_length["unit"]
+
+    def scene(self, p, tau=None, pilot=False, tau_eq=None, unit=None):
+        """The scene of run p as tables; with tau, run lengths in units of it,
+        the equilibration in units of tau_eq where given (the equilibration's
+        own unit); unit: the pilot's (default run_length.unit)."""
+        unit = unit or self.run_length["unit"]
         sc = copy.deepcopy(self.base)
         for a, (table, key, _) in AXES.items():
             sc.setdefault(table, {})[key] = p[a]
@@ -261,24 +287,26 @@ class Study:
             eq, origins, lag_max = rl["equilibration_tau"], rl["origins"], rl["lag_max_tau"]
             if pilot:  # short and small: only tau_alpha (or tau_alpha^CR) is wanted
                 eq, origins = min(eq, 5.0), min(origins, 4)
-                sc["system"]["n_particles"] = min(int(sc["system"]["n_particles"]), rl["pilot_particles"])
+                cap = rl["pilot_particles_cr"] if unit != rl["unit"] else rl["pilot_particles"]
+                sc["system"]["n_particles"] = min(int(sc["system"]["n_particles"]), cap)
                 sc["observables"] = {"compute": ["overlap"], "cutoff_a": sc.get("observables", {}).get("cutoff_a", [0.6])}
                 for t in ("chi4", "s4", "clusters", "msd", "displacement"):
                     sc.pop(t, None)
-            sc.setdefault("run", {})["equilibration_time"] = round(eq * tau, 6)
+            sc.setdefault("run", {})["equilibration_time"] = round(eq * (tau_eq if tau_eq and not pilot else tau), 6)
             sc["run"].pop("production_time", None)
             sched = sc.setdefault("schedule", {})
             sched["origins"] = origins
             sched["origin_spacing"] = round(rl["origin_spacing_tau"] * tau, 6)
             sched["lag_min"] = round(rl["lag_min_tau"] * tau, 6)
             sched["lag_max"] = round(lag_max * tau, 6)
-        if self.run_length["unit"] == "tau_alpha_cr":  # lengths in tau_alpha^CR: every run (and pilot) measures it
+        if unit == "tau_alpha_cr" and (pilot or not self.split_units()):
+            # lengths in tau_alpha^CR: every run (and pilot) of it measures it
             sc.setdefault("observables", {})["cage_relative"] = True
         return sc
 
-    def tau_group(self):
-        """The run.h5 group whose tau_alpha the run lengths are counted in."""
-        return "overlap_cr" if self.run_length["unit"] == "tau_alpha_cr" else "overlap"
+    def tau_group(self, unit=None):
+        """The run.h5 group whose tau_alpha the run lengths (or unit's) are counted in."""
+        return "overlap_cr" if (unit or self.run_length["unit"]) == "tau_alpha_cr" else "overlap"
 
     def first_cutoff(self, sc):
         return sc.get("observables", {}).get("cutoff_a", [0.6])[0]

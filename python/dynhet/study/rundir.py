@@ -42,22 +42,38 @@ def run_h5_result(path, cutoff, group="overlap"):
 
 
 def same_toml(a, b):
-    """Whether two TOML texts (bytes) say the same: equal, or equal once
-    parsed (comments, spacing and order of keys are not the study)."""
+    """Whether two study files (bytes) say the same study: equal, or equal once
+    parsed (comments, spacing and order of keys are not the study, nor is
+    where its results are archived, [study] archive)."""
     if a == b:
         return True
     try:
-        return tomllib.loads(a.decode()) == tomllib.loads(b.decode())
+        ta, tb = tomllib.loads(a.decode()), tomllib.loads(b.decode())
     except (UnicodeDecodeError, tomllib.TOMLDecodeError):
         return False
+    for t in (ta, tb):
+        if isinstance(t.get("study"), dict):
+            t["study"].pop("archive", None)
+    return ta == tb
 
 
 class StudyDir:
-    def __init__(self, study, out):
+    def __init__(self, study, out, archive=None):
+        """archive: the results archive's directory (a --archive flag), else
+        the study file's [study] archive, else the one a study directory
+        recorded when it started (archive.txt: a Slurm task's), else none."""
+        from ..archive import Archive
+        from .archiving import resolve
         self.study = study
         self.dir = os.path.abspath(out)
         self.runs_dir = os.path.join(self.dir, "runs")
         self.lock = threading.Lock()
+        recorded = os.path.join(self.dir, "archive.txt")
+        if archive is None and study.archive:
+            archive = resolve(study.archive)
+        if archive is None and os.path.exists(recorded):
+            archive = open(recorded).read().strip() or None
+        self.archive = Archive(archive) if archive else None
 
     def refusal(self):
         """Why the directory cannot take this study (None if it can): it holds
@@ -121,6 +137,13 @@ class StudyDir:
                 f.write(self.study.text)
         if not os.path.exists(base_path):
             write_atomic(base_path, base_text)
+        if self.archive is not None:
+            from ..archive import ArchiveError
+            try:
+                self.archive.claim(self.study)
+            except ArchiveError as e:
+                raise StudyError(str(e)) from None
+            write_atomic(os.path.join(self.dir, "archive.txt"), self.archive.dir + "\n")
         return moved
 
     def run_dir(self, p):
@@ -148,6 +171,8 @@ class StudyDir:
         if os.path.isdir(pdir):
             for name in os.listdir(pdir):
                 st = read_status(os.path.join(pdir, name))
+                if st.get("unit", self.study.run_length["unit"]) != self.study.run_length["unit"]:
+                    continue  # the equilibration's pilot, of the other tau_alpha
                 ser = tuple(st.get("series", []))
                 if st.get("state") == "complete" and len(ser) == 3 and ser[:2] == (key[0], key[1]) and (
                         ser[2] == key[2] or (pp and min(ser[2], pp) == pilot_n)):
@@ -178,18 +203,18 @@ class StudyDir:
         s = (math.log(b[1]) - math.log(a[1])) / (b[0] - a[0])
         return math.exp(math.log(a[1]) + s * (phi - a[0]))
 
-    def guess(self, p, finished=True):
+    def guess(self, p, finished=True, table="tau_guess"):
         """A prior guess of tau_alpha: finished points (between them ln tau
         linear in phi), then the study's tau_guess table, then 1. Beyond the
         finished points' range the table's shape, scaled to the nearest
         finished point: ln tau is far from linear in phi near the transition,
         and a line through two high densities extrapolated down undershoots
-        (scale.toml: 0.78 and 0.80 put 0.76 at 3.6, where the table has a
+        (a finite-size study: 0.78 and 0.80 put 0.76 at 3.6, where the table has a
         third of 0.78's). Estimates only (the dry run, the ETA, the order of
         the runs) unless the study's run lengths interpolate."""
         phi = p["packing_fraction"]
-        g = self.study.run_length["tau_guess"]
-        pts = self.finished_taus(p) if finished else []
+        g = self.study.run_length[table]
+        pts = self.finished_taus(p) if finished and table == "tau_guess" else []
         exact = [t for ph, t in pts if abs(ph - phi) < 1e-12]
         if exact:
             return exact[0], "interpolated from finished points"

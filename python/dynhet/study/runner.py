@@ -10,6 +10,7 @@ from .rundir import read_status, run_h5_result, write_status
 from .children import RESUMABLE, STOPPING, newest_whole_cut, run_scene
 from .progress import sim_progress
 from .states import equilibrated_state, pid_alive, pilot, prepared_state
+from .archiving import archive_run, restored_run
 
 
 def effective_state(old):
@@ -43,6 +44,33 @@ def running_status(old, resume, source):
     return status
 
 
+def equilibration_tau(sd, p, tau_est, source):
+    """(tau, its source) the equilibration counts in: None (tau_est's own
+    unit) unless run_length.equilibration_unit differs from the unit, then
+    its own pilot's, times the margin."""
+    st = sd.study
+    if tau_est is None or not st.split_units():
+        return None, None
+    unit = st.run_length["equilibration_unit"]
+    m = st.run_length["pilot_margin"]
+    return m * pilot(sd, p, unit), f"{unit} pilot x {m:g}"
+
+
+def equilibrated(sd, sc, d, tau):
+    """Whether the run's equilibration reached 0.9 x equilibration_tau of the
+    tau_alpha it counts in, as the run itself measured it (tau: the run's
+    tau_alpha of run_length.unit). With the equilibration in the other unit,
+    the run's own measure of that where the run has it (cage_relative on and
+    lags long enough); else its pilot's estimate stands."""
+    st = sd.study
+    rl = st.run_length
+    if st.split_units():
+        _, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc), st.tau_group(rl["equilibration_unit"]))
+        if not math.isfinite(tau):
+            return True
+    return sc["run"]["equilibration_time"] >= 0.9 * rl["equilibration_tau"] * tau
+
+
 def do_run(sd, p, log=print):
     """Runs (or resumes) one run to the end; returns its final status."""
     st = sd.study
@@ -51,8 +79,13 @@ def do_run(sd, p, log=print):
     old = read_status(d)
     if old.get("state") == "complete":
         return old
+    restored = restored_run(sd, p)  # a run the archive holds is complete, its directory gone or not
+    if restored is not None:
+        log(f"{st.run_name(p)}: complete in the archive {sd.archive.dir}; not run again")
+        return restored
     rl = st.run_length
     resume = None
+    tau_eq = None
     tau_est, source = old.get("tau_estimate"), old.get("tau_source")
     if old.get("state") == "running" and old.get("host") == socket.gethostname() and pid_alive(old.get("pid")):
         return dict(old, state="running", message=f"still running in process {old.get('pid')}")
@@ -85,7 +118,8 @@ def do_run(sd, p, log=print):
             # studies/quick.toml): a margin spares most runs a second attempt.
             tau_est = rl["pilot_margin"] * pilot(sd, p)
             source = "pilot" if rl["pilot_margin"] == 1.0 else f"pilot x {rl['pilot_margin']:g}"
-        sc = st.scene(p, tau_est)
+        tau_eq, eq_source = equilibration_tau(sd, p, tau_est, source)
+        sc = st.scene(p, tau_est, tau_eq=tau_eq)
         # A lag at the best tau_alpha estimate (the pilot's, or the previous
         # attempt's, without the margin), for what the paper takes at
         # tau_alpha (clusters, S4). Measured in studies/seeds.toml it does not
@@ -113,6 +147,10 @@ def do_run(sd, p, log=print):
     carried = status["cpu_s"]
     if tau_est is not None:
         status["tau_estimate"] = tau_est
+    if resume is None and tau_eq is not None:
+        status.update(tau_eq_estimate=tau_eq, tau_eq_source=eq_source)
+    elif old.get("tau_eq_estimate"):
+        status.update(tau_eq_estimate=old["tau_eq_estimate"], tau_eq_source=old.get("tau_eq_source", "?"))
     for a in AXES:
         status[a] = p[a]
     write_status(d, status)
@@ -160,14 +198,15 @@ def do_run(sd, p, log=print):
     if rc != 0 or not complete:
         status["state"] = "failed"
         status["message"] = f"run_scene exit {rc}, complete {complete}; log {d}/run_scene.log"
-    elif tau_est is not None and not (math.isfinite(tau) and
-                                      sc["run"]["equilibration_time"] >= 0.9 * rl["equilibration_tau"] * tau):
+    elif tau_est is not None and not (math.isfinite(tau) and equilibrated(sd, sc, d, tau)):
         status["state"] = "too_short"
         status["message"] = (f"tau_alpha {tau:.4g} against the estimate {tau_est:.4g}: the equilibration was "
-                             f"under {0.9 * rl['equilibration_tau']:g} tau_alpha")
+                             f"under {0.9 * rl['equilibration_tau']:g} {rl['equilibration_unit']}")
     else:
         status["state"] = "complete"
     write_status(d, status)
+    if status["state"] == "complete":
+        archive_run(sd, p, status, log)
     if status["state"] == "too_short" and status["attempts"] < rl["max_attempts"] and not STOPPING.is_set():
         log(f"{st.run_name(p)}: {status['message']}; again with 1.3 tau_alpha")
         return do_run(sd, p, log)

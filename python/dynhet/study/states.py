@@ -11,6 +11,7 @@ from .toml_io import toml_dump, write_atomic
 from .model import StudyError, StudyInterrupted
 from .rundir import read_status, run_h5_result, write_status
 from .children import STOPPING, call_child, run_scene
+from .archiving import archive_pilot, restored_pilot
 
 
 def prepared_state(sd, sc):
@@ -107,46 +108,63 @@ def pid_alive(pid):
         return True
 
 
-def pilot(sd, p):
-    """tau_alpha of p from a short, small run of its series; cached per point (not per seed)."""
+def pilot(sd, p, unit=None):
+    """tau_alpha of p (unit: "tau_alpha" or "tau_alpha_cr", default the
+    study's run_length.unit) from a short, small run of its series; cached
+    per point (not per seed)."""
     st = sd.study
+    unit = unit or st.run_length["unit"]
     name = f"phi{p['packing_fraction']:.4f}_eps{p['restitution']:.3f}_n{p['n_particles']}_{p['pairs']}"
+    if unit != st.run_length["unit"]:
+        name += "_" + unit  # the equilibration's pilot (run_length.equilibration_unit)
     d = os.path.join(sd.dir, "pilots", name)
     os.makedirs(d, exist_ok=True)
     # Other seeds of the point (threads here, or Slurm tasks elsewhere) wait
     # for the one pilot instead of running it again in the same directory.
     with open(os.path.join(d, ".lock"), "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
-        return pilot_locked(sd, p, name, d)
+        return pilot_locked(sd, p, name, d, unit)
 
 
-def pilot_locked(sd, p, name, d):
+def pilot_locked(sd, p, name, d, unit):
     st = sd.study
     old = read_status(d)
     if old.get("state") == "complete":
         return old["tau_alpha"]
+    kept = restored_pilot(sd, name, d)  # the archive's: the same tau_alpha, not simulated again
+    if kept is not None:
+        return kept["tau_alpha"]
     # The same pilot whichever seed of the point comes first (the first
     # seed's), and whatever else has finished (its first guess only from the
     # study file): the pilot, and so the run, is a function of the point.
     p = dict(p, seed=st.axes.get("seed", [st.base_value("seed")])[0])
-    g, _ = sd.guess(p, finished=False)
+    own = unit == st.run_length["unit"]
+    g, _ = sd.guess(p, finished=False, table="tau_guess" if own else "tau_guess_cr")
+    spent_wall = spent_cpu = 0.0  # over every attempt: what the pilot cost
     for attempt in range(1, 7):
-        sc = st.scene(p, g, pilot=True)
+        sc = st.scene(p, g, pilot=True, unit=unit)
         prepared_state(sd, sc)
         write_atomic(os.path.join(d, "scene.toml"), toml_dump(sc, f"# pilot of {name}, tau guess {g:.6g}"))
+        # A later attempt runs its longer scene from the start (run_scene.sh
+        # --fresh): on the same directory it would find the earlier attempt's
+        # complete run.h5 and run nothing, and its tau_alpha would be the
+        # earlier, too short attempt's.
         rc, wall, cpu = run_scene(os.path.join(d, "scene.toml"), d, os.path.join(d, "run_scene.log"),
-                                  plots=st.run_plots)
+                                  fresh=attempt > 1, plots=st.run_plots)
+        spent_wall, spent_cpu = spent_wall + wall, spent_cpu + cpu
         if STOPPING.is_set():
             raise StudyInterrupted(f"pilot of {name} stopped")
-        complete, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc), st.tau_group())
+        complete, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc), st.tau_group(unit))
         if rc != 0 or not complete:
             write_status(d, {"state": "failed", "exit": rc, "message": f"pilot run failed; log {d}/run_scene.log"})
             raise StudyError(f"pilot of {name} failed (exit {rc}); its log: {d}/run_scene.log")
         if math.isfinite(tau) and tau <= g:
             key = st.series_key(p)
-            write_status(d, {"state": "complete", "tau_alpha": tau, "guess": g, "attempts": attempt,
-                             "packing_fraction": p["packing_fraction"], "series": list(key),
-                             "wall_s": wall, "cpu_s": cpu})
+            done = {"state": "complete", "tau_alpha": tau, "guess": g, "attempts": attempt,
+                    "packing_fraction": p["packing_fraction"], "series": list(key), "wall_s": spent_wall, "cpu_s": spent_cpu,
+                    "unit": unit}
+            write_status(d, done)
+            archive_pilot(sd, name, done)
             return tau
         g = 4 * g if not math.isfinite(tau) else 1.3 * tau
     raise StudyError(f"pilot of {name}: tau_alpha not found after 6 attempts")
