@@ -65,7 +65,7 @@ check 'grep -q "analyse_study: .* rows" "$tmp/a.out"' "the study analysis ran wh
 check '! grep -q "analyse_study: FAILED\|Traceback" "$tmp/a.out"' "no step of the study analysis failed"
 /usr/bin/python3 "$root/tests/check_study_analysis.py" "$tmp/a" || fail=1
 bash "$root/launch_scripts/analyse_study.sh" "$tmp/nothing" >"$tmp/n.out" 2>&1 && rc=0 || rc=$?
-check '[[ $rc == 2 ]] && grep -q "is not a study directory: no index.toml" "$tmp/n.out"' "analysing a directory that is no study: a bad argument, said (exit $rc)"
+check '[[ $rc == 2 ]] && grep -q "is not a study directory nor a results archive: no index.toml" "$tmp/n.out"' "analysing a directory that is no study: a bad argument, said (exit $rc)"
 
 stamp=$(stat -c %Y "$tmp"/a/runs/*/status.toml | sort | tail -1)
 sleep 1

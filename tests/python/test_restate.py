@@ -74,7 +74,7 @@ def test_restate_via_takes_label_equals_table_and_names_what_is_wrong(tmp_path, 
     with pytest.raises(SystemExit) as e:
         main([study, "--restate", str(old), "--restate-via", "errors fixed (N = 4096)=" + str(old)])
     err = capsys.readouterr().err
-    assert e.value.code == 2 and "not a study directory: no index.toml" in err and "no-study" in err
+    assert e.value.code == 2 and "not a study directory nor a results archive: no index.toml" in err and "no-study" in err
 
 
 def test_how_far_each_step_moved_the_value_in_errors(tmp_path):
