@@ -107,11 +107,15 @@ class _Dims:
 
 def _check_series(g, f, path, dims, problems):
     s = g[f["name"]]
-    if not isinstance(s, h5py.Group) or not all(k in s for k in ("step", "time", "value")):
+    final_record = isinstance(s, h5py.Group) and "value" in s and "step" in s.attrs and "time" in s.attrs
+    if not isinstance(s, h5py.Group) or not (final_record or all(k in s for k in ("step", "time", "value"))):
         problems.append(f"{path}: not a time series (step, time, value)")
         return
     n = s["value"].shape[0] if s["value"].shape else None
-    if s["step"].shape != (n,) or s["time"].shape != (n,):
+    if final_record:  # a results archive's entry (dynhet.archive): one record, its step and time attributes
+        if n != 1:
+            problems.append(f"{path}: an archived final record holds {n} records")
+    elif s["step"].shape != (n,) or s["time"].shape != (n,):
         problems.append(f"{path}: step {s['step'].shape}, time {s['time'].shape} and value {s['value'].shape} "
                         "disagree on the records")
     if s["value"].dtype != f["dtype"]:
