@@ -19,19 +19,24 @@
 namespace dynhet {
 using namespace scene_detail;
 
+// The observables are declared in their .lcm files (dynhet/observables.hpp).
 const std::vector<std::string>& known_observables() {
-  static const std::vector<std::string> v{"overlap", "chi4", "msd", "displacement", "clusters", "s4", "bond_breaking"};
+  static const std::vector<std::string> v = [] {
+    std::vector<std::string> names;
+    for (const ObservableInfo& o : kObservables) names.push_back(o.name);
+    return names;
+  }();
   return v;
 }
 
 bool has_cage_relative(const std::string& o) {
-  return o == "overlap" || o == "chi4" || o == "msd" || o == "displacement" || o == "s4" || o == "clusters";
+  const ObservableInfo* info = find_observable(o);
+  return info && info->cage_relative;
 }
 
 std::string node_of(const std::string& observable) {
-  std::string o = observable;
-  if (o.size() > 3 && o.compare(o.size() - 3, 3, "_cr") == 0) o.resize(o.size() - 3);
-  return o == "chi4" || o == "msd" || o == "displacement" || o == "bond_breaking" ? "overlap" : o;
+  const ObservableInfo* info = find_computed_observable(observable);
+  return info ? info->node : observable;
 }
 
 std::vector<std::string> nodes_for(const std::vector<std::string>& observables) {

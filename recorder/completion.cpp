@@ -2,19 +2,21 @@
 
 #include <algorithm>
 
+#include "dynhet/observables.hpp"
 #include "dynhet/scene.hpp"
 
 namespace dynhet {
 
 namespace {
-// Observables whose result messages the recorder knows how to write.
-bool recordable(const std::string &observable) {
-  return observable == "overlap" || observable == "chi4" || observable == "msd" || observable == "displacement" ||
-         observable == "clusters" || observable == "s4" || observable == "bond_breaking" ||
-         (observable.size() > 3 && observable.compare(observable.size() - 3, 3, "_cr") == 0 &&
-          has_cage_relative(observable.substr(0, observable.size() - 3)));
-}
+// Observables whose result messages the recorder knows how to write: the
+// declared ones and their cage-relative variants.
+bool recordable(const std::string &observable) { return find_computed_observable(observable) != nullptr; }
 } // namespace
+
+std::string Completion::final_label(const std::string &observable, double cutoff_a) {
+  const ObservableInfo *o = find_computed_observable(observable);
+  return o && !o->per_cutoff ? observable : observable + " " + cutoff_label(cutoff_a);
+}
 
 Completion::Completion(const std::vector<std::string> &observables, const std::vector<double> &cutoffs)
     : observables_(observables) {

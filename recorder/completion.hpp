@@ -25,17 +25,12 @@ public:
   // A node's frame counts from its last status: a node that did not
   // reassemble every frame the sim published makes the file incomplete.
   void node_frames(const std::string &node, int whole, int lost, int expected);
-  // A final result of `observable` ("overlap", "chi4", "clusters", "s4") for
-  // one cutoff, or of one with a single final result ("msd" and
-  // "displacement", which do not depend on the cutoff; cutoff ignored);
-  // "<name>_cr" for the cage-relative results.
+  // A final result of `observable` ("overlap", or "overlap_cr" for the
+  // cage-relative results) for one cutoff; one of an observable that is not
+  // per cutoff (msd, ...) stands for every cutoff (cutoff ignored).
   void final_result(const std::string &observable, double cutoff_a) { finals_.insert(final_label(observable, cutoff_a)); }
-  static std::string final_label(const std::string &observable, double cutoff_a) {
-    return observable == "msd" || observable == "displacement" || observable == "msd_cr" ||
-                   observable == "displacement_cr" || observable == "bond_breaking"
-               ? observable
-               : observable + " " + cutoff_label(cutoff_a);
-  }
+  // "overlap a0.6", or "msd" for an observable that is not per cutoff.
+  static std::string final_label(const std::string &observable, double cutoff_a);
   void frames(int lost, int expected);
 
   // The sim has said done or failed.

@@ -64,7 +64,7 @@ bool RunRecorder::rejected(const std::string &channel, const std::string &why) {
 // below kDiskReserve it stops writing for good: it marks the file
 // incomplete ("no space left on device"), closes it while it still can,
 // and the run ends non-zero. A write that fails anyway stops writing too.
-template <class F> void RunRecorder::guarded(const char *what, F &&write) {
+void RunRecorder::guarded(const char *what, const std::function<void()> &write) {
   if (stopped_) return;
   if (const int64_t free = free_bytes(out_path_); free >= 0 && free < kDiskReserve)
     return stop_writing("no space left on device (ENOSPC): " + std::to_string(free / 1024) +
@@ -224,81 +224,6 @@ void RunRecorder::write_node(const node_status_t &m) {
   writer_->append_scalar(base + "chunks_received", *at, m.chunks_received);
   writer_->append_scalar(base + "pairs_done", *at, m.pairs_done);
   writer_->append_scalar(base + "wall_time", *at, 1e-6 * static_cast<double>(m.utime - *node_clock_zero_));
-}
-
-bool RunRecorder::on_overlap(const overlap_t &m) {
-  if (!info_ || m.run_id != info_->run_id) return false;
-  if (const std::string bad = frame_problem(m.frame_index); !bad.empty())
-    return rejected(cutoff_channel(kChanOverlap, m.cutoff_a, m.cage_relative), bad);
-  guarded("overlap", [&] { write_overlap(m); });
-  if (m.is_final) completion_.final_result(result_group("overlap", m.cage_relative), m.cutoff_a);
-  return true;
-}
-
-bool RunRecorder::on_msd(const msd_t &m) {
-  if (!info_ || m.run_id != info_->run_id) return false;
-  std::string bad = frame_problem(m.frame_index);
-  if (bad.empty() && m.n_fs > 0) bad = size_problem("F_s", m.n_fs, m.n_q, m.n_lags);
-  if (!bad.empty()) return rejected(result_channel(kChanMsd, m.cage_relative), bad);
-  guarded("msd", [&] { write_msd(m); });
-  if (m.is_final) completion_.final_result(result_group("msd", m.cage_relative), 0.0);
-  return true;
-}
-
-bool RunRecorder::on_displacement(const displacement_t &m) {
-  if (!info_ || m.run_id != info_->run_id) return false;
-  std::string bad = frame_problem(m.frame_index);
-  if (bad.empty() && m.n_values > 0)
-    bad = size_problem("displacement series", m.n_series, m.n_sets, m.n_targets);
-  if (bad.empty() && m.n_values > 0)
-    bad = size_problem("displacement bins", m.n_values, m.n_sets, m.n_targets, m.n_bins);
-  if (!bad.empty()) return rejected(result_channel(kChanDisplacement, m.cage_relative), bad);
-  guarded("displacement", [&] { write_displacement(m); });
-  if (m.is_final) completion_.final_result(result_group("displacement", m.cage_relative), 0.0);
-  return true;
-}
-
-bool RunRecorder::on_s4(const s4_t &m) {
-  if (!info_ || m.run_id != info_->run_id) return false;
-  std::string bad = frame_problem(m.frame_index);
-  if (bad.empty() && m.n_values > 0) bad = size_problem("s4_lag", m.n_lag_values, m.n_lags, m.n_values);
-  if (bad.empty() && m.n_values > 0)
-    bad = size_problem("xi_lag, chi0_lag", m.n_lag_fits, m.n_lags, m.n_grids);
-  if (bad.empty() && m.n_values > 0)
-    bad = size_problem("scan_oz_xi, scan_oz_chi0, scan_a2_xi, scan_a2_chi0", m.n_scan_values, m.n_grids, m.n_scan);
-  if (!bad.empty()) return rejected(cutoff_channel(kChanS4, m.cutoff_a, m.cage_relative), bad);
-  guarded("s4", [&] { write_s4(m); });
-  if (m.is_final) completion_.final_result(result_group("s4", m.cage_relative), m.cutoff_a);
-  return true;
-}
-
-bool RunRecorder::on_clusters(const clusters_t &m) {
-  if (!info_ || m.run_id != info_->run_id) return false;
-  if (const std::string bad = frame_problem(m.frame_index); !bad.empty())
-    return rejected(cutoff_channel(kChanClusters, m.cutoff_a, m.cage_relative), bad);
-  guarded("clusters", [&] { write_clusters(m); });
-  if (m.is_final) completion_.final_result(result_group("clusters", m.cage_relative), m.cutoff_a);
-  return true;
-}
-
-bool RunRecorder::on_bond_breaking(const bond_breaking_t &m) {
-  if (!info_ || m.run_id != info_->run_id) return false;
-  std::string bad = frame_problem(m.frame_index);
-  if (bad.empty()) bad = size_problem("chi_B", m.n_values, m.n_grids, m.n_lags);
-  if (!bad.empty()) return rejected(kChanBondBreaking, bad);
-  guarded("bond_breaking", [&] { write_bond_breaking(m); });
-  if (m.is_final) completion_.final_result("bond_breaking", 0.0);
-  return true;
-}
-
-bool RunRecorder::on_chi4(const chi4_t &m) {
-  if (!info_ || m.run_id != info_->run_id) return false;
-  std::string bad = frame_problem(m.frame_index);
-  if (bad.empty() && m.n_values > 0) bad = size_problem("chi4", m.n_values, m.n_grids, m.n_lags);
-  if (!bad.empty()) return rejected(cutoff_channel(kChanChi4, m.cutoff_a, m.cage_relative), bad);
-  guarded("chi4", [&] { write_chi4(m); });
-  if (m.is_final) completion_.final_result(result_group("chi4", m.cage_relative), m.cutoff_a);
-  return true;
 }
 
 bool RunRecorder::on_frame_chunk(const frame_chunk_t &m) {

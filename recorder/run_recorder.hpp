@@ -23,20 +23,18 @@
 //   schedule/{frame_time, origin_frame, lag_time, pair_frame [origin][lag], cutoff_a}
 //   sim/<field>            the sim's status, with sim_time (its own simulation time)
 //   nodes/<node>/<field>   the node's frame counts, with wall_time (s since the first node status)
-//   overlap/a<cutoff>/<field>, with lag_time
-//   chi4/a<cutoff>/..., s4/a<cutoff>/..., msd/... likewise (see write_chi4, write_s4)
-//   clusters/a<cutoff>/<field> likewise, with lag_time, r and the size bins
-//   msd/<field>, displacement/<field> likewise (one each per run), with
-//   lag_time (msd) and x, the bin centres (displacement)
-//   bond_breaking/<field>: C_B, tau_B, chi_B per grid (write_bond_breaking)
-//   overlap_cr/, chi4_cr/, msd_cr/, displacement_cr/  the same of the
-//     cage-relative displacements (attribute displacements), in the same layout
+//   <observable>[/a<cutoff>]/<field>  each result type's group, as its
+//     declaration in lcmtypes/<type>.lcm says (docs/run_h5.md): one group per
+//     cutoff if per cutoff; series, fixed axes and attributes
+//   <observable>_cr[/a<cutoff>]/  the same of the cage-relative
+//     displacements (attribute displacements), in the same layout
 #pragma once
 #include <array>
 
 #include "dynhet/bus_auth.hpp"
 
 #include <cstdint>
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -49,17 +47,20 @@
 #include "dynhet/frame_chunk_t.hpp"
 #include "dynhet/h5md.hpp"
 #include "dynhet/node_status_t.hpp"
-#include "dynhet/bond_breaking_t.hpp"
-#include "dynhet/chi4_t.hpp"
-#include "dynhet/clusters_t.hpp"
-#include "dynhet/displacement_t.hpp"
-#include "dynhet/msd_t.hpp"
-#include "dynhet/s4_t.hpp"
-#include "dynhet/overlap_t.hpp"
+#include "dynhet/lcm_url.hpp"
+#include "dynhet/result_decl.hpp"
 #include "dynhet/run_info_t.hpp"
 #include "dynhet/sim_status_t.hpp"
 
 namespace dynhet {
+
+// The one channel a result may come on: its family (DYNHET_OVERLAP), _CR if
+// of the cage-relative displacements, _<a> if per cutoff.
+template <class T> std::string result_channel_of(const T &m) {
+  using D = ResultDecl<T>;
+  return D::per_cutoff ? cutoff_channel(D::channel, D::cutoff(m), D::cage_relative(m))
+                       : result_channel(D::channel, D::cage_relative(m));
+}
 
 class RunRecorder {
 public:
@@ -78,13 +79,9 @@ public:
   bool on_run(const run_info_t &m);
   bool on_sim_status(const sim_status_t &m);
   bool on_node_status(const node_status_t &m);
-  bool on_overlap(const overlap_t &m);
-  bool on_chi4(const chi4_t &m);
-  bool on_msd(const msd_t &m);
-  bool on_s4(const s4_t &m);
-  bool on_clusters(const clusters_t &m);
-  bool on_displacement(const displacement_t &m);
-  bool on_bond_breaking(const bond_breaking_t &m);
+  // A result of any declared type (DYNHET_RESULT_TYPES: overlap_t, ...),
+  // written as its declaration says (ResultDecl<T>, run_recorder_results.cpp).
+  template <class T> bool on_result(const T &m);
   bool on_frame_chunk(const frame_chunk_t &m);
   // A message dropped as malformed or inconsistent (by the caller or here):
   // counted, the last reason kept, both written to the file's summary.
@@ -164,16 +161,10 @@ private:
   void write_run_info(const run_info_t &m);
   void write_sim(const sim_status_t &m);
   void write_node(const node_status_t &m);
-  void write_overlap(const overlap_t &m);
-  void write_chi4(const chi4_t &m);
-  void write_msd(const msd_t &m);
-  void write_s4(const s4_t &m);
-  void write_clusters(const clusters_t &m);
-  void write_displacement(const displacement_t &m);
-  void write_bond_breaking(const bond_breaking_t &m);
+  template <class T> void write_result(const T &m);
   void write_summary(const std::vector<std::string> &missing);
   void count_frames();
-  template <class F> void guarded(const char *what, F &&write);
+  void guarded(const char *what, const std::function<void()> &write);
 };
 
 } // namespace dynhet

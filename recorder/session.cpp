@@ -8,23 +8,6 @@ std::string channel_of(const dynhet::run_info_t &) { return dynhet::kChanRun; }
 std::string channel_of(const dynhet::sim_status_t &) { return dynhet::kChanSimStatus; }
 std::string channel_of(const dynhet::frame_chunk_t &) { return dynhet::kChanFrame; }
 std::string channel_of(const dynhet::node_status_t &m) { return dynhet::node_status_channel(m.node); }
-using dynhet::cutoff_channel;
-std::string channel_of(const dynhet::overlap_t &m) {
-  return cutoff_channel(dynhet::kChanOverlap, m.cutoff_a, m.cage_relative);
-}
-std::string channel_of(const dynhet::chi4_t &m) {
-  return cutoff_channel(dynhet::kChanChi4, m.cutoff_a, m.cage_relative);
-}
-std::string channel_of(const dynhet::s4_t &m) { return cutoff_channel(dynhet::kChanS4, m.cutoff_a, m.cage_relative); }
-std::string channel_of(const dynhet::clusters_t &m) {
-  return cutoff_channel(dynhet::kChanClusters, m.cutoff_a, m.cage_relative);
-}
-std::string channel_of(const dynhet::bond_breaking_t &) { return dynhet::kChanBondBreaking; }
-std::string channel_of(const dynhet::msd_t &m) { return dynhet::result_channel(dynhet::kChanMsd, m.cage_relative); }
-std::string channel_of(const dynhet::displacement_t &m) {
-  return dynhet::result_channel(dynhet::kChanDisplacement, m.cage_relative);
-}
-
 
 // Run info and sim status come from the log when one is given, results
 // always from the bus. Every queue holds what the run can send while the
@@ -53,22 +36,14 @@ void Session::subscribe() {
   }
   // Every channel of each family (a cutoff's, a node's), and names outside
   // the scheme that start like it, to be dropped and counted.
-  using R = dynhet::RunRecorder;
   using dynhet::channel_family;
   auto family = [&](const char *name, auto handler) {
     lcm_.subscribe(channel_family(name), handler, this)->setQueueCapacity(kQueueSmall);
   };
   family(dynhet::kChanNodeStatus, &Session::raw<dynhet::node_status_t, &Session::take_node>);
-  family(dynhet::kChanOverlap, &Session::raw<dynhet::overlap_t, &Session::take_result<dynhet::overlap_t, &R::on_overlap>>);
-  family(dynhet::kChanChi4, &Session::raw<dynhet::chi4_t, &Session::take_result<dynhet::chi4_t, &R::on_chi4>>);
-  family(dynhet::kChanMsd, &Session::raw<dynhet::msd_t, &Session::take_result<dynhet::msd_t, &R::on_msd>>);
-  family(dynhet::kChanS4, &Session::raw<dynhet::s4_t, &Session::take_result<dynhet::s4_t, &R::on_s4>>);
-  family(dynhet::kChanClusters,
-         &Session::raw<dynhet::clusters_t, &Session::take_result<dynhet::clusters_t, &R::on_clusters>>);
-  family(dynhet::kChanDisplacement,
-         &Session::raw<dynhet::displacement_t, &Session::take_result<dynhet::displacement_t, &R::on_displacement>>);
-  family(dynhet::kChanBondBreaking,
-         &Session::raw<dynhet::bond_breaking_t, &Session::take_result<dynhet::bond_breaking_t, &R::on_bond_breaking>>);
+#define DYNHET_SUBSCRIBE(T) family(dynhet::ResultDecl<dynhet::T>::channel, &Session::raw<dynhet::T, &Session::take_result<dynhet::T>>);
+  DYNHET_RESULT_TYPES(DYNHET_SUBSCRIBE)
+#undef DYNHET_SUBSCRIBE
   // The launch scripts wait for this line before starting the sim.
   std::fprintf(stderr, "recorder: ready, waiting for run info%s%s (bus %s)\n", log_ ? " in " : "",
                log_ ? opt_.from_log.c_str() : "", bus_.describe());
@@ -135,7 +110,6 @@ void Session::journal_epoch() {
 }
 
 void Session::dispatch(const std::string &ch, const void *d, int n) {
-  using R = dynhet::RunRecorder;
   namespace dh = dynhet;
   auto in = [&](const char *family) { return ch.rfind(family, 0) == 0; };
   if (ch == kJournalEpoch) { // a replayed journal: the epoch of what follows
@@ -150,16 +124,10 @@ void Session::dispatch(const std::string &ch, const void *d, int n) {
   else if (ch == dh::kChanSimStatus) take_bytes<dh::sim_status_t, &Session::take_sim>(d, n, ch);
   else if (ch == dh::kChanFrame) take_bytes<dh::frame_chunk_t, &Session::take_frame>(d, n, ch);
   else if (in(dh::kChanNodeStatus)) take_bytes<dh::node_status_t, &Session::take_node>(d, n, ch);
-  else if (in(dh::kChanOverlap)) take_bytes<dh::overlap_t, &Session::take_result<dh::overlap_t, &R::on_overlap>>(d, n, ch);
-  else if (in(dh::kChanChi4)) take_bytes<dh::chi4_t, &Session::take_result<dh::chi4_t, &R::on_chi4>>(d, n, ch);
-  else if (in(dh::kChanMsd)) take_bytes<dh::msd_t, &Session::take_result<dh::msd_t, &R::on_msd>>(d, n, ch);
-  else if (in(dh::kChanS4)) take_bytes<dh::s4_t, &Session::take_result<dh::s4_t, &R::on_s4>>(d, n, ch);
-  else if (in(dh::kChanClusters))
-    take_bytes<dh::clusters_t, &Session::take_result<dh::clusters_t, &R::on_clusters>>(d, n, ch);
-  else if (in(dh::kChanDisplacement))
-    take_bytes<dh::displacement_t, &Session::take_result<dh::displacement_t, &R::on_displacement>>(d, n, ch);
-  else if (in(dh::kChanBondBreaking))
-    take_bytes<dh::bond_breaking_t, &Session::take_result<dh::bond_breaking_t, &R::on_bond_breaking>>(d, n, ch);
+#define DYNHET_DISPATCH(T) \
+  else if (in(dh::ResultDecl<dh::T>::channel)) take_bytes<dh::T, &Session::take_result<dh::T>>(d, n, ch);
+  DYNHET_RESULT_TYPES(DYNHET_DISPATCH)
+#undef DYNHET_DISPATCH
 }
 
 bool Session::start_cuts() {

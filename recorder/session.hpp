@@ -53,13 +53,7 @@ std::string channel_of(const dynhet::run_info_t &);
 std::string channel_of(const dynhet::sim_status_t &);
 std::string channel_of(const dynhet::frame_chunk_t &);
 std::string channel_of(const dynhet::node_status_t &);
-std::string channel_of(const dynhet::overlap_t &);
-std::string channel_of(const dynhet::chi4_t &);
-std::string channel_of(const dynhet::s4_t &);
-std::string channel_of(const dynhet::clusters_t &);
-std::string channel_of(const dynhet::bond_breaking_t &);
-std::string channel_of(const dynhet::msd_t &);
-std::string channel_of(const dynhet::displacement_t &);
+template <class Result> std::string channel_of(const Result &m) { return dynhet::result_channel_of(m); }
 
 // The bus (and optionally a log) on one side, the RunRecorder on the
 // other, and the clocks that decide when to stop waiting.
@@ -121,8 +115,8 @@ private:
     if (m.node == dynhet::kRecorderNode) return; // the recorder's own (or one posing as it): no analysis node
     if (rec_.on_node_status(m)) last_progress_ = Clock::now();
   }
-  template <class Msg, bool (dynhet::RunRecorder::*On)(const Msg &)> void take_result(const Msg &m) {
-    if ((rec_.*On)(m)) last_progress_ = Clock::now();
+  template <class Result> void take_result(const Result &m) {
+    if (rec_.on_result(m)) last_progress_ = Clock::now();
   }
   void take_frame(const dynhet::frame_chunk_t &m) {
     const int before = rec_.frames_whole() + rec_.frames_lost();

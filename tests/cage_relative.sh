@@ -40,6 +40,8 @@ check '$py "$root/tests/check_run.py" "$tmp/ref/run.h5" "$tmp/scene.toml" >"$tmp
   "the standard results equal brute force with the cage-relative ones beside them"
 grep FAIL "$tmp/check_run.out" || true
 check '$py "$root/tests/check_cage_relative.py" "$tmp/ref/run.h5"' "the cage-relative results equal brute force"
+check 'PYTHONPATH="$root/python" $py -c "import sys; from dynhet.schema import main; sys.exit(main(sys.argv[1:]))" "$tmp/ref/run.h5"' \
+  "the file fits the schema of run.h5, its _cr groups and bond breaking too (docs/run_h5.md)"
 check '$py "$root/tests/check_bond_breaking.py" "$tmp/ref/run.h5"' "bond breaking equals brute force"
 check 'grep -q "overlap_node (cage-relative): a=0.6 tau_alpha=" "$tmp/ref/overlap_node.log"' \
   "the overlap node states the cage-relative tau_alpha"

@@ -22,8 +22,13 @@ Usage: check_h5md.py RUN.h5 [--author NAME]
 import argparse
 import sys
 
+import os
+
 import h5py
 import numpy as np
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from dynhet import schema  # noqa: E402
 
 failures = []
 
@@ -132,35 +137,15 @@ def check_links(f):
               f"particles/all/image/{d} is a hard link")
 
 
-def shape_of(g, name):
-    return tuple(g[name]["value"].shape[1:]) if name in g else None
-
-
 def check_dimensions(f):
-    o = f["observables"]
-    for a, g in o.get("chi4", {}).items():
-        dims = (len(g["subbox_particles"]), len(g["lag_time"]))
-        for k in ("chi4", "chi4_err"):
-            check(g[k]["value"].ndim == 3 and shape_of(g, k) == dims,
-                  f"chi4/{a}/{k}: value [record][grid][lag] {g[k]['value'].shape} (grids, lags {dims})")
-    for a, g in o.get("s4", {}).items():
-        n_lags, n_values, n_grids = len(g["lag_time"]), len(g["q"]), len(g["subbox_particles"])
-        check(shape_of(g, "s4_lag") == (n_lags, n_values), f"s4/{a}/s4_lag: value [record][lag][value]")
-        for k in ("xi_lag", "chi0_lag"):
-            check(shape_of(g, k) == (n_lags, n_grids), f"s4/{a}/{k}: value [record][lag][grid]")
-    if "displacement" in o:
-        g = o["displacement"]
-        n_sets, n_bins = int(g.attrs["n_sets"]), len(g["x"])
-        n_targets = g["target_time"]["value"].shape[1]
-        for k in ("p", "p_err", "count"):
-            check(shape_of(g, k) == (n_sets, n_targets, n_bins),
-                  f"displacement/{k}: value [record][set][target][bin] {shape_of(g, k)}")
-        series = ("n_pairs", "samples", "fraction_outside", "gauss_d", "gauss_d_err", "gauss_bins", "tail_x0",
-                  "tail_x0_err", "tail_amplitude", "tail_x_min", "tail_x_max", "tail_bins")
-        check(all(shape_of(g, k) == (n_sets, n_targets) for k in series),
-              "displacement: per-series values [record][set][target]")
-    if "schedule" in o:
-        s = o["schedule"]
+    """Every observable group against the schema generated from the
+    observables' declarations (dynhet.schema); the schedule's own pair table."""
+    problems = schema.check(f.filename)
+    for line in problems[:20]:
+        print("     " + line)
+    check(not problems, f"the observables fit the schema of run.h5 (docs/run_h5.md): {len(problems)} problem(s)")
+    if "observables/schedule" in f:
+        s = f["observables/schedule"]
         check(s["pair_frame"].shape == (len(s["origin_frame"]), len(s["lag_time"])),
               f"schedule/pair_frame [origin][lag] {s['pair_frame'].shape}")
 

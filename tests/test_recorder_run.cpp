@@ -128,7 +128,7 @@ void run_until_done(dynhet::RunRecorder &rec, bool lose_a_frame = false) {
   EXPECT_TRUE(rec.on_node_status(node(1.1, "running", 0)));
   for (int f = 0; f < 3; ++f) {
     send_frame(rec, f, lose_a_frame && f == 1);
-    for (double a : {0.6, 1.8}) EXPECT_TRUE(rec.on_overlap(overlap(a, false, f)));
+    for (double a : {0.6, 1.8}) EXPECT_TRUE(rec.on_result(overlap(a, false, f)));
     EXPECT_TRUE(rec.on_sim_status(sim(1.2 + f, "production", 100.1 + 0.5 * f, f + 1)));
     EXPECT_TRUE(rec.on_node_status(node(1.2 + 0.1 * f, "running", f + 1)));
   }
@@ -141,10 +141,10 @@ TEST(RunRecorder, IgnoresOtherRuns) {
   const std::string path = temp_file("other");
   dynhet::RunRecorder rec(path, "test");
   auto o = overlap(0.6, true, 2);
-  EXPECT_FALSE(rec.on_overlap(o)); // no run yet
+  EXPECT_FALSE(rec.on_result(o)); // no run yet
   ASSERT_TRUE(rec.on_run(run_info()));
   o.run_id = 7;
-  EXPECT_FALSE(rec.on_overlap(o));
+  EXPECT_FALSE(rec.on_result(o));
   auto s = sim(1, "done", 1);
   s.run_id = 7;
   EXPECT_FALSE(rec.on_sim_status(s));
@@ -161,7 +161,7 @@ TEST(RunRecorder, CompleteRunIsWrittenAndMarkedComplete) {
   for (double a : {0.6, 1.8}) {
     auto final = overlap(a, true, 2); // the same frame as the last running result
     final.tau_alpha = 0.75;
-    rec.on_overlap(final);
+    rec.on_result(final);
   }
   EXPECT_FALSE(rec.completion().settled()); // the node has not said done
   EXPECT_TRUE(rec.on_node_status(node(2.7, "done", 3)));
@@ -231,7 +231,7 @@ TEST(RunRecorder, MissingResultsAreNamed) {
   const std::string path = temp_file("missing");
   dynhet::RunRecorder rec(path, "test");
   run_until_done(rec, /*lose_a_frame=*/true);
-  rec.on_overlap(overlap(0.6, true, 2));
+  rec.on_result(overlap(0.6, true, 2));
   rec.on_node_status(node(2.7, "done", 3));
   EXPECT_FALSE(rec.completion().settled()); // a1.8 has no final result
   const auto missing = rec.finish("timeout");
@@ -293,11 +293,11 @@ TEST(RunRecorder, S4IsRecordedPerCutoff) {
   auto n = node(1.1, "done", 3);
   n.node = "s4";
   rec.on_node_status(n);
-  for (double a : {0.6, 1.8}) EXPECT_TRUE(rec.on_s4(s4(a, false, 1)));
-  EXPECT_TRUE(rec.on_s4(s4(0.6, true, 2)));
+  for (double a : {0.6, 1.8}) EXPECT_TRUE(rec.on_result(s4(a, false, 1)));
+  EXPECT_TRUE(rec.on_result(s4(0.6, true, 2)));
   EXPECT_FALSE(rec.completion().settled()); // a1.8 has no final S4 yet
   EXPECT_EQ(rec.completion().missing(), std::vector<std::string>{"s4 a1.8: no final result"});
-  EXPECT_TRUE(rec.on_s4(s4(1.8, true, 2)));
+  EXPECT_TRUE(rec.on_result(s4(1.8, true, 2)));
   EXPECT_TRUE(rec.completion().settled());
   EXPECT_TRUE(rec.finish().empty());
 
@@ -336,13 +336,13 @@ TEST(RunRecorder, MultiDimensionalResultsKeepTheirShape) {
   c.chi4_per_origin = c.chi4, c.chi4_per_origin_err = c.chi4_err;
   c.chi4_peak = c.tau4 = c.chi4_peak_err = c.tau4_err = {1, 2};
   c.tau4_interior = {1, 0};
-  EXPECT_TRUE(rec.on_chi4(c));
+  EXPECT_TRUE(rec.on_result(c));
   auto wrong = c;
   wrong.n_lags = 2, wrong.lag_time = {0.5, 1}; // 6 values are not 2 x 2
-  EXPECT_FALSE(rec.on_chi4(wrong));
+  EXPECT_FALSE(rec.on_result(wrong));
   auto late = c;
   late.frame_index = 3; // the run has frames 0 .. 2
-  EXPECT_FALSE(rec.on_chi4(late));
+  EXPECT_FALSE(rec.on_result(late));
   EXPECT_EQ(rec.messages_rejected(), 2);
 
   auto d = result<dynhet::displacement_t>(0.6, false, 2);
@@ -357,7 +357,7 @@ TEST(RunRecorder, MultiDimensionalResultsKeepTheirShape) {
   d.gauss_bins = d.tail_bins = {0, 1, 10, 11};
   d.n_values = 12;
   for (int i = 0; i < 12; ++i) d.p.push_back(i), d.p_err.push_back(i), d.count.push_back(i);
-  EXPECT_TRUE(rec.on_displacement(d));
+  EXPECT_TRUE(rec.on_result(d));
   rec.finish("test over");
 
   h5read::File f(path);
@@ -392,7 +392,7 @@ TEST(RunRecorder, FailedSimSettlesButIsIncomplete) {
   auto s = sim(1.0, "failed", 100, 0);
   s.message = "boom";
   rec.on_sim_status(s);
-  for (double a : {0.6, 1.8}) EXPECT_TRUE(rec.on_overlap(overlap(a, true, -1)));
+  for (double a : {0.6, 1.8}) EXPECT_TRUE(rec.on_result(overlap(a, true, -1)));
   rec.on_node_status(node(1.5, "failed", 0));
   EXPECT_TRUE(rec.completion().settled());
   EXPECT_EQ(rec.messages_rejected(), 0);
@@ -420,7 +420,7 @@ TEST(RunRecorder, ANodeThatLostFramesMakesTheFileIncomplete) {
   rec.on_sim_status(sim(0.9, "production", 0.9)); // the sim goes on
   EXPECT_FALSE(rec.completion().sim_ended());
   rec.on_sim_status(sim(1.0, "done", 100));
-  for (double a : {0.6, 1.8}) rec.on_overlap(overlap(a, true, 2));
+  for (double a : {0.6, 1.8}) rec.on_result(overlap(a, true, 2));
   auto n = node(1.5, "done", 2);
   n.frames_lost = 1;
   rec.on_node_status(n);
@@ -449,12 +449,12 @@ TEST(RunRecorder, S4RangeScanKeepsItsShapeAndAMismatchIsRejected) {
   m.n_scan = 3, m.scan_qxi_max = {0.5, 1, 2};
   m.n_scan_values = 6; // 2 grids x 3 ranges
   for (auto *v : {&m.scan_oz_xi, &m.scan_oz_chi0, &m.scan_a2_xi, &m.scan_a2_chi0}) *v = {0, 1, 2, 10, 11, 12};
-  EXPECT_TRUE(rec.on_s4(m));
+  EXPECT_TRUE(rec.on_result(m));
   auto wrong = m;
   wrong.n_scan_values = 4; // 4 values are not 2 x 3
   for (auto *v : {&wrong.scan_oz_xi, &wrong.scan_oz_chi0, &wrong.scan_a2_xi, &wrong.scan_a2_chi0}) v->resize(4);
   wrong.frame_index = 2;
-  EXPECT_FALSE(rec.on_s4(wrong));
+  EXPECT_FALSE(rec.on_result(wrong));
   EXPECT_EQ(rec.messages_rejected(), 1);
   rec.finish("test over");
 

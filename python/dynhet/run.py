@@ -12,7 +12,9 @@ value) gives its last record, the final result, as an array named like
 the dataset (`.history(name)` gives every record with its time); a fixed
 dataset (lag_time, q, r, size_centre, ...) is itself; the group's
 attributes are `.attrs`. `value_error(name)` pairs `name` with `name_err`.
-Names are the datasets' own (docs/analysis.md says what each is).
+Names are the datasets' own: docs/run_h5.md and help(run.chi4) say what
+each is, its shape and unit (dynhet.schema, from the observables'
+declarations).
 
 open_run takes a run directory or its run.h5 and nothing else: another
 HDF5 file (a checkpoint, a study's study.h5), a truncated file or one a
@@ -27,6 +29,8 @@ import warnings
 
 import h5py
 import numpy as np
+
+from . import schema
 
 A_DEFAULT = 0.6  # the paper's cutoff, "unless stated otherwise"
 CUTOFF_REL_TOL = 1e-6  # a cutoff asked for matches the run's within this (labels and floats round)
@@ -160,24 +164,6 @@ class Run:
             g = g[near[0][1]]
         return Observable(g)
 
-    def overlap(self, a=A_DEFAULT):
-        return self.observable("overlap", a)
-
-    def chi4(self, a=A_DEFAULT):
-        return self.observable("chi4", a)
-
-    def clusters(self, a=A_DEFAULT):
-        return self.observable("clusters", a)
-
-    def s4(self, a=A_DEFAULT):
-        return self.observable("s4", a)
-
-    def msd(self):
-        return self.observable("msd")
-
-    def displacement(self):
-        return self.observable("displacement")
-
     def has_frames(self):
         """Whether the run kept its frames (observables.keep_frames)."""
         return "particles" in self._f and "position" in self._f["particles/all"]
@@ -202,6 +188,26 @@ class Run:
     def __repr__(self):
         return (f"Run({self.path}: N = {self.n_particles}, phi = {self.packing_fraction:g}, eps = {self.restitution:g}, "
                 f"{'complete' if self.complete else 'incomplete: ' + self.missing})")
+
+
+def _reader(kind):
+    """Run.<kind>(a) (per cutoff) or Run.<kind>(): the group, with what it
+    holds as the docstring (dynhet.schema.describe)."""
+    if schema.declaration(kind)["per_cutoff"]:
+        def read(self, a=A_DEFAULT):
+            return self.observable(kind, a)
+    else:
+        def read(self):
+            return self.observable(kind)
+    read.__name__ = read.__qualname__ = kind
+    read.__doc__ = schema.describe(kind)
+    return read
+
+
+# One reader per declared observable and cage-relative variant: run.overlap(a),
+# run.chi4_cr(a), run.msd(), ... (help(run.chi4) lists its datasets).
+for _kind in schema.kinds():
+    setattr(Run, _kind, _reader(_kind))
 
 
 def _label(label):

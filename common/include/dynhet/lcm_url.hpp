@@ -8,6 +8,8 @@
 #include <cstdlib>
 #include <string>
 
+#include "dynhet/observables.hpp" // kChan<Observable>
+
 namespace dynhet {
 
 inline constexpr const char* kDefaultLcmUrl = "udpm://239.255.76.67:7667?ttl=0";
@@ -31,14 +33,15 @@ inline int64_t utime_now() {
 //   DYNHET_RUN, DYNHET_FRAME, DYNHET_SIM_STATUS       the sim
 //   DYNHET_NODE_STATUS_<node>                         each node's status (overlap,
 //                                                     clusters, s4; recorder)
-//   DYNHET_OVERLAP_<a>, DYNHET_CHI4_<a>,              results, one channel per
-//   DYNHET_CLUSTERS_<a>, DYNHET_S4_<a>                cutoff a: <a> is cutoff_label
-//                                                     (a0.6), as in run.h5's groups
-//   DYNHET_MSD, DYNHET_DISPLACEMENT                   results of all cutoffs at once
-//   DYNHET_BOND_BREAKING                              bond breaking (no cutoff)
-//   DYNHET_OVERLAP_CR_<a>, ..., DYNHET_MSD_CR          the same of the cage-relative
+//   DYNHET_<OBSERVABLE>_<a>                           a per-cutoff observable's results
+//                                                     (overlap, chi4, ...): <a> is
+//                                                     cutoff_label (a0.6), as in run.h5
+//   DYNHET_<OBSERVABLE>                               the others' (msd, ...): one for all cutoffs
+//   DYNHET_<OBSERVABLE>_CR[_<a>]                       the same of the cage-relative
 //                                                     displacements ([observables]
 //                                                     cage_relative; groups <name>_cr)
+// Which observable is which is its declaration's (lcmtypes/*.lcm,
+// dynhet/observables.hpp).
 // The names are also LCM subscription patterns (regular expressions): a
 // channel with a cutoff holds a '.', so subscribe to the family
 // (channel_family) and compare names, never subscribe to a name.
@@ -46,13 +49,9 @@ inline constexpr const char* kChanRun = "DYNHET_RUN";
 inline constexpr const char* kChanFrame = "DYNHET_FRAME";
 inline constexpr const char* kChanSimStatus = "DYNHET_SIM_STATUS";
 inline constexpr const char* kChanNodeStatus = "DYNHET_NODE_STATUS"; // + "_<node>"
-inline constexpr const char* kChanOverlap = "DYNHET_OVERLAP";         // + "_<a>"
-inline constexpr const char* kChanChi4 = "DYNHET_CHI4";               // + "_<a>"
-inline constexpr const char* kChanMsd = "DYNHET_MSD";
-inline constexpr const char* kChanS4 = "DYNHET_S4";                   // + "_<a>"
-inline constexpr const char* kChanClusters = "DYNHET_CLUSTERS";       // + "_<a>"
-inline constexpr const char* kChanDisplacement = "DYNHET_DISPLACEMENT";
-inline constexpr const char* kChanBondBreaking = "DYNHET_BOND_BREAKING";
+// The results' families, kChanOverlap = "DYNHET_OVERLAP" and the rest, one
+// per observable, are generated from the observables' declarations
+// (dynhet/observables.hpp; "+ _<a>" for a per-cutoff one).
 // Checkpoint cuts (dynhet/cut.hpp): the sim's requests, and each process's
 // answer on DYNHET_CHECKPOINT_<process>.
 inline constexpr const char* kChanCheckpoint = "DYNHET_CHECKPOINT";

@@ -175,13 +175,15 @@ double scene_contact_value(const Scene& s);
 // omega_coll = 2.59 phi G_c / sqrt(pi) with scene_contact_value().
 double scene_kick_rate(const Scene& s);
 
-// Observables this build knows how to compute.
+// Observables this build knows how to compute: those declared in
+// lcmtypes/*.lcm (dynhet/observables.hpp).
 const std::vector<std::string>& known_observables();
 
 // Whether an observable has a cage-relative version ("overlap" -> "overlap_cr").
 bool has_cage_relative(const std::string& observable);
 
-// The node that computes an observable (a "<name>_cr" too, beside <name>): Q(t), chi4(t), the MSD and P(dx, t)
+// The node that computes an observable (a "<name>_cr" too, beside <name>),
+// its declaration's @node: Q(t), chi4(t), the MSD and P(dx, t)
 // come from the same pass over the displacements of the same (origin, lag)
 // pairs, so one node, "overlap", serves all four (one pass, one copy of the
 // frames). S4(q,t) has its own node, "s4" (an FFT per pair and grid: its own

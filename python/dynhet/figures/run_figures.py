@@ -8,12 +8,27 @@ import traceback
 
 import matplotlib.pyplot as plt
 
-from . import chi4, clusters, displacement, msd, overlap, s4
+import importlib
+import importlib.util
+
+from .. import schema
 from ..run import open_run
 
-# In run_scene.sh's order; the overlap figure is drawn whatever the run has
-# (it says so when Q(t) is missing).
-FIGURES = (("chi4", chi4), ("msd", msd), ("displacement", displacement), ("clusters", clusters), ("s4", s4))
+
+def _figures():
+    """(name, module) of every declared observable that has a figure, a
+    module of this package named after it (dynhet.schema)."""
+    out = []
+    for d in schema.OBSERVABLES:
+        if d["name"] != "overlap" and importlib.util.find_spec(f"{__package__}.{d['name']}") is not None:
+            out.append((d["name"], importlib.import_module(f".{d['name']}", __package__)))
+    return tuple(out)
+
+
+# The overlap figure is drawn last and whatever the run has (it says so
+# when Q(t) is missing).
+FIGURES = _figures()
+overlap = importlib.import_module(".overlap", __package__)
 
 
 def draw_all(path, outdir):

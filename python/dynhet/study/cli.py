@@ -122,6 +122,9 @@ def main():
     except StudyError as e:
         print(f"run_study: {e}", file=sys.stderr)
         return 1 if running else 2
+    except KeyboardInterrupt:  # stopped before the executor took over (checking the scenes): nothing ran
+        print("run_study: stopped before any run started; the same command starts again", file=sys.stderr)
+        return 75  # (interrupted: the same command goes on)
 
 
 def archive_dir(sd):

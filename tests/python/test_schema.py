@@ -1,0 +1,103 @@
+"""The schema check (dynhet.schema, generated from the observables'
+declarations in lcmtypes/*.lcm) against a real run's file, and against
+copies of it with one thing wrong; and docs/run_h5.md against what the
+declarations generate."""
+import os
+import shutil
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+import pytest
+
+from dynhet import schema
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+# A finished run of the quick study, committed under results/ (all observables but bond breaking).
+RUN = os.path.join(ROOT, "results", "quick", "runs", "phi0.8000_eps0.900_n4096_seed1_any.h5")
+
+
+@pytest.fixture
+def run_copy(tmp_path):
+    if not os.path.exists(RUN):
+        pytest.skip(f"no {RUN}")
+    p = tmp_path / "run.h5"
+    shutil.copy(RUN, p)
+    return str(p)
+
+
+def test_a_real_run_fits():
+    if not os.path.exists(RUN):
+        pytest.skip(f"no {RUN}")
+    assert schema.check(RUN) == []
+
+
+def test_a_missing_dataset_is_refused(run_copy):
+    with h5py.File(run_copy, "a") as f:
+        del f["observables/chi4/a0.6/tau4"]
+    assert schema.check(run_copy) == ["observables/chi4/a0.6/tau4: missing"]
+
+
+def test_a_missing_group_is_refused(run_copy):
+    with h5py.File(run_copy, "a") as f:
+        del f["observables/s4/a0.6"]
+    assert schema.check(run_copy) == ["observables/s4/a0.6: missing"]
+
+
+def test_a_misshaped_series_is_refused(run_copy):
+    path = "observables/overlap/a0.6/q/value"
+    with h5py.File(run_copy, "a") as f:
+        v = f[path][()]
+        del f[path]
+        f[path] = v[:, :-1]  # one lag short of lag_time
+    problems = schema.check(run_copy)
+    assert len(problems) == 1 and problems[0].startswith(path) and "n_lags" in problems[0]
+
+
+def test_a_misshaped_flat_array_is_refused(run_copy):
+    path = "observables/chi4/a0.6/chi4/value"
+    with h5py.File(run_copy, "a") as f:
+        v = f[path][()]
+        del f[path]
+        f[path] = v.transpose(0, 2, 1)  # [record][lag][grid] instead of [record][grid][lag]
+    assert any(p.startswith(path) for p in schema.check(run_copy))
+
+
+def test_a_wrong_dtype_and_attribute_are_refused(run_copy):
+    with h5py.File(run_copy, "a") as f:
+        g = f["observables/msd"]
+        v = g["lag_time"][()]
+        del g["lag_time"]
+        g["lag_time"] = v.astype(np.float32)
+        del g.attrs["fraction_all"]
+    problems = schema.check(run_copy)
+    assert "observables/msd/lag_time: dtype float32, expected float64" in problems
+    assert "observables/msd: attribute fraction_all missing" in problems
+
+
+def test_every_declared_field_has_unit_and_meaning():
+    units = {"length", "time", "particles", "count", "index", "1/length", "length^2", "length^2/time", "1"}
+    for d in schema.OBSERVABLES:
+        for f in d["fields"]:
+            assert f["unit"] in units and f["meaning"], (d["name"], f["name"])
+
+
+def test_reader_docstrings_come_from_the_declarations():
+    import dynhet.run
+    doc = dynhet.run.Run.chi4.__doc__
+    assert "tau4: series (records, grid) float64 [time]" in doc
+    assert dynhet.run.Run.overlap_cr.__doc__.startswith("observables/overlap_cr/a<cutoff>")
+
+
+def test_run_h5_doc_is_what_the_declarations_generate(tmp_path):
+    lcm = sorted(os.path.join(ROOT, "lcmtypes", n) for n in os.listdir(os.path.join(ROOT, "lcmtypes"))
+                 if n.endswith(".lcm"))
+    out = tmp_path / "run_h5.md"
+    subprocess.run([sys.executable, os.path.join(ROOT, "lcmtypes", "gen_observables.py"), "--doc", str(out)] + lcm,
+                   check=True)
+    with open(os.path.join(ROOT, "docs", "run_h5.md")) as f:
+        committed = f.read()
+    assert committed == out.read_text(), (
+        "docs/run_h5.md is not what lcmtypes/*.lcm declare: run "
+        "lcmtypes/gen_observables.py --doc docs/run_h5.md lcmtypes/*.lcm")
