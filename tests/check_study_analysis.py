@@ -47,7 +47,7 @@ for name, m in runs.items():
         o = f["observables"]
         tau = o["overlap/a0.6/tau_alpha/value"][-1]
         mine = {"tau_alpha": tau, "beta": o["overlap/a0.6/beta/value"][-1],
-                "D": o["msd/diffusion/value"][-1], "Z": o["sim/reduced_pressure/value"][-1]}
+                "diffusion": o["msd/diffusion/value"][-1], "Z": o["sim/reduced_pressure/value"][-1]}
         ns = o["chi4/a0.6/subbox_particles"][()]
         lag = o["chi4/a0.6/lag_time"][()]  # chi4 records are [grid][lag]
         gi = max((i for i in range(len(ns)) if ns[i] < 0.999 * m["n_particles"]), key=lambda i: ns[i])
@@ -71,7 +71,7 @@ for name, m in runs.items():
 check(not fails, f"{n_checked} per-run values in study.h5 equal those recomputed from the runs")
 for key in S["points"]:
     g = S["points"][key]
-    for k in ("tau_alpha", "beta", "D", "Z"):
+    for k in ("tau_alpha", "beta", "diffusion", "Z"):
         v = g[k][:, 0]
         check(abs(g[k].attrs["mean"] - v.mean()) <= 1e-12 * abs(v.mean()) and
               abs(g[k].attrs["seed_spread_error"] - v.std(ddof=1) / math.sqrt(len(v))) <= 1e-9 * abs(v.mean()),

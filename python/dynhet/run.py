@@ -49,6 +49,22 @@ def _text(v):
     return v.decode() if isinstance(v, bytes) else v
 
 
+def _scalar(v):
+    """A 0-d array as the Python number it is; anything else unchanged."""
+    a = np.asarray(v)
+    if a.ndim == 0 and a.dtype.kind in "fiub":
+        return a.item()
+    return v
+
+
+def _field(kind, name):
+    d = schema.declaration(kind)
+    for f in (d or {}).get("fields", []):
+        if f["name"] == name:
+            return f
+    raise KeyError(f"{kind}: no declared dataset {name!r}")
+
+
 class Observable:
     """One group of run.h5's observables (e.g. chi4 at a = 0.6)."""
 
@@ -65,13 +81,41 @@ class Observable:
         return name in self._g
 
     def __getitem__(self, name):
+        """The dataset's final record (a series) or itself (fixed): an array,
+        or a Python float or int where it is one number."""
         if name not in self._g:
             raise KeyError(f"{self.name}: no dataset {name!r}; it has {', '.join(self.names())}")
         d = self._g[name]
         if isinstance(d, h5py.Group):  # an H5MD time series: the last record
             v = d["value"]
-            return v[-1] if v.shape[0] else np.full(v.shape[1:], np.nan)
-        return d[()]
+            return _scalar(v[-1] if v.shape[0] else np.full(v.shape[1:], np.nan))
+        return _scalar(d[()])
+
+    def __dir__(self):
+        """The datasets with the methods: tab completion offers ov.q, ov.tau_alpha, ..."""
+        return sorted(set(super().__dir__()) | {n for n in self._g.keys() if n.isidentifier()})
+
+    def describe(self, name=None):
+        """What the group (or one dataset of it) is: kind, shape, dtype, unit
+        and meaning, from the observables' declarations."""
+        text = schema.describe(self.name.split("/")[0])
+        if name is None:
+            return text
+        lines = [line for line in text.splitlines() if line.strip().startswith(name + ":")]
+        if not lines:
+            raise KeyError(f"{self.name}: no declared dataset {name!r}")
+        return lines[0].strip()
+
+    def unit(self, name):
+        """The unit of a dataset (length, time, 1, ...), from its declaration."""
+        return _field(self.name.split("/")[0], name)["unit"]
+
+    def to_xarray(self, history=False):
+        """The group as an xarray.Dataset with named dimensions, units and
+        meanings (dynhet.xarray_view): the final record, or every record
+        along "record" with history=True."""
+        from .xarray_view import to_xarray
+        return to_xarray(self, history)
 
     def __getattr__(self, name):
         if name.startswith("_"):
@@ -82,10 +126,11 @@ class Observable:
             raise AttributeError(str(e)) from None
 
     def value_error(self, name):
-        """(name, name_err) as arrays (the error NaN where the run has none)."""
+        """(name, name_err): floats where the value is one number, else
+        arrays (the error NaN where the run has none)."""
         v = np.asarray(self[name], float)
         e = np.asarray(self[name + "_err"], float) if name + "_err" in self._g else np.full_like(v, np.nan)
-        return v, e
+        return (float(v), float(e)) if v.ndim == 0 else (v, e)
 
     def history(self, name):
         """Every record of a time series: (time of each record, values [record][...])."""

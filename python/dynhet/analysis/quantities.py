@@ -196,7 +196,7 @@ def oz_fit(q, s, q_max):
 # The per-run quantities by name, each run -> (value, error): what study.h5
 # records per point and what Analysis.against_phi gives.
 PER_RUN = {"tau_alpha": tau, "beta": lambda r: (cut(r)["beta"], cut(r)["beta_err"]),
-           "tau0": lambda r: (cut(r)["tau0"], cut(r)["tau0_err"]), "D": lambda r: (r["D"], r["D_err"]),
+           "tau0": lambda r: (cut(r)["tau0"], cut(r)["tau0_err"]), "diffusion": lambda r: (r["D"], r["D_err"]),
            "Z": lambda r: (r["Z"], r["Z_err"]), "chi4_tau_alpha": chi4_at_tau, "xi_tau_alpha": xi_at_tau,
            "chi0_tau_alpha": chi0_at_tau,
            "d_f_slow": lambda r: (cut(r)["cl_slow_d_f"], cut(r)["cl_slow_d_f_err"]),

@@ -2,6 +2,7 @@
 import math
 import os
 import tomllib
+from typing import NamedTuple
 
 import matplotlib.pyplot as plt
 import numpy as np
@@ -12,6 +13,23 @@ from .config import A_MAIN, EPS_MAIN
 from .runs import read_run
 from .points import Point, ensure_calibrated, point_error
 from .quantities import PER_RUN
+
+
+class PhiSeries(NamedTuple):
+    """A per-run quantity against the packing fraction over one series of a
+    study (Analysis.against_phi); unpacks as (phi, value, error, seeds)."""
+    phi: np.ndarray
+    """(n_phi,) the packing fractions, increasing."""
+    value: np.ndarray
+    """(n_phi,) the mean over the point's seeds."""
+    error: np.ndarray
+    """(n_phi,) its error (the runs' own, scaled to the seeds' spread where they scatter more; NaN: none)."""
+    seeds: np.ndarray
+    """(n_phi,) how many seeds (complete runs) each point has."""
+
+
+# A run's dataset name -> the study's name of the same quantity.
+QUANTITY_ALIASES = {"D": "diffusion"}
 
 
 def drawable(ax):
@@ -244,11 +262,15 @@ class Analysis:
         return min(pts, key=lambda p: abs(p.phi - phi)) if pts else None
 
     def against_phi(self, quantity, pairs="neighbours", eps=EPS_MAIN, N=None):
-        """A per-run quantity (a name of quantities.PER_RUN: tau_alpha, D,
-        chi4_tau_alpha, xi_tau_alpha, d_f_slow, ...) against phi over one
-        series: arrays (phi, mean over seeds, its error, seeds)."""
+        """A per-run quantity against phi over one series: a PhiSeries of
+        arrays (phi, value: the mean over seeds, error, seeds), one entry per
+        density. quantity: a name of quantities.PER_RUN (tau_alpha, beta,
+        tau0, diffusion, chi4_tau_alpha, xi_tau_alpha, d_f_slow, tau_b, ...);
+        a run's dataset names are the study's (diffusion is msd's, D is
+        accepted for it)."""
+        quantity = QUANTITY_ALIASES.get(quantity, quantity)
         if quantity not in PER_RUN:
-            raise KeyError(f"no quantity {quantity!r}; known: {', '.join(PER_RUN)}")
+            raise KeyError(f"no quantity {quantity!r}; known: {', '.join(sorted(PER_RUN))}")
         pts = self.series(pairs, eps, N)
         if not pts:  # a series the study lacks: said, not empty arrays
             have = sorted({(k[0], k[1], k[3]) for k in self.points})
@@ -256,9 +278,8 @@ class Analysis:
                            + (f", N = {N}" if N is not None else "") + " in this study; it has "
                            + ("; ".join(f"pairs = {q!r}, eps = {e!r}, N = {n}" for q, e, n in have) or "no complete run"))
         ms = [p.mean(PER_RUN[quantity]) for p in pts]
-        return (np.array([p.phi for p in pts]), np.array([m[0] for m in ms]), np.array([point_error(m) if m[3] else np.nan
-                                                                                     for m in ms]),
-                np.array([m[3] for m in ms]))
+        return PhiSeries(np.array([p.phi for p in pts]), np.array([m[0] for m in ms]),
+                         np.array([point_error(m) if m[3] else np.nan for m in ms]), np.array([m[3] for m in ms]))
 
     def save(self, fig, name):
         os.makedirs(self.figdir, exist_ok=True)
