@@ -9,7 +9,8 @@
 Lengths are in units of the small disks' radius r1 = 1 (the paper's unit);
 times in the run's time unit (kinetic energy per particle 1 at t = 0).
 Species 0 are the small disks (radius 1, mass 1), species 1 the large ones
-(radius = the scene's system.radius_ratio, mass its square)."""
+(radius the scene's system.radius_ratio, mass its square), as the
+simulator resolved them (parameters/run_info)."""
 from dataclasses import dataclass
 
 import numpy as np
@@ -48,8 +49,12 @@ class Frame:
         return np.column_stack([p, np.zeros(len(p))])
 
 
-def radius_ratio(run):
-    return float(run.parameters.get("system", {}).get("radius_ratio", 1.43))
+def species_table(run):
+    """(radius, mass) of each species as the simulator resolved them
+    (parameters/run_info: the scene's radius ratio or its default, never a
+    copy of the default here)."""
+    info = run._f["parameters/run_info"].attrs
+    return np.asarray(info["radius"], float), np.asarray(info["mass"], float)
 
 
 def frame_count(run):
@@ -67,7 +72,7 @@ def frames(run, start=0, stop=None, step=1):
     pa = run._f["particles/all"]
     box = np.asarray(pa["box/edges"][()], float)
     species = np.asarray(pa["species"][()], np.int32)
-    radii = np.where(species == 1, radius_ratio(run), 1.0)
+    radii = species_table(run)[0][species]
     pos, img = pa["position"], pa["image"]
     for i in range(*slice(start, stop, step).indices(frame_count(run))):
         yield Frame(index=i, step=int(pos["step"][i]), time=float(pos["time"][i]), box=box,
@@ -81,7 +86,7 @@ def export_gsd(run, path, start=0, stop=None, step=1):
     masses, types "small" and "large". MDAnalysis, OVITO and HOOMD read it.
     Returns the number of frames written."""
     import gsd.hoomd
-    ratio = radius_ratio(run)
+    masses = species_table(run)[1]
     n = 0
     with gsd.hoomd.open(str(path), mode="wb") as out:
         for fr in frames(run, start, stop, step):
@@ -95,7 +100,7 @@ def export_gsd(run, path, start=0, stop=None, step=1):
             s.particles.position = fr.positions3d(centred=True).astype(np.float32)
             s.particles.image = np.column_stack([fr.images, np.zeros(len(fr.species), np.int32)]).astype(np.int32)
             s.particles.diameter = (2 * fr.radii).astype(np.float32)
-            s.particles.mass = np.where(fr.species == 1, ratio * ratio, 1.0).astype(np.float32)
+            s.particles.mass = masses[fr.species].astype(np.float32)
             s.log["dynhet/time"] = np.array([fr.time])
             out.append(s)
             n += 1

@@ -161,7 +161,6 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
         shown.append(p)
         r = next(r for r in p.runs if r.get("has_frames"))
         xy, sp, slow, fast, box, lag = snapshot(r["path"], A_MAIN, cut(r)["tau_alpha"])
-        rad = np.where(sp == 0, 1.0, 1.43)
         ax[k].scatter(xy[:, 0], xy[:, 1], s=0.2, c="#dddddd")
         ax[k].scatter(xy[slow, 0], xy[slow, 1], s=1.2, c="#b2182b", label=f"slow ({slow.mean():.2f})")
         ax[k].scatter(xy[fast, 0], xy[fast, 1], s=1.2, c="#555555", label=f"fast ({fast.mean():.2f})")
@@ -170,7 +169,6 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
         ax[k].set_ylim(0, box[1])
         ax[k].set_title(f"φ = {p.phi:g}, t = {lag:.3g} (τ_α = {cut(r)['tau_alpha']:.3g})", fontsize=9)
         ax[k].legend(fontsize=7, loc="upper right")
-        del rad
     f3 = A.save(fig, "snapshots.png")
     A.row("snapshots of slow and fast particles at τ_α, three densities", "3.3, fig. SD-2", "figure only",
           ", ".join(f"φ = {p.phi:g}" for p in shown) or "no run kept its frames", "figure", f3, shown)
