@@ -6,6 +6,7 @@
 #include "dynhet/flow_control.hpp"
 #include "dynhet/lcm_guard.hpp"
 #include "dynhet/message_checks.hpp"
+#include "dynhet/run_info_scene.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -181,6 +182,16 @@ void FrameNode::on_run(const run_info_t& mm) {
     std::fprintf(stderr, "%s_node: warning: the socket buffer holds less than a frame (%.1f MiB): frames may be "
                  "lost if this node is off the CPU while one arrives; raise net.core.rmem_max or run as root\n",
                  name_.c_str(), want / 1048576.0);
+  // A re-analysis: the analysis of its file in place of the recorded one
+  // (what decided the frames, and so the lines above, stays the recording's).
+  if (!reanalysis_origin_.empty()) {
+    try {
+      apply_reanalysis(*info_, reanalysis_, reanalysis_origin_);
+    } catch (const std::exception& e) {
+      finish(1, e.what());
+      return;
+    }
+  }
   try {
     start(*info_); // the node may keep references into it: the copy lives as long as the node
   } catch (const std::exception& e) {

@@ -78,6 +78,13 @@ public:
   // and what it dropped or saw (a stalled receive loop) names the cause of
   // lost frames.
   void attach_inbox(Inbox* inbox) { inbox_ = inbox; }
+  // A re-analysis (dynhet/reanalysis.hpp): the run info, once checked,
+  // goes with the analysis of this TOML text (`origin` names its file) in
+  // place of the recorded one. Changes to what decided the frames fail the
+  // node before it computes anything.
+  void set_reanalysis(std::string analysis_toml, std::string origin) {
+    reanalysis_ = std::move(analysis_toml), reanalysis_origin_ = std::move(origin);
+  }
   // Tests: sleep this long on every frame, a stand-in for heavy physics.
   void set_frame_delay(double seconds) { frame_delay_ = seconds; }
   // One message from the inbox, to its raw handler by channel.
@@ -193,6 +200,7 @@ private:
     ar(origins_, last_frame_, last_time_, pairs_done_, assembler_, status_.messages_rejected, status_.chunks_rejected,
        status_.last_rejection, status_.messages_unauthenticated);
   }
+  std::string reanalysis_, reanalysis_origin_;
   std::string cut_dir_;
   int resume_cut_ = -1, signal_ = 0;
   Clock::time_point signalled_at_;

@@ -10,6 +10,8 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <thread>
 
 #include <CLI/CLI.hpp>
@@ -19,6 +21,15 @@ namespace dynhet {
 namespace {
 
 std::atomic<int> g_node_signal{0};
+
+bool read_text_file(const std::string& path, std::string& text) {
+  std::ifstream in(path);
+  if (!in) return false;
+  std::stringstream buf;
+  buf << in.rdbuf();
+  text = buf.str();
+  return true;
+}
 void on_node_signal(int sig) { g_node_signal = sig; }
 
 // The receive thread: LCM's handle loop on the input bus, copying each
@@ -114,7 +125,16 @@ int node_main(const std::string& program, const std::string& description, NodeFa
                  "save this node's part of each checkpoint cut the sim asks for here (docs/checkpoints.md); "
                  "SIGTERM/SIGINT then stop the node after the next cut");
   app.add_option("--resume-cut", resume_cut, "resume from this cut of --checkpoint-dir");
+  std::string analysis_path;
+  app.add_option("--analysis", analysis_path,
+                 "re-analysis: go by the recorded run's scene with the analysis tables and keys of this TOML in "
+                 "place (cutoffs a, sub-box sizes, cage-relative, observables; dynhet/reanalysis.hpp)");
   CLI11_PARSE(app, argc, argv);
+  std::string analysis_toml;
+  if (!analysis_path.empty() && !read_text_file(analysis_path, analysis_toml)) {
+    std::fprintf(stderr, "%s: cannot read %s\n", program.c_str(), analysis_path.c_str());
+    return 2;
+  }
   if (resume_cut >= 0 && checkpoint_dir.empty()) {
     std::fprintf(stderr, "%s: --resume-cut needs --checkpoint-dir\n", program.c_str());
     return 2;
@@ -140,6 +160,7 @@ int node_main(const std::string& program, const std::string& description, NodeFa
   inbox.set_bound(kQueueMin); // until the run info sizes it (frames come only after it)
   node->attach_inbox(&inbox);
   node->set_frame_delay(frame_delay);
+  if (!analysis_path.empty()) node->set_reanalysis(analysis_toml, analysis_path);
   if (!checkpoint_dir.empty()) {
     node->set_checkpointing(checkpoint_dir, resume_cut);
     std::signal(SIGINT, on_node_signal);

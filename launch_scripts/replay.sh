@@ -6,7 +6,7 @@
 # status it reads from the log too).
 #
 # Usage: launch_scripts/replay.sh LOG [LOG2 ...] --out DIR [--run-id ID] [--key-file KEY]
-#                                 [--only-verified] [--no-build]
+#                                 [--only-verified] [--analysis FILE.toml] [--no-build]
 #        several logs: the segments of one run interrupted and resumed
 #        (run_scene.sh --record LOG writes LOG, LOG.2, ...), in order; they
 #        are played as one (a frame the next segment publishes again, from
@@ -32,12 +32,26 @@
 # Exit: 0 replayed; 1 a process failed; 2 bad arguments, a log refused or a
 # refused DIR (nothing written); 130 interrupted (the same command replays
 # again). The last line says where and the exit.
+#   --analysis FILE  re-analyse the run with another analysis section: FILE
+#                    is a TOML of analysis tables and keys only ([observables]
+#                    compute, cutoff_a, cage_relative, cage; [overlap], [chi4],
+#                    [s4], [clusters], [msd], [displacement], [bond_breaking])
+#                    that replace the recorded scene's for the nodes and the
+#                    recorder. What decided the recorded frames ([system],
+#                    [driving], [run], [schedule], [transport],
+#                    observables.keep_frames) is refused by name (exit 2)
+#                    before anything runs. The new run.h5's parameters/ hold
+#                    the changed scene, and parameters/reanalysis says whose
+#                    re-analysis it is (of_run_id, the file and its text, the
+#                    recorded scene). At the recorded settings the results
+#                    equal the live run's bit for bit. Messages are checked
+#                    against the run's key all the same
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 build=${BUILD_DIR:-$root/build}
 bin=$build/bin
 
-log="" out="" build_first=1 run_id="" list=0 segments=() key_file="" only_verified=0 checked=0 fresh=0
+log="" out="" build_first=1 run_id="" list=0 segments=() key_file="" only_verified=0 checked=0 fresh=0 analysis=""
 while (($#)); do
   case "$1" in
   --out) out=$2; shift 2 ;;
@@ -46,6 +60,7 @@ while (($#)); do
   --key-file) key_file=$2; shift 2 ;;
   --only-verified) only_verified=1; shift ;;
   --fresh) fresh=1; shift ;;
+  --analysis) analysis=$2; shift 2 ;;
   --log-checked) checked=1; shift ;; # internal: the first pass checked LOG (the re-run in the namespace)
   --list) list=1; shift ;;
   -h | --help) awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; exit 0 ;;
@@ -94,6 +109,18 @@ fi
 runs=$root/launch_scripts/lcmlog_runs.py
 if ((list)); then exec /usr/bin/python3 "$runs" "$log"; fi
 [[ -n $out ]] || { echo "usage: replay.sh LOG --out DIR [--run-id ID]" >&2; exit 2; }
+# A re-analysis: what the file may not change is refused before anything
+# is written (the recorder applies it to the run info of the log, as every
+# process of the replay will).
+if [[ -n $analysis ]]; then
+  [[ -f $analysis ]] || { echo "replay: no analysis file $analysis" >&2; exit 2; }
+  analysis=$(cd "$(dirname "$analysis")" && pwd)/$(basename "$analysis")
+  if ((checked == 0)); then
+    ((build_first)) && { BUILD_DIR=$build "$root/launch_scripts/setup.sh"; build_first=0; }
+    "$bin/recorder" --list-nodes "$log" --analysis "$analysis" ${run_id:+--run-id "$run_id"} >/dev/null ||
+      { echo "replay: refused: $analysis cannot re-analyse the run of $log" >&2; exit 2; }
+  fi
+fi
 # With --only-verified the run is chosen among the messages that verify
 # (a log of two runs, with one run's key, is then that run's).
 if [[ -z $run_id && $only_verified == 0 ]]; then
@@ -139,7 +166,7 @@ out=$(cd "$out" && pwd)
 if [[ -z ${DYNHET_IN_NETNS:-} ]]; then
   ((build_first)) && BUILD_DIR=$build "$root/launch_scripts/setup.sh"
   exec "$root/launch_scripts/netns.sh" "$0" "$log" --out "$out" --run-id "$run_id" --key-file "$key_file" --no-build \
-    --log-checked
+    --log-checked ${analysis:+--analysis "$analysis"}
 fi
 
 # Which nodes ran: the observables named in the run info of the log. The
@@ -148,17 +175,19 @@ fi
 trap 'rc=$?; [[ -z ${rec:-} ]] || kill "$rec" 2>/dev/null || true
   case $rc in 0 | 1 | 2 | 130) ;; *) rc=1 ;; esac; echo "replay: results in $out (exit $rc)" >&2; exit $rc' EXIT
 trap 'echo "replay: interrupted" >&2; exit 130' INT TERM
-nodes=$("$bin/recorder" --list-nodes "$log") || { echo "replay: cannot read run info from $log" >&2; exit 1; }
+reanalysis=()
+[[ -z $analysis ]] || reanalysis=(--analysis "$analysis")
+nodes=$("$bin/recorder" --list-nodes "$log" --run-id "$run_id" "${reanalysis[@]}") || { echo "replay: cannot read run info from $log" >&2; exit 1; }
 bus="udpm://239.255.76.67:7670?ttl=0&recv_buf_size=4194304"
 
 "$bin/recorder" --lcm-url "$bus" --from-log "$log" --out "$out/run.h5" --run-id "$run_id" --key-file "$key_file" --bus-epoch any \
-  2>"$out/recorder.log" &
+  "${reanalysis[@]}" 2>"$out/recorder.log" &
 rec=$!
 for _ in $(seq 100); do grep -q ready "$out/recorder.log" && break; sleep 0.1; done
 status=0
 for n in $nodes; do
   "$bin/$n" --lcm-url "file://$log?speed=0" --publish-url "$bus" --run-id "$run_id" --key-file "$key_file" --bus-epoch any \
-    2>"$out/$n.log" || {
+    "${reanalysis[@]}" 2>"$out/$n.log" || {
     echo "replay: $n failed; log $out/$n.log" >&2; tail -3 "$out/$n.log" >&2; status=1; }
 done
 wait $rec || { echo "replay: recorder failed; log $out/recorder.log" >&2; tail -3 "$out/recorder.log" >&2; status=1; }

@@ -257,6 +257,17 @@ void H5mdWriter::write_parameters(const std::string &scene_toml) {
   impl_->changed();
 }
 
+void H5mdWriter::write_reanalysis(int64_t run_id, const std::string &analysis_file,
+                                  const std::string &analysis_toml, const std::string &recorded_scene_toml) {
+  h5::Id params = h5::require_group(impl_->open_file(), "parameters");
+  h5::Id g = h5::require_group(params, "reanalysis");
+  h5::write_string_dataset(g, "analysis_toml", analysis_toml);
+  h5::write_string_dataset(g, "recorded_scene_toml", recorded_scene_toml);
+  impl_->changed();
+  set_attribute("parameters/reanalysis", "of_run_id", run_id);
+  set_attribute("parameters/reanalysis", "analysis_file", analysis_file);
+}
+
 void H5mdWriter::set_particles(const std::string &group, double box_length,
                                const std::vector<int32_t> &species) {
   if (!(box_length > 0) || species.empty())

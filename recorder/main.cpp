@@ -12,7 +12,13 @@
 // ignores it when it reads the nodes' status.
 //
 // `recorder --list-nodes LOG` prints the analysis nodes the run in an
-// lcm-logger log needs (for replays) and exits.
+// lcm-logger log needs (for replays) and exits; with --analysis FILE, those
+// of its re-analysis, or (exit 2) what the file may not change, by name.
+//
+// --analysis FILE (with --from-log): a re-analysis of the recorded run
+// (dynhet/reanalysis.hpp): the run info, once checked, goes with the
+// analysis tables and keys of FILE in place, and parameters/reanalysis says
+// whose re-analysis the file is.
 //
 // Exit: 0 complete; 1 incomplete (sim failed, results missing after
 // --timeout, no run info within --wait-run); 2 interrupted (SIGINT or
@@ -26,6 +32,8 @@
 #include <atomic>
 #include <csignal>
 #include <cstdio>
+#include <fstream>
+#include <sstream>
 #include <optional>
 #include <string>
 
@@ -38,6 +46,7 @@
 #include "dynhet/lcm_guard.hpp"
 #include "dynhet/lcm_url.hpp"
 #include "dynhet/message_checks.hpp"
+#include "dynhet/run_info_scene.hpp"
 #include "dynhet/scene.hpp"
 #include "session.hpp"
 
@@ -48,7 +57,8 @@ void on_signal(int sig) { g_signal = sig; }
 
 // The nodes the run in `log_path` needs, named as the launch scripts
 // start them ("overlap" -> overlap_node), on one line.
-int list_nodes(const std::string &log_path) {
+int list_nodes(const std::string &log_path, int64_t run_id, const std::string &analysis_path,
+               const std::string &analysis_toml) {
   lcm::LogFile log(log_path, "r");
   if (!log.good()) {
     std::fprintf(stderr, "recorder: cannot read the log %s\n", log_path.c_str());
@@ -61,8 +71,16 @@ int list_nodes(const std::string &log_path) {
     // (the replayed run's processes check every message).
     if (e->channel != dynhet::kChanRun ||
         !dynhet::guard::safe_decode(e->data, static_cast<int>(dynhet::lcm_bytes_of(e->data, e->datalen)), run, why) ||
-        !dynhet::run_info_problem(run).empty())
+        !dynhet::run_info_problem(run).empty() || (run_id && run.run_id != run_id))
       continue;
+    if (!analysis_path.empty()) {
+      try {
+        dynhet::apply_reanalysis(run, analysis_toml, analysis_path);
+      } catch (const std::exception &e) {
+        std::fprintf(stderr, "recorder: %s\n", e.what());
+        return 2;
+      }
+    }
     std::string line;
     for (const std::string &n : dynhet::nodes_for(run.observables)) line += (line.empty() ? "" : " ") + n;
     std::printf("%s\n", line.c_str());
@@ -104,8 +122,20 @@ int main(int argc, char **argv) {
                  "tests: sleep this long (s) for each message taken from the bus, a recorder that falls behind");
   app.add_option("--list-nodes", list_log,
                  "print the analysis nodes the run in this lcm-logger log needs, and exit");
+  app.add_option("--analysis", o.analysis,
+                 "re-analysis: the recorded run's scene with the analysis tables and keys of this TOML in place "
+                 "(cutoffs a, sub-box sizes, cage-relative, observables); the file says so in parameters/reanalysis");
   CLI11_PARSE(app, argc, argv);
-  if (!list_log.empty()) return list_nodes(list_log);
+  if (!o.analysis.empty()) {
+    std::ifstream in(o.analysis);
+    std::stringstream text;
+    if (!in || !(text << in.rdbuf())) {
+      std::fprintf(stderr, "recorder: cannot read %s\n", o.analysis.c_str());
+      return 2;
+    }
+    o.analysis_toml = text.str();
+  }
+  if (!list_log.empty()) return list_nodes(list_log, o.run_id, o.analysis, o.analysis_toml);
   if (o.out.empty()) return app.exit(CLI::RequiredError("--out"));
   const std::optional<dynhet::Bus> bus = dynhet::bus_or_say("recorder", o.bus);
   if (!bus) return 2;

@@ -7,6 +7,7 @@
 
 #include "dynhet/lcm_url.hpp"
 #include "dynhet/model.hpp"
+#include "dynhet/run_info_scene.hpp"
 #include "run_recorder_util.hpp"
 
 namespace dynhet {
@@ -101,8 +102,13 @@ void RunRecorder::stop_writing(const std::string &why) {
   }
 }
 
-bool RunRecorder::on_run(const run_info_t &m) {
+bool RunRecorder::on_run(const run_info_t &recorded) {
   if (info_) return false;
+  run_info_t m = recorded;
+  if (!reanalysis_file_.empty()) {
+    recorded_scene_ = recorded.scene_toml;
+    apply_reanalysis(m, reanalysis_, reanalysis_file_);
+  }
   writer_ =
       std::make_unique<H5mdWriter>(out_path_, "dynhet recorder", creator_version_, author_, author_email_);
   info_ = std::make_unique<run_info_t>(m);
@@ -121,6 +127,8 @@ void RunRecorder::write_run_info(const run_info_t &m) {
     writer_->set_attribute("", "missing", std::string("the recorder did not finish the file (killed?)"));
   });
   guarded("parameters", [&] { writer_->write_parameters(m.scene_toml); });
+  if (!reanalysis_file_.empty())
+    guarded("re-analysis", [&] { writer_->write_reanalysis(m.run_id, reanalysis_file_, reanalysis_, recorded_scene_); });
   guarded("particles", [&] {
     const auto sp = dynhet::species_by_rule(m.n_particles, m.n_small);
     writer_->set_particles("all", m.box_length, std::vector<int32_t>(sp.begin(), sp.end()));

@@ -77,6 +77,13 @@ public:
   // (message_rejected). on_run creates the file on the first run info and
   // throws if it cannot.
   bool on_run(const run_info_t &m);
+  // A re-analysis (dynhet/reanalysis.hpp): on_run goes by the recorded run
+  // info with the analysis of this TOML text in place (throwing, before
+  // the file is made, what it refuses), and the file says whose
+  // re-analysis it is (H5mdWriter::write_reanalysis).
+  void set_reanalysis(std::string analysis_toml, std::string analysis_file) {
+    reanalysis_ = std::move(analysis_toml), reanalysis_file_ = std::move(analysis_file);
+  }
   bool on_sim_status(const sim_status_t &m);
   bool on_node_status(const node_status_t &m);
   // A result of any declared type (DYNHET_RESULT_TYPES: overlap_t, ...),
@@ -129,6 +136,7 @@ private:
 
   std::string out_path_, creator_version_, author_, author_email_;
   std::unique_ptr<run_info_t> info_;
+  std::string reanalysis_, reanalysis_file_, recorded_scene_;
   std::unique_ptr<H5mdWriter> writer_;
   Completion completion_;
   FrameAssembler assembler_{1};

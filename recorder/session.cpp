@@ -55,7 +55,7 @@ void Session::take_run(const dynhet::run_info_t &m) {
     return reject(dynhet::kChanRun, "run info: " + bad);
   try {
     if (!rec_.on_run(m)) return;
-    if (cuts_) cuts_->set_run(m);
+    if (cuts_) cuts_->set_run(*rec_.run_info()); // the run info it goes by (a re-analysis: the changed scene)
   } catch (const std::exception &e) {
     fatal_ = e.what(); // the file cannot be written
     return;

@@ -42,6 +42,7 @@ struct Options {
   std::string checkpoint_dir;
   int resume_cut = -1;
   double cut_wait = 300; // after a signal: how long to wait for the next cut
+  std::string analysis, analysis_toml; // re-analysis: the analysis file and its text
   double test_message_delay = 0; // tests: seconds of sleep per message taken from the bus (a recorder behind)
   dynhet::BusOptions bus;
 };
@@ -63,6 +64,7 @@ public:
   Session(lcm::LCM &lcm, dynhet::Bus bus, const Options &o, const std::atomic<int> &signal)
       : lcm_(lcm), bus_(std::move(bus)), opt_(o), rec_(o.out, DYNHET_VERSION, o.author, o.author_email),
         start_(Clock::now()), signal_(signal) {
+    if (!o.analysis.empty()) rec_.set_reanalysis(o.analysis_toml, o.analysis);
     if (!o.checkpoint_dir.empty()) cuts_ = std::make_unique<dynhet::RecorderCuts>(lcm, bus_, o.checkpoint_dir);
   }
 

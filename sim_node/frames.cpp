@@ -7,6 +7,7 @@
 #include <thread>
 
 #include "dynhet/model.hpp"
+#include "dynhet/run_info_scene.hpp"
 #include "dynhet/stats.hpp"
 
 namespace dynhet {
@@ -28,13 +29,7 @@ run_info_t make_run_info(const Scene& sc, const engine::Engine& e, const FrameSc
   m.n_lags = static_cast<int32_t>(m.lag_time.size());
   m.pair_frame = s.pair_frame;
   m.n_pairs = static_cast<int32_t>(m.pair_frame.size());
-  m.cutoff_a = sc.cutoff_a;
-  m.n_cutoffs = static_cast<int32_t>(m.cutoff_a.size());
-  m.observables = sc.computed_observables();
-  m.n_observables = static_cast<int32_t>(m.observables.size());
-  m.overlap_subbox_particles = sc.overlap_subbox_particles;
-  m.chi4_subbox_particles = sc.chi4_subbox_particles;
-  m.n_chi4_sizes = static_cast<int32_t>(m.chi4_subbox_particles.size());
+  set_analysis_fields(m, sc);
   m.keep_frames = sc.keep_frames;
   m.chunk_particles = sc.chunk_particles;
   m.scene_toml = sc.text;

@@ -28,3 +28,8 @@ add_executable(test_cut_coordinator ${CMAKE_CURRENT_SOURCE_DIR}/test_cut_coordin
 target_include_directories(test_cut_coordinator PRIVATE ${PROJECT_SOURCE_DIR}/sim_node)
 target_link_libraries(test_cut_coordinator PRIVATE dynhet_common dynhet_lcmtypes GTest::gtest_main)
 gtest_discover_tests(test_cut_coordinator DISCOVERY_TIMEOUT 30 PROPERTIES LABELS unit)
+# Re-analysis scenes (dynhet/reanalysis.hpp): merge, refusals by name, the
+# recorded text back at the original settings.
+add_executable(test_reanalysis ${CMAKE_CURRENT_SOURCE_DIR}/test_reanalysis.cpp)
+target_link_libraries(test_reanalysis PRIVATE dynhet_common GTest::gtest_main)
+gtest_discover_tests(test_reanalysis DISCOVERY_TIMEOUT 30 PROPERTIES LABELS unit)

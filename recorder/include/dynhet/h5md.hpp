@@ -70,6 +70,13 @@ public:
   // per key. The text is kept even when it is not valid TOML, then this
   // throws.
   void write_parameters(const std::string &scene_toml);
+  // A re-analysis of recorded run `run_id` (dynhet/reanalysis.hpp):
+  // parameters/reanalysis says so, with the analysis file's name
+  // (attributes of_run_id, analysis_file) and text (analysis_toml) and the
+  // recorded scene (recorded_scene_toml); parameters/scene_toml holds the
+  // scene the re-analysis went by.
+  void write_reanalysis(int64_t run_id, const std::string &analysis_file, const std::string &analysis_toml,
+                        const std::string &recorded_scene_toml);
 
   // particles/<group>/{box, species} for a square periodic 2D box of side
   // `box_length`. Must come before append_frame for that group.
