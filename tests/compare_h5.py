@@ -11,8 +11,9 @@ What a run's wall clock decides, and so is compared only where it is not the clo
   compared (the final result), the earlier ones are the clock's.
 
 Usage: compare_h5.py A.h5 B.h5 [--verbose] [--ignore PATH]...
-  --ignore PATH  leave out a dataset (parameters/scene_toml) or an attribute (parameters/system@initial_state):
-                 runs of two study directories name their own prepared states
+  --ignore PATH  leave out a dataset (parameters/scene_toml), an attribute (parameters/system@initial_state) or a
+                 group and all it holds (parameters/reanalysis, which only a re-analysis has): runs of two study
+                 directories name their own prepared states
 """
 import sys
 
@@ -48,6 +49,8 @@ def compare(pa, pb, verbose=False, ignore=()):
     with h5py.File(pa, "r") as fa, h5py.File(pb, "r") as fb:
         ia, ib = items(fa), items(fb)
         for k in sorted(ia.keys() ^ ib.keys()):
+            if any(k == i or k.startswith(i + "/") for i in ignore):
+                continue
             bad.append(f"{k}: only in {'A' if k in ia else 'B'}")
         for k in sorted(ia.keys() & ib.keys()):
             a, b = ia[k], ib[k]

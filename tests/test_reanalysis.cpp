@@ -90,7 +90,7 @@ TEST(Reanalysis, WhatDecidedTheFramesIsRefusedByName) {
   // Every refused key is named, the allowed ones not.
   const std::string err = error_of("[observables]\ncutoff_a = [0.5]\n[system]\nn_particles = 400\nseed = 8\n");
   EXPECT_NE(err.find("system.n_particles, system.seed"), std::string::npos) << err;
-  EXPECT_EQ(err.find("cutoff_a"), err.find("[observables] compute, cutoff_a")) << err;
+  EXPECT_EQ(err.find("observables.cutoff_a"), std::string::npos) << err;
 }
 
 TEST(Reanalysis, TheMergedSceneIsCheckedLikeAnyScene) {
