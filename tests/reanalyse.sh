@@ -9,7 +9,7 @@
 #    there, the a = 0.6 results equal the live run's bit for bit, and
 #    parameters/ hold the changed scene;
 #  - a change to what decided the frames (system.n_particles,
-#    schedule.lag_max) is refused by name, exit 2, and nothing is written.
+#    schedule.lag_max) is refused by name, exit 2, and no result is written.
 # Private network namespaces throughout (run_scene.sh and replay.sh).
 set -euo pipefail
 root=$1 build=$2
@@ -75,7 +75,7 @@ for change in "system n_particles 400" "schedule lag_max 20.0"; do
   read -r table key value <<<"$change"
   printf '[observables]\ncutoff_a = [0.8]\n[%s]\n%s = %s\n' "$table" "$key" "$value" >"$tmp/bad.toml"
   replay --out "$tmp/bad_$key" --analysis "$tmp/bad.toml" >"$tmp/bad_$key.log" 2>&1 && rc=0 || rc=$?
-  check '[[ $rc == 2 ]] && grep -q "refused: $table.$key" "$tmp/bad_$key.log" && [[ ! -e $tmp/bad_$key ]]' \
+  check '[[ $rc == 2 ]] && grep -q "refused: $table.$key" "$tmp/bad_$key.log" && [[ ! -e $tmp/bad_$key/run.h5 && ! -e $tmp/bad_$key/recorder.log ]]' \
     "$table.$key refused by name, exit $rc, nothing written"
 done
 ((fail == 0)) || for f in "$tmp"/*.log "$tmp"/*.cmp; do echo "== $f"; tail -n 15 "$f"; done
