@@ -312,6 +312,7 @@ int main(int argc, char** argv) {
       out(next_frame, phase, next_slot, kind);
       if (between) {
         dynhet::engine::Snapshot snap = eng.snapshot();
+        out.reserve(snap.bytes() + 4096);
         out(snap);
       } else {
         dynhet::engine::State st = eng.state();

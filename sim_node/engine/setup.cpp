@@ -261,7 +261,7 @@ Snapshot Engine::snapshot() const {
   s.id = id_;
   s.image_x = image_x_;
   s.image_y = image_y_;
-  s.last_collision = last_collision_;
+  if (p_.tc > 0) s.last_collision = last_collision_;
   s.centres.resize(2 * static_cast<size_t>(n_));
   for (long i = 0; i < n_; ++i) s.centres[2 * i] = centre_[i].x, s.centres[2 * i + 1] = centre_[i].y;
   nbr_.save(s.neighbours);
@@ -278,7 +278,7 @@ void Engine::restore_snapshot(const Snapshot& s) {
     throw std::invalid_argument("engine: a snapshot that does not fit this run: " + why);
   };
   if (s.particles.size() != n * sizeof(Particle) || s.id.size() != n || s.image_x.size() != n ||
-      s.image_y.size() != n || s.last_collision.size() != n || s.centres.size() != 2 * n)
+      s.image_y.size() != n || s.last_collision.size() != (p_.tc > 0 ? n : 0) || s.centres.size() != 2 * n)
     refuse("its arrays are not of " + std::to_string(n) + " particles");
   if (!std::isfinite(s.now) || !std::isfinite(s.offset) || s.events_since_rebase < 0)
     refuse("its clock is not finite");
@@ -304,7 +304,8 @@ void Engine::restore_snapshot(const Snapshot& s) {
   id_ = s.id;
   image_x_ = s.image_x;
   image_y_ = s.image_y;
-  last_collision_ = s.last_collision;
+  if (p_.tc > 0) last_collision_ = s.last_collision;
+  else last_collision_.assign(n, -kNever);
   const auto limit = static_cast<int32_t>(n_);
   if (!nbr_.load(n, s.neighbours, limit)) refuse("its neighbour lists are malformed");
   if (!kick_nbr_.load(kick_lists() ? n : 0, s.kick_lists, limit)) refuse("its kick lists are malformed");

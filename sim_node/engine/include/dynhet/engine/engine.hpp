@@ -177,10 +177,16 @@ struct Snapshot {
   int64_t events_since_rebase = 0;
   std::vector<uint8_t> particles;
   std::vector<int32_t> id, image_x, image_y;
-  std::vector<double> last_collision, centres; // centres: x0 y0 x1 y1 ...
+  std::vector<double> last_collision; // empty with the TC model off (every one is -inf then)
+  std::vector<double> centres;        // x0 y0 x1 y1 ...
   std::vector<int32_t> neighbours, kick_lists, cells; // rows: count, then members
   uint64_t rng[4] = {0, 0, 0, 0};
   Counters counters;
+  size_t bytes() const {
+    return particles.size() + 4 * (id.size() + image_x.size() + image_y.size() + neighbours.size() +
+                                   kick_lists.size() + cells.size()) +
+           8 * (last_collision.size() + centres.size()) + 256;
+  }
   template <class Ar> void state(Ar& ar) {
     ar(now, offset, kick_time, events_since_rebase, particles, id, image_x, image_y, last_collision, centres,
        neighbours, kick_lists, cells, rng, counters);
