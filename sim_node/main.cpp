@@ -452,17 +452,20 @@ int main(int argc, char** argv) {
         if (cuts) cuts->poll();
       }
       advance(sched.frame_time[f]);
+      // A signal seen at frame f's time, f not yet published (at small N a
+      // frame may come sooner than a slice ends): the cut after f - 1.
+      auto stop_before_frame = [&] {
+        std::fprintf(stderr, "\nsim_node: signal %d: a checkpoint cut at t=%.10g, before frame %d\n",
+                     g_signal.load(), eng.time(), f);
+        stop_with_cut(true);
+      };
+      if (stop_between()) stop_before_frame();
       const auto t_wait = Clock::now();
       pacer.before_frame(f, [&] {
         if (seconds_since(last_info) > 2.0) publish_info();
         if (cuts) cuts->poll();
         rep.update(eng, t_end - eng.time());
-        if (stop_between()) {
-          // At frame f's time, f not yet published: the cut after f - 1.
-          std::fprintf(stderr, "\nsim_node: signal %d: a checkpoint cut at t=%.10g, before frame %d\n",
-                       g_signal.load(), eng.time(), f);
-          stop_with_cut(true);
-        }
+        if (stop_between()) stop_before_frame();
         if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
       });
       wait_seconds += seconds_since(t_wait);

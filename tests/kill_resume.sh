@@ -151,9 +151,11 @@ check 'complete "$out/run.h5" && same "$out"' "stopped twice by SIGTERM and resu
 sed 's/^checkpoint_interval = 0.5/checkpoint_interval = 1000/' "$tmp/scene.toml" >"$tmp/far.toml"
 bash "$root/launch_scripts/run_scene.sh" "$tmp/far.toml" --out "$tmp/ref_far" --run-id $run_id --no-build --no-plots \
   --test-node-delay 0.1 >"$tmp/ref_far.log" 2>&1
+# The sim sleeps 0.1 s a frame (DYNHET_TEST_SIM_DELAY), so that the signal
+# finds it in its production, not done and waiting for the nodes.
 out=$tmp/term_far
 for round in 1 2; do
-  start_run "$out" "$tmp/far.toml"
+  DYNHET_TEST_SIM_DELAY=0.1 start_run "$out" "$tmp/far.toml"
   t=$(( 1500 + RANDOM % 3000 ))
   sleep "$(printf '%d.%03d' $((t / 1000)) $((t % 1000)))"
   kill -TERM -- -$run_pid 2>/dev/null || true
