@@ -96,17 +96,27 @@ void write_part(const std::string& path, PartHeader h, const std::vector<uint8_t
   h.crc = crc32_of(payload.data(), payload.size());
   StateOut out;
   put_header(out, h, payload.size());
-  std::vector<uint8_t> bytes = out.bytes();
+  std::vector<uint8_t> bytes;
+  bytes.reserve(out.bytes().size() + payload.size());
+  bytes = out.bytes();
   bytes.insert(bytes.end(), payload.begin(), payload.end());
   write_file_atomic(path, bytes);
 }
 
 namespace {
 
+// The whole file in one read (a sim part is 200 bytes a particle: 0.8 GB
+// at N = 4 x 10^6, which a stream read a byte at a time took seconds over).
 std::vector<uint8_t> slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw BadPart(path + ": cannot be read");
-  return std::vector<uint8_t>(std::istreambuf_iterator<char>(in), {});
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw BadPart(path + ": cannot be read");
+  std::vector<uint8_t> b(static_cast<size_t>(size));
+  in.seekg(0);
+  if (size > 0 && !in.read(reinterpret_cast<char*>(b.data()), size))
+    throw BadPart(path + ": cannot be read");
+  return b;
 }
 
 // The header, and where the payload starts.

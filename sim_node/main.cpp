@@ -4,8 +4,11 @@
 // Usage: sim_node SCENE.toml [--lcm-url URL] [--checkpoint FILE.h5]
 //        sim_node --resume FILE.h5 [--checkpoint FILE.h5]
 // With --checkpoint, a checkpoint is written at every multiple of the
-// scene's run.checkpoint_interval and at the end; SIGINT/SIGTERM run on to
-// the next such time, write it and exit (status 128 + signal).
+// scene's run.checkpoint_interval and at the end. SIGINT/SIGTERM: with
+// checkpoint cuts (--checkpoint-dir), a cut of the whole engine as it is
+// (at most one slice of events later) and exit; without them, run on to
+// the next synchronised time, write the checkpoint and exit (status 128 +
+// signal).
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -226,16 +229,28 @@ int main(int argc, char** argv) {
     rep.msg().frames_total = info.n_frames;
 
     const auto t_wall = Clock::now();
-    // A cut's sim part: next frame, the reporter's phase, the engine state,
-    // then the reporter's blocks (applied after that phase's reset below).
+    // A cut's sim part: next frame, the reporter's phase, the next
+    // synchronised slot, whether it was taken between synchronised times,
+    // the engine (its State at a synchronised time; between them, on a
+    // signal, its whole Snapshot), then the reporter's blocks (applied
+    // after that phase's reset below).
     std::string cut_phase;
     size_t cut_reporter_at = 0;
+    uint8_t cut_between = 0;
+    int64_t cut_next_slot = -1;
     if (!cut_part.empty()) {
       dynhet::StateIn in(cut_part.data(), cut_part.size(), dynhet::part_path(cut_root, resume_cut, "sim", 0));
-      dynhet::engine::State st;
-      in(resumed.next_frame, cut_phase, st);
+      in(resumed.next_frame, cut_phase, cut_next_slot, cut_between);
+      if (cut_between) {
+        dynhet::engine::Snapshot snap;
+        in(snap);
+        eng.restore_snapshot(snap);
+      } else {
+        dynhet::engine::State st;
+        in(st);
+        eng.restore(st);
+      }
       cut_reporter_at = in.offset();
-      eng.restore(st);
       std::fprintf(stderr, "sim_node: resumed from checkpoint cut %d at t=%.10g, next frame %d (%s)\n", resume_cut,
                    eng.time(), resumed.next_frame, dynhet::cut_dir(cut_root, resume_cut).c_str());
     } else if (!resume_path.empty()) {
@@ -266,7 +281,9 @@ int main(int argc, char** argv) {
     // Synchronised times k * interval (k counted from t = 0), the same in a
     // resumed run as in the uninterrupted one.
     const double interval = scene.checkpoint_interval;
-    int64_t next_slot = static_cast<int64_t>(std::floor(eng.time() / interval + 0.5)) + 1;
+    // (A cut between synchronised times says which slot comes next.)
+    int64_t next_slot = cut_next_slot >= 0 ? cut_next_slot
+                                           : static_cast<int64_t>(std::floor(eng.time() / interval + 0.5)) + 1;
     int next_frame = resumed.next_frame;
     auto checkpoint = [&] {
       const dynhet::Checkpoint c{scene.text, run_id, next_frame, scene.kick_pairs, eng.state()};
@@ -295,13 +312,24 @@ int main(int argc, char** argv) {
       cuts = std::make_unique<dynhet::CutCoordinator>(lcm, bus, cut_root, run_id, scene.text, parts);
     }
     rep.count_unauthenticated([&] { return pacer.unauthenticated() + (cuts ? cuts->unauthenticated() : 0); });
-    // At a synchronised time: a cut after the last frame published.
-    auto take_cut = [&](bool stop) {
+    // A cut after the last frame published: at a synchronised time the
+    // engine's State; between synchronised times (`between`, on a signal)
+    // its whole Snapshot, from which the run goes on as if never stopped.
+    auto take_cut = [&](bool stop, bool between = false) {
       const auto t0 = Clock::now();
       dynhet::StateOut out;
       std::string phase = rep.msg().phase;
-      dynhet::engine::State st = eng.state();
-      out(next_frame, phase, st, rep);
+      uint8_t kind = between ? 1 : 0;
+      out(next_frame, phase, next_slot, kind);
+      if (between) {
+        dynhet::engine::Snapshot snap = eng.snapshot();
+        out.reserve(snap.bytes() + 4096);
+        out(snap);
+      } else {
+        dynhet::engine::State st = eng.state();
+        out(st);
+      }
+      out(rep);
       const int c = cuts->take(next_frame - 1, eng.time(), out.bytes(), stop);
       if (c < 0) return c; // cuts are off (said once)
       std::fprintf(stderr, "%ssim_node: checkpoint: cut %d after frame %d at t=%.10g (sim part %.1f MB in %.2f s)\n",
@@ -321,6 +349,29 @@ int main(int argc, char** argv) {
       return cuts && cuts->broken().empty() && (g_signal || scene.checkpoint_wall_interval <= 0 ||
                       cuts->seconds_since_take() >= scene.checkpoint_wall_interval);
     };
+    // On a signal: the last cut, stop = true, then wait until it is whole and
+    // end (throws). `between`: the engine stands between synchronised times
+    // (after a slice of events, or at a frame's time), and its whole
+    // snapshot is the sim's part: a stop takes seconds, not the wall time
+    // to the next synchronised time (docs/checkpoints.md).
+    auto stop_with_cut = [&](bool between) {
+      checkpoint_written = true;
+      int c = -1;
+      try {
+        c = take_cut(true, between);
+      } catch (const std::exception& e) { // a full disk, say: the last whole cut stays the restart point
+        std::fprintf(stderr, "\nsim_node: checkpoint cut not taken: %s\n", e.what());
+      }
+      const int before = cuts->last_whole();
+      if (c >= 0 && cuts->wait_whole(c, cut_wait, keep_talking))
+        throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) + "; checkpoint cut " +
+                                 std::to_string(c) + " after frame " + std::to_string(next_frame - 1) +
+                                 " (t=" + std::to_string(eng.time()) + ") is whole: the same command resumes the run");
+      throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
+                               "; the last cut was not whole within " + std::to_string(cut_wait) +
+                               " s: the run resumes from cut " + std::to_string(before));
+    };
+    auto stop_between = [&] { return g_signal && cuts && cuts->broken().empty(); };
 
     // Advance to time t in slices, so that status and run info go out and
     // signals are seen at least once a second; synchronise (and checkpoint)
@@ -341,6 +392,11 @@ int main(int argc, char** argv) {
           if (cuts) cuts->poll();
           if (g_signal && checkpoint_path.empty() && !cuts)
             throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
+          if (stop_between()) {
+            std::fprintf(stderr, "\nsim_node: signal %d: a checkpoint cut at t=%.10g, between synchronised times\n",
+                         g_signal.load(), eng.time());
+            stop_with_cut(true);
+          }
           if (g_signal && !announced) {
             std::fprintf(stderr, "\nsim_node: signal %d: running on to t=%g to write a checkpoint\n",
                          g_signal.load(), slot);
@@ -352,23 +408,11 @@ int main(int argc, char** argv) {
           ++next_slot;
           if (!checkpoint_path.empty()) checkpoint();
           if (cut_due()) {
-            int c = -1;
+            if (g_signal) stop_with_cut(false);
             try {
-              c = take_cut(g_signal != 0);
+              take_cut(false);
             } catch (const std::exception& e) { // a full disk, say: the last whole cut stays the restart point
               std::fprintf(stderr, "\nsim_node: checkpoint cut not taken: %s\n", e.what());
-            }
-            if (g_signal) {
-              checkpoint_written = true;
-              const int before = cuts->last_whole();
-              if (c >= 0 && cuts->wait_whole(c, cut_wait, keep_talking))
-                throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
-                                         "; checkpoint cut " + std::to_string(c) + " after frame " +
-                                         std::to_string(next_frame - 1) + " (t=" + std::to_string(eng.time()) +
-                                         ") is whole: the same command resumes the run");
-              throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
-                                       "; the last cut was not whole within " + std::to_string(cut_wait) +
-                                       " s: the run resumes from cut " + std::to_string(before));
             }
           }
           if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()) +
@@ -381,7 +425,9 @@ int main(int argc, char** argv) {
       rep.update(eng, t_end - eng.time());
     };
 
-    if (eng.time() < scene.equilibration_time) {
+    // A cut taken between synchronised times in equilibration resumes it
+    // (even if its last event fell on the phase's end exactly).
+    if (eng.time() < scene.equilibration_time || (cut_between && cut_phase == "equilibrate")) {
       rep.msg().phase = "equilibrate";
       rep.msg().phase_end_time = scene.equilibration_time;
       rep.reset_rates(eng, scene.equilibration_time - eng.time());
@@ -412,11 +458,20 @@ int main(int argc, char** argv) {
         if (cuts) cuts->poll();
       }
       advance(sched.frame_time[f]);
+      // A signal seen at frame f's time, f not yet published (at small N a
+      // frame may come sooner than a slice ends): the cut after f - 1.
+      auto stop_before_frame = [&] {
+        std::fprintf(stderr, "\nsim_node: signal %d: a checkpoint cut at t=%.10g, before frame %d\n",
+                     g_signal.load(), eng.time(), f);
+        stop_with_cut(true);
+      };
+      if (stop_between()) stop_before_frame();
       const auto t_wait = Clock::now();
       pacer.before_frame(f, [&] {
         if (seconds_since(last_info) > 2.0) publish_info();
         if (cuts) cuts->poll();
         rep.update(eng, t_end - eng.time());
+        if (stop_between()) stop_before_frame();
         if (g_signal) throw std::runtime_error("interrupted by signal " + std::to_string(g_signal.load()));
       });
       wait_seconds += seconds_since(t_wait);

@@ -11,6 +11,9 @@
 #  4. SIGTERM of the whole process group at random times, twice: every
 #     process saves its part of one last cut and exits; run_scene.sh exits
 #     75 within a bound; run.h5 says incomplete, interrupted;
+#  4a. the same with no synchronised time left in the run: the sim cuts
+#     from its whole engine between synchronised times, and the resumed run
+#     equals the uninterrupted one with that interval;
 #  4b. SIGTERM while the processes start (the nodes up and the sim not; a
 #     process launched and not yet ready): exit 75, nothing left running;
 #  5. the newest whole cut corrupted (one byte of a node's part): refused
@@ -40,21 +43,23 @@ check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
 sed 's/^equilibration_time = 5.0/equilibration_time = 5.0\ncheckpoint_interval = 0.5/' "$root/scenes/tiny.toml" >"$tmp/scene.toml"
 grep -q "checkpoint_interval = 0.5" "$tmp/scene.toml"
 run_id=4711
-same() { $py "$root/tests/compare_h5.py" "$tmp/ref/run.h5" "$1/run.h5" >"$1.cmp" 2>&1 || { cat "$1.cmp"; return 1; }; }
+same() { # DIR [REFERENCE]: DIR's run.h5 equals the reference's (default the uninterrupted run)
+  $py "$root/tests/compare_h5.py" "${2:-$tmp/ref}/run.h5" "$1/run.h5" >"$1.cmp" 2>&1 || { cat "$1.cmp"; return 1; }
+}
 complete() { $py -c "import h5py, sys; sys.exit(0 if int(h5py.File(sys.argv[1], 'r').attrs['complete']) == 1 else 1)" "$1"; }
 
 # Starts the run in DIR in the background, in a process group of its own
 # (pid in $run_pid, the group's id too).
-start_run() {
+start_run() { # DIR [SCENE]
   set -m
-  bash "$root/launch_scripts/run_scene.sh" "$tmp/scene.toml" --out "$1" --run-id $run_id --no-build --no-plots \
+  bash "$root/launch_scripts/run_scene.sh" "${2:-$tmp/scene.toml}" --out "$1" --run-id $run_id --no-build --no-plots \
     --test-node-delay 0.1 >>"$1.log" 2>&1 &
   run_pid=$!
   set +m
 }
-finish_run() { # DIR: the same command until it completes (at most 4 more times)
+finish_run() { # DIR [SCENE]: the same command until it completes (at most 4 more times)
   for _ in 1 2 3 4; do
-    bash "$root/launch_scripts/run_scene.sh" "$tmp/scene.toml" --out "$1" --run-id $run_id --no-build --no-plots \
+    bash "$root/launch_scripts/run_scene.sh" "${2:-$tmp/scene.toml}" --out "$1" --run-id $run_id --no-build --no-plots \
       --test-node-delay 0.1 >>"$1.log" 2>&1 && return 0
   done
   return 1
@@ -140,6 +145,33 @@ for round in 1 2; do
 done
 finish_run "$out" || true
 check 'complete "$out/run.h5" && same "$out"' "stopped twice by SIGTERM and resumed: run.h5 equals the uninterrupted run's"
+# 4a. SIGTERM with no synchronised time left in the run (checkpoint_interval
+# 1000): the sim cuts between synchronised times, from its whole engine, and
+# the resumed run equals the uninterrupted one with the same interval.
+sed 's/^checkpoint_interval = 0.5/checkpoint_interval = 1000/' "$tmp/scene.toml" >"$tmp/far.toml"
+bash "$root/launch_scripts/run_scene.sh" "$tmp/far.toml" --out "$tmp/ref_far" --run-id $run_id --no-build --no-plots \
+  --test-node-delay 0.1 >"$tmp/ref_far.log" 2>&1
+# The sim sleeps 0.1 s a frame (DYNHET_TEST_SIM_DELAY), so that the signal
+# finds it in its production, not done and waiting for the nodes.
+out=$tmp/term_far
+for round in 1 2; do
+  DYNHET_TEST_SIM_DELAY=0.1 start_run "$out" "$tmp/far.toml"
+  t=$(( 1500 + RANDOM % 3000 ))
+  sleep "$(printf '%d.%03d' $((t / 1000)) $((t % 1000)))"
+  kill -TERM -- -$run_pid 2>/dev/null || true
+  s0=$(date +%s%N)
+  set +e; wait $run_pid; rc=$?; set -e
+  ms=$(( ($(date +%s%N) - s0) / 1000000 ))
+  echo "     SIGTERM at $t ms (no synchronised time ahead): exit $rc after $ms ms"
+  if [[ -f $out/run.h5 ]] && ! complete "$out/run.h5"; then
+    check '[[ $rc == 75 && $ms -lt 20000 ]]' "SIGTERM $round between synchronised times: exit 75 within 20 s (got $rc, $ms ms)"
+    check 'grep -q "a checkpoint cut at t=.*\(between synchronised times\|before frame\)" "$out/sim_node.log"' \
+      "SIGTERM $round: the sim cut between synchronised times"
+  fi
+done
+finish_run "$out" "$tmp/far.toml" || true
+check 'complete "$out/run.h5" && same "$out" "$tmp/ref_far"' \
+  "stopped twice between synchronised times and resumed: run.h5 equals the uninterrupted run's"
 # 4b. SIGTERM while the processes start: (a) the nodes up, the sim not yet;
 # (b) a process launched and not yet seen ready (the script in a sleep: a
 # group signal ends the sleep too, which under errexit had ended the script

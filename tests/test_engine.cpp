@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "dynhet/engine/engine.hpp"
+#include "dynhet/state_archive.hpp"
 #include "engine_test_params.hpp"
 
 using dynhet::engine::Engine;
@@ -266,6 +267,71 @@ TEST(Engine, RestoredRunContinuesBitForBit) {
     wrong.n_particles = 401;
     Engine c(wrong);
     EXPECT_THROW(c.restore(saved), std::invalid_argument);
+  }
+}
+
+TEST(Engine, SnapshotBetweenSynchronisedTimesContinuesBitForBit) {
+  // A snapshot taken anywhere (here after a count of events, between the
+  // synchronised times 10 and 20), written out and read back, continues in
+  // a second engine exactly as the first engine goes on: the same kick
+  // pairs, collisions and positions through the next synchronisation.
+  for (const auto rule : {KickPairs::neighbours, KickPairs::any}) {
+    for (const double eps : {0.9, 1.0}) {
+      Params p = params(400, 0.75, eps, eps < 1.0);
+      p.tc = eps < 1.0 ? 1e-3 : 0.0;
+      p.kick_pairs = rule;
+      Engine a(p);
+      a.prepare();
+      a.run_until(10.0);
+      a.synchronize();
+      ASSERT_FALSE(a.run_until(20.0, 3 * 400 + 17)); // stops at an event, mid-interval
+      dynhet::StateOut out;
+      auto snap = a.snapshot();
+      out(snap);
+      dynhet::StateIn in(out.bytes().data(), out.bytes().size(), "snapshot");
+      dynhet::engine::Snapshot back;
+      in(back);
+      Engine b(p);
+      b.restore_snapshot(back);
+      EXPECT_EQ(a.time(), b.time());
+      for (const double t : {13.0, 17.5, 20.0}) {
+        a.run_until(t);
+        b.run_until(t);
+        const auto ka = a.next_kick_pair(), kb = b.next_kick_pair();
+        EXPECT_EQ(ka.i, kb.i);
+        EXPECT_EQ(ka.j, kb.j);
+      }
+      a.synchronize();
+      b.synchronize();
+      a.run_until(25.0);
+      b.run_until(25.0);
+      std::vector<double> xa, xb;
+      a.unwrapped_positions(xa);
+      b.unwrapped_positions(xb);
+      ASSERT_EQ(xa.size(), xb.size());
+      for (size_t i = 0; i < xa.size(); ++i) ASSERT_EQ(xa[i], xb[i]) << i;
+      EXPECT_EQ(a.counters().collisions, b.counters().collisions);
+      EXPECT_EQ(a.counters().kicks, b.counters().kicks);
+      EXPECT_EQ(a.counters().rebuilds, b.counters().rebuilds);
+      EXPECT_EQ(a.counters().stale, b.counters().stale);
+      EXPECT_EQ(a.counters().tc, b.counters().tc);
+      EXPECT_EQ(a.counters().virial, b.counters().virial);
+      EXPECT_GT(a.counters().collisions, 20 * 400);
+
+      // A snapshot that does not fit is refused by name.
+      auto bad = snap;
+      std::swap(bad.id[0], bad.id[1]);
+      bad.id[1] = bad.id[0];
+      Engine c(p);
+      EXPECT_THROW(c.restore_snapshot(bad), std::invalid_argument);
+      bad = snap;
+      bad.neighbours.push_back(3);
+      EXPECT_THROW(c.restore_snapshot(bad), std::invalid_argument);
+      Params wrong = p;
+      wrong.n_particles = 401;
+      Engine d(wrong);
+      EXPECT_THROW(d.restore_snapshot(snap), std::invalid_argument);
+    }
   }
 }
 

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <stdexcept>
 #include <string>
 
@@ -243,6 +244,88 @@ void Engine::restore(const State& s) {
   kick_time_ = s.kick_in;
   reorder(); // the same slot order as the run that wrote the state
   clear_events();
+}
+
+} // namespace dynhet::engine
+
+namespace dynhet::engine {
+
+Snapshot Engine::snapshot() const {
+  Snapshot s;
+  s.now = now_;
+  s.offset = offset_;
+  s.kick_time = kick_time_;
+  s.events_since_rebase = events_since_rebase_;
+  s.particles.resize(part_.size() * sizeof(Particle));
+  std::memcpy(s.particles.data(), part_.data(), s.particles.size());
+  s.id = id_;
+  s.image_x = image_x_;
+  s.image_y = image_y_;
+  if (p_.tc > 0) s.last_collision = last_collision_;
+  s.centres.resize(2 * static_cast<size_t>(n_));
+  for (long i = 0; i < n_; ++i) s.centres[2 * i] = centre_[i].x, s.centres[2 * i + 1] = centre_[i].y;
+  nbr_.save(s.neighbours);
+  if (kick_lists()) kick_nbr_.save(s.kick_lists);
+  cells_.save(s.cells);
+  for (int k = 0; k < 4; ++k) s.rng[k] = rng_.state()[k];
+  s.counters = count_;
+  return s;
+}
+
+void Engine::restore_snapshot(const Snapshot& s) {
+  const size_t n = static_cast<size_t>(n_);
+  auto refuse = [&](const std::string& why) {
+    throw std::invalid_argument("engine: a snapshot that does not fit this run: " + why);
+  };
+  if (s.particles.size() != n * sizeof(Particle) || s.id.size() != n || s.image_x.size() != n ||
+      s.image_y.size() != n || s.last_collision.size() != (p_.tc > 0 ? n : 0) || s.centres.size() != 2 * n)
+    refuse("its arrays are not of " + std::to_string(n) + " particles");
+  if (!std::isfinite(s.now) || !std::isfinite(s.offset) || s.events_since_rebase < 0)
+    refuse("its clock is not finite");
+  start_run();
+  scale0_ = 1.0;
+  grow_ = 0.0;
+  list_scale_ = 1.0;
+  now_ = s.now;
+  offset_ = s.offset;
+  kick_time_ = s.kick_time;
+  events_since_rebase_ = s.events_since_rebase;
+  std::memcpy(part_.data(), s.particles.data(), s.particles.size());
+  std::vector<uint8_t> seen(n, 0);
+  for (size_t k = 0; k < n; ++k) {
+    const int32_t i = s.id[k];
+    if (i < 0 || static_cast<size_t>(i) >= n || seen[i]++) refuse("its ids are not a permutation");
+    if (part_[k].species != species_by_id_[i]) refuse("a species differs from the scene's");
+    if (part_[k].partner < kRebuild || part_[k].partner >= n_) refuse("a partner is out of range");
+    if (!(part_[k].event_time >= now_)) refuse("an event lies in the past");
+    species_[k] = species_by_id_[i];
+    centre_[k] = Centre{s.centres[2 * k], s.centres[2 * k + 1]};
+  }
+  id_ = s.id;
+  image_x_ = s.image_x;
+  image_y_ = s.image_y;
+  if (p_.tc > 0) last_collision_ = s.last_collision;
+  else last_collision_.assign(n, -kNever);
+  const auto limit = static_cast<int32_t>(n_);
+  if (!nbr_.load(n, s.neighbours, limit)) refuse("its neighbour lists are malformed");
+  if (!kick_nbr_.load(kick_lists() ? n : 0, s.kick_lists, limit)) refuse("its kick lists are malformed");
+  const size_t cells = static_cast<size_t>(nc_) * nc_;
+  if (!cells_.load(cells, s.cells, limit)) refuse("its cells are malformed");
+  cell_x_.assign(n, -1);
+  cell_y_.assign(n, -1);
+  for (size_t c = 0; c < cells; ++c) {
+    const int32_t* row = cells_.row(c);
+    for (int k = 1; k <= row[0]; ++k) {
+      if (cell_x_[row[k]] >= 0) refuse("a particle is in two cells");
+      cell_x_[row[k]] = static_cast<int32_t>(c % nc_);
+      cell_y_[row[k]] = static_cast<int32_t>(c / nc_);
+    }
+  }
+  for (size_t k = 0; k < n; ++k)
+    if (cell_x_[k] < 0) refuse("a particle is in no cell");
+  rng_.set_state(s.rng);
+  count_ = s.counters;
+  cal_.rebuild(n_, now_, event_times());
 }
 
 } // namespace dynhet::engine

@@ -34,6 +34,7 @@ class StateOut {
 public:
   template <class... T> void operator()(T&... v) { (put(v), ...); }
   const std::vector<uint8_t>& bytes() const { return buf_; }
+  void reserve(size_t n) { buf_.reserve(n); }
   void raw(const void* p, size_t n) {
     const auto* b = static_cast<const uint8_t*>(p);
     buf_.insert(buf_.end(), b, b + n);

@@ -162,6 +162,37 @@ struct State {
   }
 };
 
+// Everything the engine holds at any moment of a run, by storage slot: the
+// particles at their own local times with their pending events, the list
+// centres, the neighbour and kick lists and the cells with their members
+// in order (a rebuild lists candidates in cell order, and a kick draws its
+// partner by its place in a kick list). Engine::restore_snapshot() from it
+// continues bit for bit from between two synchronised times, so a run
+// stops in seconds (docs/checkpoints.md). The calendar alone is built
+// anew: it returns events in the order (time, slot) whatever its buckets
+// hold. The particle records are this build's bytes (a checkpoint part of
+// another build is refused anyway).
+struct Snapshot {
+  double now = 0, offset = 0, kick_time = 0;
+  int64_t events_since_rebase = 0;
+  std::vector<uint8_t> particles;
+  std::vector<int32_t> id, image_x, image_y;
+  std::vector<double> last_collision; // empty with the TC model off (every one is -inf then)
+  std::vector<double> centres;        // x0 y0 x1 y1 ...
+  std::vector<int32_t> neighbours, kick_lists, cells; // rows: count, then members
+  uint64_t rng[4] = {0, 0, 0, 0};
+  Counters counters;
+  size_t bytes() const {
+    return particles.size() + 4 * (id.size() + image_x.size() + image_y.size() + neighbours.size() +
+                                   kick_lists.size() + cells.size()) +
+           8 * (last_collision.size() + centres.size()) + 256;
+  }
+  template <class Ar> void state(Ar& ar) {
+    ar(now, offset, kick_time, events_since_rebase, particles, id, image_x, image_y, last_collision, centres,
+       neighbours, kick_lists, cells, rng, counters);
+  }
+};
+
 class Engine {
 public:
   explicit Engine(const Params& p);
@@ -204,6 +235,12 @@ public:
   // std::invalid_argument if it does not fit these parameters.
   void restore(const State& s);
   const Params& params() const { return p_; }
+  // The whole engine at any time of a run (begun: not while compressing),
+  // and back: the run continues as if never stopped. restore_snapshot()
+  // throws std::invalid_argument if the snapshot does not fit these
+  // parameters or is not self-consistent.
+  Snapshot snapshot() const;
+  void restore_snapshot(const Snapshot& s);
 
   // Processes every event up to time t (absolute), then the system is at t.
   // Stops early, at an event, after max_events; returns true if t was reached.

@@ -40,6 +40,31 @@ public:
     c[k] = c[c[0]--];
   }
   size_t bytes() const { return data_.capacity() * sizeof(int32_t); }
+  // Every row as its count and then its members, in order (checkpoints
+  // between synchronised times: the order of a row decides later ones).
+  void save(std::vector<int32_t>& out) const {
+    out.clear();
+    for (size_t r = 0; r < rows_; ++r) {
+      const int32_t* c = row(r);
+      out.insert(out.end(), c, c + c[0] + 1);
+    }
+  }
+  // n rows as save() wrote them; false (the rows then unusable) if `in` is
+  // not n such rows of members in [0, limit).
+  bool load(size_t n, const std::vector<int32_t>& in, int32_t limit) {
+    reset(n);
+    size_t k = 0;
+    for (size_t r = 0; r < n; ++r) {
+      if (k >= in.size()) return false;
+      const int32_t m = in[k++];
+      if (m < 0 || in.size() - k < static_cast<size_t>(m)) return false;
+      for (int32_t q = 0; q < m; ++q, ++k) {
+        if (in[k] < 0 || in[k] >= limit) return false;
+        push(r, in[k]);
+      }
+    }
+    return k == in.size();
+  }
 
 private:
   [[gnu::noinline, gnu::cold]] void grow() {
