@@ -20,7 +20,7 @@ import h5py
 import numpy as np
 
 sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from dynhet.archive import MAX_BYTES, sha256_of  # noqa: E402
+from dynhet.archive import MAX_BYTES, Archive, sha256_of  # noqa: E402
 
 fails = []
 
@@ -75,6 +75,7 @@ def entries(archive, study_dir):
         check(e["bytes"] <= MAX_BYTES, f"{name}: {e['bytes']} bytes <= 1 MiB")
         run_h5 = os.path.join(study_dir, sidx[name]["path"], "run.h5")
         check(e["source_sha256"] == sha256_of(run_h5), f"{name}: names the hash of the run.h5 it was reduced from")
+        p = Archive(archive).path(name)   # the entry decompressed, as every reader gets it
         with h5py.File(p, "r") as f:
             pv = dict(f["provenance"].attrs)
             scene = open(os.path.join(study_dir, sidx[name]["path"], "scene.toml")).read()

@@ -58,9 +58,9 @@ check '[[ $(grep -c "complete in the archive" "$tmp/r.out") == 4 ]] && ! ls "$tm
 /usr/bin/python3 "$root/tests/check_archive.py" same-analysis "$tmp/study/tiny/study.h5" "$tmp/from_archive/study.h5" || fail=1
 
 # A corrupted entry is refused by name, by the analysis and by the study.
-entry=$(ls "$tmp"/results/tiny/runs/*.h5 | head -1)
-name=$(basename "$entry" .h5)
-cp "$entry" "$tmp/keep.h5"
+entry=$(ls "$tmp"/results/tiny/runs/*.h5.gz | head -1)
+name=$(basename "$entry" .h5.gz)
+cp "$entry" "$tmp/keep.h5.gz"
 printf 'X' | dd of="$entry" bs=1 seek=2000 conv=notrunc 2>/dev/null
 "${analyse[@]}" "$tmp/results/tiny" --out "$tmp/bad" >"$tmp/bad.out" 2>&1 && rc=0 || rc=$?
 check '[[ $rc != 0 ]] && grep -q "entry .$name.: .* does not match the index" "$tmp/bad.out"' \
@@ -68,12 +68,12 @@ check '[[ $rc != 0 ]] && grep -q "entry .$name.: .* does not match the index" "$
 rm -rf "$tmp/study/tiny/runs"
 "${study[@]}" "$root/studies/tiny.toml" --out "$tmp/study/tiny" --archive "$tmp/results/tiny" --jobs 1 >"$tmp/bad2.out" 2>&1 && rc=0 || rc=$?
 check 'grep -q "$name.*does not match the index" "$tmp/bad2.out"' "a corrupted entry: the study refuses it by name"
-cp "$tmp/keep.h5" "$entry"
+cp "$tmp/keep.h5.gz" "$entry"
 
 # A half-written entry (the temporary name an entry is written to) and a file
 # the index does not list are not entries: the archive reads as before.
-cp "$entry" "$tmp/results/tiny/runs/$name.h5.tmp.host.1"
-cp "$entry" "$tmp/results/tiny/runs/unlisted.h5"
+cp "$entry" "$tmp/results/tiny/runs/$name.h5.gz.tmp.host.1"
+cp "$entry" "$tmp/results/tiny/runs/unlisted.h5.gz"
 "${analyse[@]}" "$tmp/results/tiny" --out "$tmp/again" >"$tmp/again.out" 2>&1 || { cat "$tmp/again.out"; fail=1; }
 /usr/bin/python3 "$root/tests/check_archive.py" same-analysis "$tmp/from_archive/study.h5" "$tmp/again/study.h5" || fail=1
 

@@ -11,9 +11,11 @@ import numpy as np
 import pytest
 
 import dynhet
+from dynhet.archive import Archive
 
 ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-ENTRIES = sorted(glob.glob(os.path.join(ROOT, "results", "quick", "runs", "*.h5")))
+_QUICK = Archive(os.path.join(ROOT, "results", "quick"))
+ENTRIES = [_QUICK.path(n) for n in sorted(_QUICK.runs())]
 pytestmark = pytest.mark.skipif(not ENTRIES, reason="results/quick holds no run")
 
 

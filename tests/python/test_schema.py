@@ -11,11 +11,15 @@ import h5py
 import numpy as np
 import pytest
 
+from dynhet.archive import Archive
+
 from dynhet import schema
 
 ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
 # A finished run of the quick study, committed under results/ (all observables but bond breaking).
-RUN = os.path.join(ROOT, "results", "quick", "runs", "phi0.8000_eps0.900_n4096_seed1_any.h5")
+QUICK = os.path.join(ROOT, "results", "quick")
+RUN = (Archive(QUICK).path("phi0.8000_eps0.900_n4096_seed1_any")
+       if "phi0.8000_eps0.900_n4096_seed1_any" in Archive(QUICK).runs() else "")
 
 
 @pytest.fixture
