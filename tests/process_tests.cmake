@@ -70,10 +70,11 @@ add_test(NAME study_slurm_tiny
 set_tests_properties(study_slurm_tiny PROPERTIES LABELS process TIMEOUT 600)
 
 # A run longer than its Slurm time limit completes through requeues
-# (tests/slurm_requeue.sh) and equals the local executor's run.
+# (tests/slurm_requeue.sh) and equals the local executor's run. Label long:
+# out of the default suite (140 s), run with `ctest -L long`.
 add_test(NAME study_slurm_requeue
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/slurm_requeue.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
-set_tests_properties(study_slurm_requeue PROPERTIES LABELS process TIMEOUT 900)
+set_tests_properties(study_slurm_requeue PROPERTIES LABELS "process;long" TIMEOUT 900)
 
 # Prepared states (sim_node --prepare-only, system.initial_state): runs from
 # one equal the runs that compress themselves, bit for bit; bad states refused.
