@@ -22,7 +22,7 @@ check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
 # lcm-logger can miss a frame chunk on a starved machine (tests/e2e_tiny.sh):
 # a log with holes is recorded again (at most three times, each said).
 for attempt in 1 2 3; do
-  rm -rf "$tmp/live"
+  rm -rf "$tmp/live" "$tmp"/run.lcmlog*   # run_scene.sh --record never writes over a log
   bash "$root/launch_scripts/run_scene.sh" "$root/scenes/tiny.toml" --no-build --no-plots --out "$tmp/live" \
     --url 'udpm://239.255.76.67:7693?ttl=0' --record "$tmp/run.lcmlog" --run-id 333 >"$tmp/live.log" 2>&1 ||
     { tail -5 "$tmp/live.log"; exit 1; }
