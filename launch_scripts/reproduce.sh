@@ -8,7 +8,7 @@
 # stopped; archived runs are never run again.
 #
 # Usage: launch_scripts/reproduce.sh [--runs DIR] [--results DIR] [--jobs K] [--only S1,S2] [--dry-run]
-#          [--analyse-only [--partial]] [--no-build] [--executor slurm [run_study.sh's Slurm flags]]
+#          [--analyse-only [--partial] [--text-only]] [--no-build] [--executor slurm [run_study.sh's Slurm flags]]
 #   --runs DIR       scratch run directories, DIR/<study> (default: runs/ beside the
 #                    checkout, ../runs)
 #   --results DIR    the archives, DIR/<study> (default: the repository's results/)
@@ -20,6 +20,8 @@
 #   --analyse-only   the analysis alone, from the archives; refused while a study has
 #                    runs not archived (their count is printed), unless --partial
 #                    (unfinished sizes are then held back and named in the documents)
+#   --text-only      the documents' text alone, no figure drawn (the figures stay as the
+#                    last full analysis drew them); the text is the same as with figures
 # The analysis rewrites the tracked documents, so it runs only once all the
 # studies are archived whole (after --only too, if the others are).
 #   --executor slurm submits each study's job array and returns; run this again
@@ -46,6 +48,7 @@ all=(quick size_standard size_cage cutoff d_size) # quick leads the analysis; th
 studies=("${all[@]}")
 before_commit=556a0f6
 runs=$root/../runs results=$root/results docs=$root/docs only="" dry=0 analyse_only=0 partial=0 build=1 pass=() fresh=()
+figures=()
 while (($#)); do
   case "$1" in
   --runs) runs=${2:?--runs needs a directory}; shift ;;
@@ -55,6 +58,7 @@ while (($#)); do
   --dry-run) dry=1 ;;
   --analyse-only) analyse_only=1 ;;
   --partial) partial=1 ;;
+  --text-only) figures=(--no-figures) ;;
   --no-build) build=0 ;;
   --fresh) fresh=(--fresh) ;;
   -h | --help) usage; exit 0 ;;
@@ -141,8 +145,8 @@ fi
 cd "$root"
 mkdir -p "$docs"
 stated="launch_scripts/reproduce.sh --analyse-only"
-((partial)) && stated+=" --partial"
+[[ -n $unfinished ]] && stated+=" --partial" # what made the documents: with every study whole, --partial changed nothing
 exec bash launch_scripts/analyse_study.sh "$rel/quick" "${also[@]}" --largest-n --out "$runs/analysis" \
   --table "$docs/reproduction.md" --finite-size "$docs/finite_size.md" --discussion docs/reproduction_findings.md \
   --command "$stated (analyse_study.sh $rel/quick ${also[*]} --largest-n)" \
-  "${restate[@]}" "${fresh[@]}"
+  "${restate[@]}" "${fresh[@]}" "${figures[@]}"

@@ -234,3 +234,8 @@ set_tests_properties(reproduce_dry PROPERTIES LABELS process TIMEOUT 120)
 add_test(NAME replay_reanalyse
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/reanalyse.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(replay_reanalyse PROPERTIES LABELS process TIMEOUT 300)
+# docs/reproduction.md and docs/finite_size.md against results/: their text
+# regenerated from the committed archive must equal the committed documents.
+add_test(NAME docs_from_results
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/docs_from_results.sh ${PROJECT_SOURCE_DIR})
+set_tests_properties(docs_from_results PROPERTIES LABELS process TIMEOUT 300)

@@ -286,6 +286,17 @@ def calibration_note(A, multi, multi_cr, multi_tb=None):
             ". Quoted errors are never made smaller.", ""]
 
 
+def drop_stale_figures(fig_dir, figures):
+    """Removes the report's figures (fs_*.png) in fig_dir that this report no
+    longer names: a figure of a size or measure the data no longer has must
+    not stay beside the text as if it were current."""
+    keep = {os.path.basename(f) for f in figures}
+    if os.path.isdir(fig_dir):
+        for name in os.listdir(fig_dir):
+            if name.startswith("fs_") and name.endswith(".png") and name not in keep:
+                os.remove(os.path.join(fig_dir, name))
+
+
 def write_finite_size(A, path, command):
     """The report at `path`; its figures next to it in finite_size/ (copied
     from the study's figures/)."""
@@ -407,10 +418,11 @@ def write_finite_size(A, path, command):
     out_dir = os.path.dirname(os.path.abspath(path))
     os.makedirs(out_dir, exist_ok=True)
     fig_dir = os.path.join(out_dir, "finite_size")
-    if figures:
+    if figures and A.figures:
         os.makedirs(fig_dir, exist_ok=True)
         for f in figures:
             shutil.copy(os.path.join(A.out, f), os.path.join(fig_dir, os.path.basename(f)))
+    drop_stale_figures(fig_dir, figures)
     with open(path, "w") as fh:
         fh.write("\n".join(L))
     return len(multi)

@@ -97,6 +97,8 @@ def run_file(sdir, name, m, archive):
 
 
 class Analysis:
+    figures = True  # False: the text alone (save() names each figure and draws none)
+
     def __init__(self, d, also=(), out=None):
         """d: the study (a study directory or a results archive); also: other
         studies whose runs add points (finite size, longer lags) without
@@ -282,8 +284,13 @@ class Analysis:
                          np.array([point_error(m) if m[3] else np.nan for m in ms]), np.array([m[3] for m in ms]))
 
     def save(self, fig, name):
-        os.makedirs(self.figdir, exist_ok=True)
+        """Writes fig to figures/name and returns that path relative to the
+        output; without figures (the text alone), names it and writes nothing."""
         path = os.path.join(self.figdir, name)
+        if not self.figures:
+            plt.close(fig)
+            return os.path.relpath(path, self.out)
+        os.makedirs(self.figdir, exist_ok=True)
         for ax in fig.axes:
             if not ax.has_data() or not drawable(ax):
                 ax.set_xscale("linear")
