@@ -1,4 +1,4 @@
-// Bond breaking for the overlap node (issue 26, item 4; Yamamoto and Onuki,
+// Bond breaking for the overlap node (Yamamoto and Onuki,
 // PRE 58, 3515 (1998); Shiba et al., PRL 117, 245701 (2016)): the bonds of
 // each origin frame (r_ij < a1 sigma_ij), which of them are still intact
 // (r_ij <= a2 sigma_ij) at every lag, C_B(t) and tau_B, and chi_B(t) per

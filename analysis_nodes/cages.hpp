@@ -1,5 +1,5 @@
 // The cages of the origin frames, for the cage-relative measures of every
-// node (issue 26): V_i(t0) of each particle, built once per origin frame
+// node: V_i(t0) of each particle, built once per origin frame
 // when it arrives and held with it. Two kinds ([observables] cage):
 //   "voronoi" (default): the Voronoi neighbours (CGAL's periodic Delaunay
 //     triangulation, analysis::voronoi_neighbours);

@@ -362,7 +362,7 @@ void bench_clusters(const Frames& f, int reps) {
 
 } // namespace
 
-// Cages (issue 26): the Voronoi neighbours of an origin frame (once per
+// Cages: the Voronoi neighbours of an origin frame (once per
 // origin) and the cage-relative displacements of one (origin, lag) pair.
 void bench_cage(const Frames& f, int reps) {
   std::printf("\n# cages: Voronoi neighbours of one frame (CGAL periodic Delaunay), cage-relative displacements "

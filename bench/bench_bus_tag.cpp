@@ -1,4 +1,4 @@
-// What the authenticated bus costs (issue 30, docs/bus.md): the time to tag
+// What the authenticated bus costs (docs/bus.md): the time to tag
 // a message and to check a tag, per message size, and per frame of N
 // particles (16 bytes a particle, in chunks as the sim sends them), on one
 // core. A sim at N = 10^6 tags each frame once; each node and the recorder

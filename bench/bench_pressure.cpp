@@ -2,7 +2,7 @@
 // sim_node computes it (engine.hpp reduced_pressure: the canonical Z at T =
 // K/(N-1), blocks of simulation time, common/include/dynhet/stats.hpp
 // RatioBlocks), the mechanical P A / (N T) of the fixed-momentum system
-// (1/N lower), and as it was computed in session 7 and before (T = K/N): a
+// (1/N lower), and as an earlier version computed it (T = K/N): a
 // table per packing fraction. Each N runs for the same particle-time (N x T
 // fixed), so the errors are comparable. bench/pressure_reference.py
 // compares sim_node's Z with published high-precision data.

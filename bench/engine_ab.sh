@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 28's goal rows, the engine of one build against another's,
+# The engine's speed rows, the engine of one build against another's,
 # interleaved (one run of each per round, ROUNDS rounds), then the median
 # of each row: elastic at N = 10^4 (200 collisions per particle), 10^5 (20)
 # and 10^6 (5), phi 0.78 and 0.805; driven (eps 0.9) at 10^5 (20) and 10^6

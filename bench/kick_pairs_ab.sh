@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 28's driven rows, interleaved: neighbour kick pairs with the
+# The engine's driven speed rows, interleaved: neighbour kick pairs with the
 # partner from the kick list (the engine's default), from the 3 x 3-cell
 # search (the earlier engine's, --kick-search cells) and pairs from the
 # whole system ("any"); eps = 0.9, phi 0.78 and 0.80, two rounds at

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Issue 28, goal 3: the live pipeline of one build against another's,
+# The live pipeline of one build against another's,
 # interleaved: the default scene (sim, every node, recorder; private bus)
 # run end to end ROUNDS times with each, no plots. Prints per run the
 # production's wall time and the median collisions per second of the sim's

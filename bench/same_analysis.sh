@@ -2,7 +2,7 @@
 # Does a change of the study analysis change any number? Runs the analysis
 # of revision REV and of the working tree on copies of one study directory
 # and compares the tables (reproduction.md) and study.h5 (all but the
-# creation time). For refactors that must change nothing (issue 29: the
+# creation time). For refactors that must change nothing (the
 # package split was checked this way against 2ee2e4c on studies/tiny.toml
 # and on the quick study).
 #

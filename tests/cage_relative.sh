@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Cage-relative measures and bond breaking live (issue 26): the tiny scene
+# Cage-relative measures and bond breaking live: the tiny scene
 # with [observables] cage_relative = true and bond_breaking, end to end over
 # LCM in a private network namespace. Its run.h5 holds overlap_cr, chi4_cr,
 # msd_cr and displacement_cr beside the standard groups, F_s and alpha_2

@@ -58,7 +58,7 @@ for name, m in runs.items():
         gw = int(np.argmax(s4n))
         xi = o["s4/a0.6/xi_lag/value"][-1][:, gw]  # [lag][grid]
         x = lin_ln_t(slag, xi, tau)
-        # issue 27, item 4: an OZ xi only where 5 q shells of its box lie below q xi = 1
+        # an OZ xi only where 5 q shells of its box lie below q xi = 1
         nsh = o["s4/a0.6/n_shells"][()]
         q = o["s4/a0.6/q"][()][int(np.sum(nsh[:gw])):int(np.sum(nsh[:gw + 1]))]
         mine["xi_tau_alpha"] = x if np.sum((q > 0) & (q * x <= 1.0)) >= 5 else math.nan

@@ -11,7 +11,7 @@
 #    no process dies, the run is complete, every node and the recorder
 #    count what they dropped, and the results equal the clean run's bit
 #    for bit;
-# 3. the authenticated bus (issue 30; docs/bus.md): an attacker that knows
+# 3. the authenticated bus (docs/bus.md): an attacker that knows
 #    the run id but not the key sends all of the above and well-formed
 #    "done" statuses of the run (run 4245); with --tamper (run 4246) it sends
 #    every message of the run back as a replay, without its tag and with

@@ -30,7 +30,7 @@ set_tests_properties(checkpoint_resume_bit_for_bit PROPERTIES LABELS process TIM
 # Engine stress test (bench/stress_engine.cpp): a short run of all three
 # cases in the default suite; under the label `stress`
 # (ctest --test-dir build -L stress) 10^9 collisions for each of the two
-# inelastic cases (8-12 minutes each on one core with session 5's engine)
+# inelastic cases (8-12 minutes each on one core, measured with an earlier engine)
 # and 10^8 for the elastic energy-drift case (about 1 minute).
 add_test(NAME stress_engine_short COMMAND stress_engine --collisions 5e6)
 set_tests_properties(stress_engine_short PROPERTIES LABELS engine TIMEOUT 600)

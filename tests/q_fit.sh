@@ -8,7 +8,7 @@
 # way moves beta and tau0 by less than 8%: the range is a systematic error
 # of its own (one lag earlier takes in more of Q's curvature and raises
 # beta: by 0.9 to 4.4 jackknife errors, 1-5%, over seeds 1-6 of this scene
-# with both the engine before and after issue 28's kick lists; "less than
+# with both the engine before and after its kick lists; "less than
 # twice the errors" held for 7 of 12 of those runs, so it was no property);
 # those errors exist and the tau_alpha and D errors too. Runs in a private
 # network namespace (run_scene.sh).

@@ -1,4 +1,4 @@
-// The authenticated bus (issue 30): a run's key file is refused unless it
+// The authenticated bus: a run's key file is refused unless it
 // is 32 bytes that only its owner can read; a tagged message verifies with
 // its key, channel and bytes and with nothing else; a copy of a message
 // already taken is dropped; bytes without a tag are dropped.

@@ -88,7 +88,7 @@ TEST(S4, GridMatchesDirectSumWithinItsErrorBound) {
       // The bound is on |sum_i w_i e^{iq.r_i}|, i.e. on N |W_r|.
       EXPECT_LT(max_mode_error(approx, exact) * grid.mean_particles, g.error_bound() * l1)
           << "m=" << grid.per_side << " R=" << g.oversampling();
-      if (k == 0) { // the default meets the 1% on S4 for q <= 1
+      if (k == 0) { // the default meets the target of 1% on S4 for q <= 1
         const S4Shells sa = s4_shells(approx);
         for (size_t s = 0; s < se.q.size(); ++s)
           if (std::isfinite(se.s4[s])) {

@@ -287,7 +287,7 @@ def test_a_size_verdict_takes_no_zero_error_and_no_size_twice():
 
 
 def test_the_reproduction_takes_xi_and_chi0_only_where_five_shells_resolve_them():
-    """Item 4 holds for every xi and chi0 the reproduction uses (its rows and
+    """The 5-shell rule holds for every xi and chi0 the reproduction uses (its rows and
     fits), not only for the finite-size table: xi = 2 in a box of side 100 has
     7 shells below q xi = 1 and is taken; xi = 4 has 3, and neither it nor the
     chi0 of the same fit is."""
@@ -367,7 +367,7 @@ def test_the_sub_box_caption_names_a_box_its_sub_boxes_stop_short_of():
 
 
 def test_the_spread_table_says_a_size_of_one_seed_cannot_check_its_errors():
-    """Item 5 at the largest N: one seed has no spread, so the check cannot be
+    """The seed-spread check at the largest N: one seed has no spread, so the check cannot be
     made there; the table says so instead of a bare dash."""
     from dynhet.analysis.finite_size import spread_section
     multi = {}

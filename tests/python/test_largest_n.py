@@ -1,4 +1,4 @@
-"""Analysis.promote_largest_n (analyse_study --largest-n, issue 27 item 3):
+"""Analysis.promote_largest_n (analyse_study --largest-n):
 at each density of the study the point of the largest N over the --also
 studies takes the place of the study's own in every series; densities the
 study does not have are not added."""
@@ -260,7 +260,7 @@ def test_a_study_tied_for_the_most_sizes_does_not_fill_a_size_the_other_has_not_
     """phi 0.76 in the real studies: scale runs N 1024-262144 and d_size (one
     seed, overlap only, other run lengths) N 4096-10^6, five sizes each. With
     scale's N = 262144 unfinished, d_size's complete run of that size fills
-    neither the finite-size table nor the largest N (review, session 24)."""
+    neither the finite-size table nor the largest N."""
     from dynhet.analysis.size import held_sizes
     A = analysis()
     A.extra = {}

@@ -1,4 +1,4 @@
-// An authenticated bus (issue 30): only the processes that hold a run's key
+// An authenticated bus: only the processes that hold a run's key
 // can put messages into it.
 //
 // LCM has no authentication of its own, and every process on the host (or,

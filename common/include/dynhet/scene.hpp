@@ -83,7 +83,7 @@ struct Scene {
   std::vector<double> cutoff_a{0.6};
   bool keep_frames = false;
   // Also every displacement observable of the cage-relative displacements
-  // dr_i - (mean dr of i's Voronoi neighbours at the origin) (issue 26):
+  // dr_i - (mean dr of i's Voronoi neighbours at the origin):
   // overlap, chi4, msd, displacement, s4 and clusters, in groups <name>_cr.
   bool cage_relative = false;
   // The cages: "voronoi" (Voronoi neighbours) or "g_ab" (within the first

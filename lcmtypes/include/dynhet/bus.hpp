@@ -1,4 +1,4 @@
-// A process's side of the authenticated bus (dynhet/bus_auth.hpp, issue 30):
+// A process's side of the authenticated bus (dynhet/bus_auth.hpp):
 // every message it publishes is tagged with the run's key, and every
 // message it receives is checked before it is decoded.
 #pragma once

@@ -18,8 +18,9 @@
 // yet sent. Measured: 1 or 2 of the 5 processes of a tiny run close so
 // (the kernel's TCPAbortOnClose counter), all of them when another
 // publisher shares the hub; a socket test lost its last bytes in 19 of 20
-// such closes under Nagle, 0 of 20 with TCP_NODELAY; runs of the issue's
-// time lost a node's last results in 2 of 5 runs (3 of 5 in the issue).
+// such closes under Nagle, 0 of 20 with TCP_NODELAY; tiny runs of an
+// earlier version (2ed0120) lost a node's last results in 2 of 5 runs (3 of
+// 5 as first reported).
 //
 // So on tcpq a process ends its connection as TCP intends: it shuts down
 // its sending side (the hub reads every byte before the end of the stream),

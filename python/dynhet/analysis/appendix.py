@@ -24,8 +24,8 @@ def whole_box(r, key):
 def appendix_results(A):
     """chi0 of the whole box's S4 fits (fit 2: OZ, fit 3: with A^2; the finest
     q) against chi4 of the same whole box (N var(Q) over origins, the s4
-    node's at t_s4): estimators of one box on both sides (until session 14
-    the 455-particle sub-box's eq. (14) chi4, biased low, stood against the
+    node's at t_s4): estimators of one box on both sides (an earlier version
+    set the 455-particle sub-box's eq. (14) chi4, biased low, against the
     whole box's chi0); the largest proper sub-box's pooled chi4 is drawn
     beside them. And the OZ refit at tau_alpha over 0 < q <= q_m for
     several q_m, against the same whole-box chi4."""

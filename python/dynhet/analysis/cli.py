@@ -1,4 +1,4 @@
-"""The paper's results from a study's runs (issue: the paper from our own runs).
+"""The paper's results from a study's runs.
 
 Usage: analyse_study.py STUDY_DIR [--table FILE] [--quiet]
 

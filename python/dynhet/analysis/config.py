@@ -31,7 +31,7 @@ CONVENTIONS = """(docs/analysis.md, "Study analysis"):
 
 A_MAIN = 0.6          # the paper's cutoff, "unless stated otherwise"
 EPS_MAIN = 0.9        # the paper's restitution, "unless stated otherwise"
-XI_MIN_DF = 3.0      # d_f' (chi4 against xi) over xi >= 3 particle diameters (item 4 of issue 31)
+XI_MIN_DF = 3.0      # d_f' (chi4 against xi) over xi >= 3 particle diameters
 PHI_SNAP = (0.60, 0.78, 0.805)   # the paper's snapshot densities (nearest available are used)
 PHI_AGE = (0.78, 0.805)          # the paper's ageing densities
 PHI_PDX = (0.60, 0.72, 0.78)     # three densities for P(dx) (the paper's fig. 8a shows several)

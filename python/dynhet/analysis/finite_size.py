@@ -1,4 +1,4 @@
-"""The finite-size report (issue 27): every quantity against N at each
+"""The finite-size report: every quantity against N at each
 density run at several N, standard and cage-relative side by side, with a
 verdict computed from the numbers: converged within errors from which N on,
 or still drifting (and by how much per doubling of N). Written by
@@ -29,7 +29,7 @@ def spread_ratio(points, fn, cr=False):
 
 
 def spread_section(multi, multi_cr, multi_tb=None):
-    """Issue 27, item 5: per N, the pooled seed-spread ratio of tau_alpha,
+    """Per N, the pooled seed-spread ratio of tau_alpha,
     tau_alpha^CR, tau_B and chi4^P over the densities run there (tau_B over
     the points its cells take: multi_tb)."""
     ns = sorted({n for d in multi.values() for n in d})
@@ -373,7 +373,7 @@ def write_finite_size(A, path, command):
                 cells = [w or cell(m, len(dd[n].runs) if n in dd else 0)
                          + (" ‡" if slug != "tau_t0_change" and n in dd and unsteady(dd[n], cr) else "")
                          for m, w, n in zip(ms, why, qn)]
-                if slug == "xi":  # how many q shells its fits had below q xi = 1 (issue 27, item 4)
+                if slug == "xi":  # how many q shells its fits had below q xi = 1 (MIN_SHELLS)
                     cells = [c + shells_note(dd.get(n), cr) for c, n in zip(cells, qn)]
                 L.append(f"| {label} | " + " | ".join(cells) + f" | {text} |")
         seeds = ", ".join(f"N {n}: {len(d[n].runs)} ({study_of(d[n])})" for n in ns) + others_note(d)

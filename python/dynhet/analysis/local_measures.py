@@ -1,4 +1,4 @@
-"""Cage-relative tau_alpha and bond breaking (issue 26): tau_alpha^CR(phi) and
+"""Cage-relative tau_alpha and bond breaking: tau_alpha^CR(phi) and
 tau_B(phi) with the power-law and VFT fits of tau_alpha(phi), and the three
 against N where a density was run at several N (studies/cage.toml). Rows only
 where some run measured them ([observables] cage_relative, "bond_breaking")."""
@@ -43,7 +43,7 @@ def local_phi_results(A):
         name = label.split(" ")[0]
         for f, what, key in ((fp, "power law: φ_c", "xc"), (fv, "VFT: φ_0", "x0")):
             extra = (f", γ {fmt(f.p['g'], f.error('g'))}" if key == "xc" else f", B {fmt(f.p['B'], f.error('B'))}")
-            A.row(f"{name}(φ) {what}", "issue 26 (not in the paper)", "not measured",
+            A.row(f"{name}(φ) {what}", "not in the paper", "not measured",
                   fmt(f.p[key], f.error(key), 4) + extra + f", χ²/dof {f.chi2_dof():.2g}", "—", "", sel, f.note)
     ax.set_yscale("log")
     ax.set_xlabel("φ")
@@ -53,7 +53,7 @@ def local_phi_results(A):
     f = A.save(fig, "tau_local_phi.png")
     for p in pts:
         cells = [f"{label.split(' ')[0]} {fmt(*p.mean(fn)[:2])}" for label, fn, _, _ in MEASURES if measured(p, fn)]
-        A.row(f"relaxation times at φ = {p.phi:g} (N {p.N})", "issue 26 (not in the paper)", "not measured",
+        A.row(f"relaxation times at φ = {p.phi:g} (N {p.N})", "not in the paper", "not measured",
               ", ".join(cells), "—", f, [p])
 
 
@@ -87,7 +87,7 @@ def local_n_results(A):
                                    [measured_error(ms[i]) if ms[i][3] == len(d[ns[i]].runs) and steady[i] else math.nan
                                     for i in ok])[0]
             cells += "".join(f"; N {ns[i]} not steady (out of the verdict)" for i in ok if not steady[i])
-            A.row(f"{label.split(' ')[0]} against N at φ = {phi:g}", "issue 26, item 8 (not in the paper)",
+            A.row(f"{label.split(' ')[0]} against N at φ = {phi:g}", "not in the paper",
                   "not measured", cells, verdict, "", used)
         ax.set_xscale("log")
         ax.set_yscale("log")

@@ -100,7 +100,7 @@ CR_SUFFIX = " (cage-relative)"
 
 
 def side_by_side(rows):
-    """Issue 27, item 3: every result the table states both ways, the
+    """Every result the table states both ways, the
     standard measure beside the cage-relative one (its rows "... (cage-
     relative)"), in the table's order; [] where there are none. A pair is
     the same section and the same name up to its numbers (a phi_c held at

@@ -62,7 +62,7 @@ def whole_box_s4(c):
 
 
 XI_MIN = 0.3   # below this OZ xi, S4 varies by less than 10% over q <= 1: not determined
-MIN_SHELLS = 5  # an OZ xi (and its chi0) needs this many q shells below q xi = 1 (issue 27, item 4)
+MIN_SHELLS = 5  # an OZ xi (and its chi0) needs this many q shells below q xi = 1
 
 
 def shells_below(c, g, xi):

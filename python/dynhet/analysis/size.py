@@ -296,7 +296,7 @@ def d_n_results(A):
     """D against N at each density run at several N, and theta of
     D ~ tau_alpha^-theta at each N over the densities it has (studies/d_size.toml):
     in two dimensions box-scale flows carry part of D and may make both
-    depend on the box (issue 31, item 8)."""
+    depend on the box."""
     dD = lambda r: (r.get("D", math.nan), r.get("D_err", math.nan))
     multi = points_by_phi_n(A, lambda p: np.isfinite(p.mean(dD)[0]), lead_by="n")
     if not multi:

@@ -141,7 +141,7 @@ def c_b_times(multi):
     """Per density, where C_B is compared across N: the longest lag that
     every run of it (at every N) reached and at which every run's origin
     blocks span it (blocks_span), so that every size, one seed too, has an
-    error there (item 5); the longest lag every run reached where no lag
+    error there; the longest lag every run reached where no lag
     has that."""
     out = []
     for phi, d in multi.items():

@@ -195,7 +195,7 @@ class Analysis:
         self.study_name = getattr(self, "study_name", study)
 
     def promote_largest_n(self):
-        """Issue 27, item 3: at each (pairs, eps, phi) of this study, the point
+        """At each (pairs, eps, phi) of this study, the point
         of the largest N over this study and the --also studies whose runs
         measured everything this study's point measured, and all of whose
         study's runs at that point are complete, and of a size that the study

@@ -47,7 +47,7 @@ def fit_verdict(f, name, paper, transform=lambda v: v):
 
 def fixed_xc_row(A, key, item, sec, paper, fn, pts, joint, fig):
     """A critical fit y = A (phi_c - phi)^-g with phi_c held at the joint
-    fit's (item 6 of the checks: a free phi_c that sits on the edge of the
+    fit's (a free phi_c that sits on the edge of the
     data decides the exponent; the same exponent with the shared phi_c is
     the comparison that can be judged). phi_c's own error is not carried."""
     xc = joint.p["xc"] if joint is not None and joint.ok else math.nan

@@ -3,7 +3,7 @@
 // PRL 117, 245701 (2016)): a bond joins i and j when r_ij < A1 sigma_ij at
 // the origin frame t0; it is broken at t0 + t when r_ij > A2 sigma_ij.
 // C_B(t) is the fraction of t0's bonds not broken. Unlike the overlap it
-// does not see a particle move together with its neighbours (issue 26).
+// does not see a particle move together with its neighbours.
 #include <array>
 #include <cstdint>
 #include <vector>

@@ -1,6 +1,6 @@
 #pragma once
 // Cages: who a particle's neighbours are at an origin frame, and the
-// displacement of a particle relative to its cage (issue 26).
+// displacement of a particle relative to its cage.
 //
 // In two dimensions long-wavelength displacements grow with the box
 // (Mermin-Wagner; Flenner and Szamel, Nat. Commun. 6, 7392 (2015)): they

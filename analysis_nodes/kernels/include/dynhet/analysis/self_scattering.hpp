@@ -1,7 +1,7 @@
 #pragma once
 // Self part of the intermediate scattering function and the non-Gaussian
-// parameter from one (origin, lag) pair's squared displacements (issue 26,
-// item 3), for all particles or one species:
+// parameter from one (origin, lag) pair's squared displacements, for all
+// particles or one species:
 //   F_s(q, t)  = < exp(i q . dr_j) > averaged over the directions of q
 //              = < J0(q |dr_j|) >                       (two dimensions),
 //   alpha_2(t) = < dr^4 > / (2 < dr^2 >^2) - 1          (two dimensions:
