@@ -184,7 +184,7 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=()):
     for r in A.rows:
         note = f" ({r['note']})" if r["note"] else ""
         L.append(f"| {r['item']} | {r['section']} | {r['paper']} | {r['ours']}{note} | {r['verdict']} | "
-                 f"{'`' + r['figure'] + '`' if r['figure'] else '—'} | {hms(r['cpu'])} |")
+                 f"{figure_link(r['figure'])} | {hms(r['cpu'])} |")
     L += side_by_side(A.rows)
     if getattr(A, "driving_table", None):
         L += ["", "## The two driving rules side by side (ε = 0.9)", "",
@@ -220,6 +220,31 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=()):
             with open(discussion) as d:
                 fh.write("\n" + d.read())
     os.replace(path + ".tmp", path)
+    copy_figures(A, os.path.dirname(os.path.abspath(path)))
+
+
+def figure_link(figure):
+    """A row's figure as a link relative to the table (figures/ beside it)."""
+    return f"[{os.path.basename(figure)}]({figure})" if figure else "—"
+
+
+def copy_figures(A, doc_dir):
+    """The figures the analysis drew, into figures/ beside a table written
+    outside the analysis's own output (docs/reproduction.md: its links then
+    resolve in the repository); a figure there that this analysis did not
+    draw is removed, never left as if current. Without figures (the text
+    alone) the folder is left as the last full analysis drew it."""
+    if not A.figures or os.path.abspath(doc_dir) == os.path.abspath(A.out) or not os.path.isdir(A.figdir):
+        return
+    import shutil
+    to = os.path.join(doc_dir, "figures")
+    os.makedirs(to, exist_ok=True)
+    drawn = {f for f in os.listdir(A.figdir) if f.endswith(".png")}
+    for f in drawn:
+        shutil.copy(os.path.join(A.figdir, f), os.path.join(to, f))
+    for f in os.listdir(to):
+        if f.endswith(".png") and f not in drawn:
+            os.remove(os.path.join(to, f))
 
 
 def study_cell(A, p):
