@@ -13,10 +13,12 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <iostream>
 #include <cstdio>
 #include <map>
 #include <optional>
 #include <random>
+#include <sstream>
 #include <string>
 #include <thread>
 #include <unistd.h>
@@ -30,6 +32,7 @@
 #include "reporter.hpp"
 #include "cut_coordinator.hpp"
 #include "initial_state.hpp"
+#include "scene_report.hpp"
 #include "dynhet/bus.hpp"
 #include "dynhet/bus_cli.hpp"
 #include "dynhet/cut.hpp"
@@ -79,6 +82,10 @@ int main(int argc, char** argv) {
   const double cut_wait = o.cut_wait, test_frame_delay = o.test_frame_delay;
   const dynhet::BusOptions& bus_options = o.bus;
 
+  if (o.scene_reference) {
+    std::fputs(dynhet::scene_reference_markdown().c_str(), stdout);
+    return 0;
+  }
   if (scene_path.empty() == resume_path.empty()) {
     std::fprintf(stderr, "sim_node: give either a scene file or --resume CHECKPOINT\n");
     return 2;
@@ -96,6 +103,10 @@ int main(int argc, char** argv) {
                                  "\", its scene now means \"" + scene.kick_pairs +
                                  "\" (a checkpoint from before driving.pairs): it cannot be resumed bit for bit; "
                                  "start the run again");
+    } else if (scene_path == "-") {
+      std::stringstream text;
+      text << std::cin.rdbuf();
+      scene = dynhet::parse_scene_text(text.str(), "<stdin>");
     } else {
       scene = dynhet::parse_scene_file(scene_path);
     }
@@ -133,25 +144,8 @@ int main(int argc, char** argv) {
       return 2;
     }
   }
-  if (check) {
-    // The engine's own refusals (a box too small for its cells, ...) are
-    // the scene's: made here, not at run time.
-    try {
-      dynhet::engine::Engine probe(dynhet::engine_params(scene));
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "sim_node: invalid scene (1 problem):\n  %s: system: %s\n", scene_path.c_str(), e.what());
-      return 2;
-    }
-    // One line per fact, for the launch scripts and for people.
-    const auto sched = dynhet::make_schedule(scene.schedule, scene.equilibration_time);
-    std::printf("scene %s: valid\n", scene_path.c_str());
-    for (const auto& note : scene.notes) std::printf("note: %s\n", note.c_str());
-    std::printf("nodes:");
-    for (const auto& n : dynhet::nodes_for(scene.observables)) std::printf(" %s", n.c_str());
-    std::printf("\nframes: %zu\nparticles: %lld\nsim_time: %g\n", sched.frame_time.size(),
-                static_cast<long long>(scene.n_particles), scene.equilibration_time + scene.production_time);
-    return 0;
-  }
+  if (check) return dynhet::report_check(scene, scene_path);
+  if (o.resolved) return dynhet::report_resolved(scene);
   for (const auto& note : scene.notes) std::fprintf(stderr, "sim_node: note: %s\n", note.c_str());
   // Where a scene's initial_state is: relative to the scene file.
   if (!scene.initial_state.empty() && scene.initial_state[0] != '/' && resume_path.empty()) {

@@ -149,16 +149,18 @@ def read_run(path, meta):
 
 def snapshot(path, a, t_target):
     """Positions at an origin frame and slow/fast flags over the pair whose lag
-    is nearest t_target: (xy, radius class, slow, fast, box, lag)."""
+    is nearest t_target: (xy, radius of each disk, slow, fast, box, lag). The
+    radii are the run's own (parameters/run_info, as the simulator resolved
+    them), whatever its radius ratio."""
     with h5py.File(path, "r") as f:
         pos = f["particles/all/position/value"]
         img = f["particles/all/image/value"]
         ftime = f["particles/all/position/time"][:]
         box = f["particles/all/box/edges"][:]
-        species = f["particles/all/species"][:]
+        radii = np.asarray(f["parameters/run_info"].attrs["radius"], float)[f["particles/all/species"][:]]
         i0 = 0
         j = int(np.argmin(np.abs(np.log(np.maximum(ftime - ftime[i0], 1e-300)) - math.log(t_target))))
         u0 = pos[i0].reshape(-1, 2) + img[i0].reshape(-1, 2) * box
         u1 = pos[j].reshape(-1, 2) + img[j].reshape(-1, 2) * box
         d = np.linalg.norm(u1 - u0, axis=1)
-        return pos[i0].reshape(-1, 2), species, d < a, d > 3 * a, box, float(ftime[j] - ftime[i0])
+        return pos[i0].reshape(-1, 2), radii, d < a, d > 3 * a, box, float(ftime[j] - ftime[i0])

@@ -18,6 +18,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ..run import open_run
+from ..scene import default
 
 
 def plot_cage_relative(ax, c, gi, qmin):
@@ -50,7 +51,7 @@ def no_fit_reason(g, gi):
     shells in a sub-box that small, the node's rule at the lags around t_s4,
     or a jackknife error of ξ not below ξ (the rule the node applies at t_s4)."""
     n = int(g["n_shells"][gi])
-    q_max = float(g.attrs.get("q_max", 1.0))
+    q_max = float(g.attrs.get("q_max", default("s4", "q_max")))
     if n < 3:
         return f"{n} q shell{'s' if n != 1 else ''} below q = {q_max:g} in a sub-box this small (3 needed)"
     rules = g["xi_lag_rule"]
