@@ -93,3 +93,45 @@ def test_no_scene_default_or_model_formula_is_copied_into_the_package():
                             found.append(f"{os.path.relpath(os.path.join(base, f), PACKAGE)}:{i}: {line.strip()}")
     assert not found, "scene defaults or model formulas copied:\n" + "\n".join(found)
 
+
+ROOT = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..")
+BEGIN, END = "<!-- begin: sim_node --scene-reference -->\n", "<!-- end: sim_node --scene-reference -->"
+
+
+def scene_reference():
+    return subprocess.run([SIM, "--scene-reference"], capture_output=True, text=True, check=True).stdout
+
+
+def described_keys():
+    keys, table = set(), None
+    for line in scene_reference().splitlines():
+        if m := re.match(r"### \[(\w+)\]$", line):
+            table = m.group(1)
+        elif m := re.match(r"\| `(\w+)` \|", line):
+            keys.add((table, m.group(1)))
+    return keys
+
+
+def test_the_scene_reference_in_the_docs_is_the_descriptions():
+    with open(os.path.join(ROOT, "docs", "scenes.md")) as f:
+        text = f.read()
+    assert BEGIN in text and END in text, "docs/scenes.md has no scene reference section"
+    section = text.split(BEGIN, 1)[1].split(END, 1)[0]
+    assert section == scene_reference(), (
+        "docs/scenes.md's scene reference is not what common/scene_keys.cpp describes: put the output of "
+        "sim_node --scene-reference between its markers")
+
+
+def test_the_default_scene_lists_every_key_the_description_has():
+    # set, or as a comment "# key = ..." under its table
+    listed, table = set(), None
+    with open(os.path.join(ROOT, "scenes", "default.toml")) as f:
+        for line in f:
+            if m := re.match(r"\[(\w+)\]", line):
+                table = m.group(1)
+            elif table and (m := re.match(r"#? ?(\w+) *=", line)):
+                listed.add((table, m.group(1)))
+    described = described_keys()
+    assert len(described) > 50
+    assert listed == described, (f"scenes/default.toml lacks {sorted(described - listed)}; "
+                                 f"lists keys no scene has: {sorted(listed - described)}")
