@@ -4,6 +4,7 @@ import math
 import h5py
 import numpy as np
 
+from .. import schema
 from ..run import open_run
 
 
@@ -47,10 +48,11 @@ def cutoff_groups(run, kind):
     return {a: run.observable(kind, a) for a in run.cutoffs(kind)}
 
 
-def read_cutoffs(run, suffix=""):
+def read_cutoffs(run, cage_relative=False):
     """{a: the cutoff's arrays} of the overlap, chi4, S4 and clusters groups
-    (suffix "_cr": their cage-relative versions; empty where the run has none)."""
-    ov, ch, s4g, cl = (cutoff_groups(run, k + suffix) for k in ("overlap", "chi4", "s4", "clusters"))
+    (their cage-relative versions with cage_relative; empty where the run has none)."""
+    kind = schema.cage_relative if cage_relative else (lambda k: k)
+    ov, ch, s4g, cl = (cutoff_groups(run, kind(k)) for k in ("overlap", "chi4", "s4", "clusters"))
     out = {}
     for a, g in ov.items():
         c = {"lag": g["lag_time"][:], "q": last(g, "q"), "q_err": last(g, "q_err")}
@@ -113,13 +115,13 @@ def read_run(path, meta):
         r["schedule"] = run_schedule(path)
         # The same of the cage-relative displacements (observables.cage_relative),
         # and their tau_alpha beside the standard one.
-        r["cut_cr"] = read_cutoffs(run, "_cr")
+        r["cut_cr"] = read_cutoffs(run, cage_relative=True)
         for a, c in r["cut"].items():
             if a in r["cut_cr"]:
                 c["tau_cr"], c["tau_cr_err"] = r["cut_cr"][a]["tau_alpha"], r["cut_cr"][a]["tau_alpha_err"]
                 c["q_cr"] = r["cut_cr"][a]["q"]
-        if "msd_cr" in obs:  # the cage-relative D (observables.cage_relative), which the cage-relative view takes
-            mc = run.observable("msd_cr")
+        if schema.cage_relative("msd") in obs:  # the cage-relative D, which the cage-relative view takes
+            mc = run.observable(schema.cage_relative("msd"))
             r["D_cr"], r["D_cr_err"] = fnum(last(mc, "diffusion")), fnum(last(mc, "diffusion_err"))
         m = run.msd() if "msd" in obs else None
         if m is not None:

@@ -17,6 +17,7 @@ from .common import pm, legend_below, save, tidy_log
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .. import schema
 from ..run import open_run
 from ..scene import default
 
@@ -131,7 +132,8 @@ def main(path, png):
             print(f"plot_s4: {path} has no s4 results", file=sys.stderr)
             return 1
         groups = [run.s4(a) for a in run.cutoffs("s4")]
-        crs = [run.observable("s4_cr", a) if a in run.cutoffs("s4_cr") else None for a in run.cutoffs("s4")]
+        s4_cr = schema.cage_relative("s4")
+        crs = [run.observable(s4_cr, a) if a in run.cutoffs(s4_cr) else None for a in run.cutoffs("s4")]
         # Per cutoff its grids' panels and the xi(t) panel, at most three a
         # row (two when there are four): a grid of panels, not a strip.
         panels = max(len(g["subbox_per_side"]) for g in groups) + 1

@@ -4,6 +4,7 @@ import math
 import os
 import tomllib
 
+from .. import schema
 from ..scene import default
 from .toml_io import read_toml
 
@@ -305,7 +306,7 @@ class Study:
 
     def tau_group(self, unit=None):
         """The run.h5 group whose tau_alpha the run lengths (or unit's) are counted in."""
-        return "overlap_cr" if (unit or self.run_length["unit"]) == "tau_alpha_cr" else "overlap"
+        return schema.cage_relative("overlap") if (unit or self.run_length["unit"]) == "tau_alpha_cr" else "overlap"
 
     @staticmethod
     def cutoffs(sc):
