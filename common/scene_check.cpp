@@ -28,6 +28,12 @@ std::string num(double v) {
   return std::string(buf, r.ptr);
 }
 
+std::string toml_float(double v) {
+  std::string t = num(v);
+  if (t.find_first_of(".en") == std::string::npos) t += ".0";
+  return t;
+}
+
 std::string show(const toml::node& n) {
   std::ostringstream s;
   if (n.is_table()) return "{...}";

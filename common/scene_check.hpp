@@ -18,6 +18,8 @@ namespace dynhet::scene_detail {
 
 // A number as the shortest text that reads back as the same double.
 std::string num(double v);
+// The same as a TOML float: with a point or an exponent (100.0, not 100).
+std::string toml_float(double v);
 // A node's value as the file wrote it (tables as {...}).
 std::string show(const toml::node& n);
 const char* type_name(const toml::node& n);

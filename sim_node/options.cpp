@@ -9,7 +9,7 @@ namespace dynhet {
 
 int parse_sim_options(int argc, char** argv, SimOptions& o) {
   CLI::App app{"dynhet sim_node: event-driven MD of a driven granular fluid, frames over LCM"};
-  app.add_option("scene", o.scene_path, "scene file (TOML)");
+  app.add_option("scene", o.scene_path, "scene file (TOML); - reads it from standard input");
   app.add_option("--checkpoint", o.checkpoint_path, "write checkpoints (HDF5) to this file");
   app.add_option("--resume", o.resume_path, "continue the run saved in this checkpoint");
   app.add_option("--checkpoint-before-frames", o.before_frames_path,
@@ -32,6 +32,12 @@ int parse_sim_options(int argc, char** argv, SimOptions& o) {
                "frames (their status on DYNHET_NODE_STATUS_<node>), have caught up to within a socket "
                "buffer's worth of frames (run_scene.sh sets it)");
   app.add_flag("--check", o.check, "validate the scene, print what it needs (nodes, frames) and exit");
+  app.add_flag("--resolved", o.resolved,
+               "validate the scene and print it with every key, the defaults filled in (TOML), then [model]: the "
+               "radii, masses, box, G_c, collision frequency, kick rate and amplitude, frames and simulated time "
+               "the simulator derives from it; exit");
+  app.add_flag("--scene-reference", o.scene_reference,
+               "print every scene key with its default, the values allowed and its meaning (Markdown) and exit");
   app.add_option("--test-frame-delay", o.test_frame_delay,
                  "tests only: sleep this many seconds before each frame, a stand-in for a slow engine (large N)");
   app.add_option("--checkpoint-dir", o.cut_root,

@@ -16,6 +16,8 @@ struct SimOptions {
   BusOptions bus;
   bool pace = false;        // --pace-nodes
   bool check = false;       // validate the scene and exit
+  bool resolved = false;    // print the scene with every default filled in and exit
+  bool scene_reference = false; // print the reference of every scene key and exit
   std::string cut_root;     // --checkpoint-dir
   int resume_cut = -1;
   bool find_cut = false;

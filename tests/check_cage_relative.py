@@ -27,7 +27,7 @@ from scipy.spatial import Delaunay
 from scipy.special import j0
 
 # The checks and tau's crossing as check_run.py has them (one list of failures).
-from check_common import check, crossing_time, failures  # noqa: E402
+from check_common import check, crossing_time, failures, scene_of  # noqa: E402
 from check_spatial import check_clusters, check_s4  # noqa: E402
 
 
@@ -78,10 +78,7 @@ def main(path):
     origin_frame, pair_frame, lag = sched["origin_frame"][()], sched["pair_frame"][()], sched["lag_time"][()]
     n = unwrapped.shape[1]
     # dr^CR of every (origin, lag) pair, with the cages of the scene's kind
-    import tomllib
-    text = f["parameters/scene_toml"][()]
-    kind = tomllib.loads(text.decode() if isinstance(text, bytes) else str(text)).get("observables", {}).get("cage",
-                                                                                                          "voronoi")
+    kind = scene_of(f["parameters/scene_toml"][()])["observables"]["cage"]
     cut = None
     if kind == "g_ab":  # the first minima of g_ab of the first origin frame: the clusters node's cutoffs
         cut = obs["clusters"][sorted(obs["clusters"])[0]]["neighbour_cutoff"]["value"][-1]
@@ -144,9 +141,7 @@ def main(path):
             check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, lag,
                      dr_of=lambda k, j: dr_cr[k, j], overlap="overlap_cr", need_fit=False)
     if "clusters_cr" in obs:  # slow and fast clusters by |dr^CR|, by check_spatial.py's brute force
-        import tomllib
-        text = f["parameters/scene_toml"][()]
-        scene = tomllib.loads(text.decode() if isinstance(text, bytes) else str(text))
+        scene = scene_of(f["parameters/scene_toml"][()])
         check_clusters(f, unwrapped, L, origin_frame, pair_frame, obs["schedule"]["lag_time"][()], scene,
                        group="clusters_cr", dr_of=lambda k, j: dr_cr[k, j])
     if "msd" in obs:

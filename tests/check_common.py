@@ -1,12 +1,25 @@
 """What the brute-force checks of a run file share (check_run.py,
 check_spatial.py, check_cage_relative.py): one list of failures, the node's
 definitions of tau's crossing and of the lag bracket, and the estimators
-over origins."""
+over origins, and a run's scene with its defaults filled in."""
 import math
+import os
+import sys
+import tomllib
 
 import numpy as np
 
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
+from dynhet.scene import DEFAULTS  # noqa: E402
+
 failures = []
+
+
+def scene_of(text):
+    """A run's scene (its parameters/scene_toml) with every table's defaults
+    filled in: the simulator's (dynhet.scene), not copies here."""
+    scene = tomllib.loads(text.decode() if isinstance(text, bytes) else str(text))
+    return {t: dict(DEFAULTS[t], **scene.get(t, {})) for t in DEFAULTS if t != "model"}
 
 
 def check(cond, what):

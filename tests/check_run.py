@@ -9,19 +9,18 @@ Usage: check_run.py RUN.h5 SCENE.toml
 """
 import math
 import sys
-import tomllib
 
 import h5py
 import numpy as np
 
-from check_common import check, crossing_time, failures, jackknife, origin_mean
+from check_common import check, crossing_time, failures, jackknife, origin_mean, scene_of
 from check_spatial import check_clusters, check_s4
 
 
 def check_msd_extremes(g, d2, species, scene):
     """The instantaneous fastest and slowest subsets: at every (origin, lag) the particles of the set
     sorted by their own |dr|^2 over that lag, the top and bottom k = round(fraction * set size)."""
-    fractions = {"all": 0.1, "small": 0.2} | {k[9:]: v for k, v in scene.get("msd", {}).items()}
+    fractions = {"all": scene["msd"]["fraction_all"], "small": scene["msd"]["fraction_small"]}
     check(float(g.attrs["fraction_all"]) == fractions["all"] and float(g.attrs["fraction_small"]) == fractions["small"],
           f"msd: fractions {fractions}")
     for name, sel in (("all", slice(None)), ("small", species == 0)):
@@ -86,20 +85,19 @@ def check_displacement(f, unwrapped, origin_frame, pair_frame, lag, scene):
     its jackknife error over blocks of origins against numpy histograms of the recorded frames; the
     Gaussian and exponential-tail fits (and their jackknife errors) redone in numpy."""
     g = f["observables/displacement"]
-    sp = scene.get("displacement", {})
+    sp = scene["displacement"]
     species = f["particles/all/species"][()]
     x, w = g["x"][()], float(g.attrs["bin_width"])
     nb, lo = len(x), x[0] - w / 2
     tail_sigmas, min_count = float(g.attrs["tail_sigmas"]), int(g.attrs["min_bin_count"])
-    check(tail_sigmas == sp.get("tail_sigmas", 2.0) and min_count == sp.get("min_bin_count", 5)
-          and abs(w - sp.get("bin_width", 0.05)) < 1e-15 and nb == round(2 * sp.get("x_max", 10.0) / w),
+    check(tail_sigmas == sp["tail_sigmas"] and min_count == sp["min_bin_count"]
+          and abs(w - sp["bin_width"]) < 1e-15 and nb == round(2 * sp["x_max"] / w),
           f"displacement: {nb} bins of {w}, tail beyond {tail_sigmas} sigma, bins with >= {min_count}")
     a0 = f["observables/schedule/cutoff_a"][0]
     tau = float(g["tau_alpha"]["value"][-1])
     tau_q = float(f[f"observables/overlap/a{a0:g}/tau_alpha/value"][-1])
     check(tau == tau_q, f"displacement: tau_alpha {tau:.5g} is the overlap node's for a = {a0:g}")
-    mult = sp.get("lags_tau_alpha", [0.01, 1.0, 8.5])
-    want = np.array([m * tau for m in mult] + list(sp.get("lags", [])), dtype=float)
+    want = np.array([m * tau for m in sp["lags_tau_alpha"]] + list(sp["lags"]), dtype=float)
     targets = g["target_time"]["value"][-1]
     lag_index = g["lag_index"]["value"][-1]
     check(np.allclose(targets, want, rtol=1e-15), f"displacement: targets {np.round(targets, 4)}")
@@ -107,7 +105,7 @@ def check_displacement(f, unwrapped, origin_frame, pair_frame, lag, scene):
     check(np.array_equal(lag_index, nearest), f"displacement: lags {lag[nearest]} nearest the targets in ln t")
     n_origins = len(origin_frame)
     blocks = min(int(g.attrs["n_blocks"]), n_origins)
-    check(blocks == min(sp.get("error_blocks", 20), n_origins), f"displacement: {blocks} blocks of origins")
+    check(blocks == min(sp["error_blocks"], n_origins), f"displacement: {blocks} blocks of origins")
     block_of = np.arange(n_origins) * blocks // n_origins
     rec = {k: g[k]["value"][-1] for k in ("count", "p", "p_err", "gauss_d", "gauss_d_err", "tail_x0",
                                            "tail_x0_err", "tail_x_min", "samples", "fraction_outside")}
@@ -292,7 +290,7 @@ def main(path, scene_path):
     text = text.decode() if isinstance(text, bytes) else str(text)
     check(text == open(scene_path).read(), "parameters/scene_toml is the scene file")
     check(int(f.attrs.get("complete", 0)) == 1, "file marked complete")
-    for obs in tomllib.loads(text).get("observables", {}).get("compute", []):
+    for obs in scene_of(text)["observables"]["compute"]:
         check(f"observables/{obs}" in f, f"observables/{obs} recorded (the scene asks for it)")
 
     box = f["particles/all/box"]
@@ -349,7 +347,7 @@ def main(path, scene_path):
         check(best <= nudged * (1 + 1e-9), f"{name}: fit beta={beta:.4g} tau0={tau0:.4g} is a least-squares minimum")
     if "observables/chi4" in f:
         check_chi4(f, unwrapped, L, origin_frame, pair_frame)
-    scene = tomllib.loads(text)
+    scene = scene_of(text)
     if "observables/msd" in f:
         check_msd(f, unwrapped, origin_frame, pair_frame, lag, scene)
     if "observables/displacement" in f:

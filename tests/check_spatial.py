@@ -7,7 +7,7 @@ from collections import deque
 
 import numpy as np
 
-from check_common import bracket, check, crossing_time, quad_minus_lin
+from check_common import bracket, check, crossing_time, quad_minus_lin, scene_of
 
 def s4_shells_brute(x0, w, L, m, q_max, n_total):
     """S4 per |q| shell (paper eqs. 15-16) for one origin and lag by the exact
@@ -66,9 +66,9 @@ def check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, sched_lag, dr_o
     lags = g["lag_time"][()]
     s4_lag = g["s4_lag"]["value"][-1]  # [lag][value]
     check(s4_lag.shape == (len(lags), len(q_rec)), f"s4 {name}: s4_lag's last record is [lag][value] {s4_lag.shape}")
-    hw = 4  # the Gaussian half-width: the scene's [s4] half_width, default 4
-    if "s4" in f["parameters"] and "half_width" in f["parameters/s4"].attrs:
-        hw = int(f["parameters/s4"].attrs["half_width"])
+    # the Gaussian half-width: the scene's [s4] half_width
+    hw = int(f["parameters/s4"].attrs["half_width"]) if "s4" in f["parameters"] and "half_width" in \
+        f["parameters/s4"].attrs else scene_of(f["parameters/scene_toml"][()])["s4"]["half_width"]
     start = np.concatenate([[0], np.cumsum(n_shells)])
     worst = 0.0
     for li, t in enumerate(lags):
@@ -233,10 +233,10 @@ def check_clusters(f, unwrapped, L, origin_frame, pair_frame, lag, scene, group=
     if dr_of is None:
         def dr_of(k, j):
             return unwrapped[pair_frame[k][j]] - unwrapped[origin_frame[k]]
-    spec = scene.get("clusters", {})
+    spec = scene["clusters"]
     species = f["particles/all/species"][()].astype(int)
     n = unwrapped.shape[1]
-    n_min = spec.get("fractal_min_size", 10)
+    n_min = spec["fractal_min_size"]
     for name, g in f["observables/" + group].items():
         name = name if group == "clusters" else f"{group}/{name}"
         a = float(g.attrs["cutoff_a"])
@@ -249,9 +249,9 @@ def check_clusters(f, unwrapped, L, origin_frame, pair_frame, lag, scene, group=
         g_rec = np.array([g[k]["value"][-1] for k in ("g11", "g12", "g22")])
         err = np.max(np.abs(np.mean(gs, axis=0) - g_rec))
         check(err < 1e-9, f"clusters {name}: g_ab over {len(gs)} origin frames equals brute force (max diff {err:.2g})")
-        frames = spec.get("cutoff_frames", 1)
+        frames = spec["cutoff_frames"]
         g_fix = np.mean(gs[:frames], axis=0)
-        cut_bf = np.array([first_minimum(r, g_fix[p], spec.get("gr_smoothing", 0.1)) for p in range(3)])
+        cut_bf = np.array([first_minimum(r, g_fix[p], spec["gr_smoothing"]) for p in range(3)])
         cut = g["neighbour_cutoff"]["value"][-1]
         check(np.allclose(cut, cut_bf, rtol=1e-9, atol=0), f"clusters {name}: neighbour cutoffs {cut} are the first minima of g_ab")
 

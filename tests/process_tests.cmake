@@ -220,7 +220,8 @@ set_tests_properties(tcpq_hub_death_ends_every_process_cleanly PROPERTIES LABELS
 # the run reader, the study model, the fits, the row-by-row restatement.
 add_test(NAME python_unit
   COMMAND /usr/bin/python3 -m pytest -q -p no:cacheprovider ${CMAKE_CURRENT_SOURCE_DIR}/python)
-set_tests_properties(python_unit PROPERTIES LABELS unit TIMEOUT 120)
+# The package asks this build's sim_node for resolved scenes (dynhet.scene).
+set_tests_properties(python_unit PROPERTIES LABELS unit TIMEOUT 120 ENVIRONMENT BUILD_DIR=${CMAKE_BINARY_DIR})
 
 # launch_scripts/reproduce.sh, the recipe of the reproduction from nothing:
 # every study it names dry-runs, the sum is theirs, bad input refused.

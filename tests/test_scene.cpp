@@ -2,6 +2,7 @@
 // message naming the key, the value and what is allowed.
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -224,4 +225,51 @@ TEST(Scene, ValuesThatCannotRunAreRefusedUpFront) {
   const auto s = parse_scene_text(
       "[schedule]\norigin_spacing = 9007199254740992\nlag_max = 10\n[run]\ncheckpoint_interval = 1e12\n", "exact");
   EXPECT_EQ(s.schedule.origin_spacing, 9007199254740992.0);
+}
+
+// The resolved scene (scene_toml, sim_node --resolved) is the scene: it
+// reads back as itself, every key written out, defaults filled in.
+TEST(Scene, ResolvedSceneReadsBackAsItself) {
+  const std::string dir = std::string(DYNHET_SOURCE_DIR) + "/scenes/";
+  std::vector<dynhet::Scene> scenes{parse_scene_text("", "empty.toml"), dynhet::parse_scene_file(dir + "default.toml"),
+                                    dynhet::parse_scene_file(dir + "tiny.toml"),
+                                    parse_scene_text("[driving]\nkick_rate = 3.5\ncontact_value = 1.25\n"
+                                                     "[clusters]\nlag = 2.0\nneighbour_cutoffs = [2.5, 3.0, 3.5]\n"
+                                                     "[s4]\nlags = [1.0, 10.0]\nsubbox_particles = [50]\n"
+                                                     "[system]\ninitial_state = \"a \\\"b\\\".h5\"\n",
+                                                     "numbers.toml")};
+  for (const auto& s : scenes) {
+    const std::string text = dynhet::scene_toml(s);
+    const dynhet::Scene again = parse_scene_text(text, s.path + " (resolved)");
+    EXPECT_EQ(dynhet::scene_toml(again), text) << s.path;
+    EXPECT_EQ(dynhet::scene_kick_rate(again), dynhet::scene_kick_rate(s)) << s.path;
+    EXPECT_EQ(again.initial_state, s.initial_state);
+    for (const std::string& key : dynhet::scene_key_names()) {
+      if (key == "system.initial_state" && s.initial_state.empty()) continue; // no path: compress
+      const std::string name = key.substr(key.find('.') + 1);
+      EXPECT_NE(text.find("\n" + name + " = "), std::string::npos) << key << " missing in\n" << text;
+    }
+  }
+  const std::string defaults = dynhet::scene_toml(scenes[0]);
+  for (const char* line : {"packing_fraction = 0.7\n", "radius_ratio = 1.43\n", "kick_rate = \"enskog\"\n",
+                           "contact_value = \"mixture\"\n", "cutoff_a = [0.6]\n", "production_time = 190.0\n",
+                           "lags = \"all\"\n", "neighbour_cutoffs = \"g_ab\"\n"})
+    EXPECT_NE(defaults.find(line), std::string::npos) << line << " not in\n" << defaults;
+}
+
+// [model]: what the simulator derives, by model.hpp's formulas.
+TEST(Scene, ModelTableHoldsTheEngineFormulas) {
+  const auto s = parse_scene_text("[system]\npacking_fraction = 0.76\nradius_ratio = 1.2\nrestitution = 0.8\n", "m");
+  const std::string t = dynhet::model_toml(s);
+  auto value = [&](const std::string& key) {
+    const auto at = t.find("\n" + key + " = ");
+    EXPECT_NE(at, std::string::npos) << key;
+    return std::stod(t.substr(at + key.size() + 4));
+  };
+  EXPECT_EQ(value("kick_rate"), dynhet::scene_kick_rate(s));
+  EXPECT_EQ(value("collision_frequency"),
+            dynhet::enskog_frequency(0.76, dynhet::mixture_contact_value(0.76, 1.2)));
+  EXPECT_EQ(value("kick_amplitude"), dynhet::kick_amplitude(0.8, 1.0, 1.44));
+  EXPECT_EQ(value("box_length"), dynhet::make_model(1000, 0.76, 1.2).box_length);
+  EXPECT_EQ(value("sim_time"), s.equilibration_time + s.production_time);
 }

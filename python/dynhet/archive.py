@@ -36,13 +36,14 @@ import time
 import h5py
 import numpy as np
 
+from .scene import default
 from .study.paths import BUILD
 from .study.toml_io import read_toml, toml_value, write_atomic
 
 FORMAT = 1
 MAX_BYTES = 1 << 20          # one entry at most 1 MiB at any N
 COMPRESS_OVER = 1024         # bytes: larger datasets are stored gzip-compressed
-A_SNAPSHOT = 0.6             # the cutoff whose tau_alpha picks the snapshot frame (analysis.config.A_MAIN)
+A_SNAPSHOT = default("observables", "cutoff_a")[0]  # whose tau_alpha picks the snapshot frame (analysis.config.A_MAIN)
 RUN_KEYS = ("state", "tau_estimate", "tau_source", "tau_alpha", "wall_s", "cpu_s", "cpu_unrecorded", "attempts",
             "requeues", "finished")
 PILOT_KEYS = ("state", "tau_alpha", "unit", "guess", "attempts", "packing_fraction", "series", "wall_s",

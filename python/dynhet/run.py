@@ -30,9 +30,9 @@ import warnings
 import h5py
 import numpy as np
 
-from . import schema
+from . import scene, schema
 
-A_DEFAULT = 0.6  # the paper's cutoff, "unless stated otherwise"
+A_DEFAULT = scene.default("observables", "cutoff_a")[0]  # the scene's, the paper's "unless stated otherwise"
 CUTOFF_REL_TOL = 1e-6  # a cutoff asked for matches the run's within this (labels and floats round)
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 

@@ -31,13 +31,23 @@ def declaration(kind):
     return d if d is not None and d["cage_relative"] else None
 
 
+def cage_relative(kind):
+    """The group kind of an observable's cage-relative variant ("chi4" ->
+    "chi4_cr"), from its declaration; KeyError if it has none."""
+    d = BY_NAME.get(kind)
+    if d is None or not d["cage_relative"]:
+        raise KeyError(f"{kind!r} has no cage-relative variant; those that have: "
+                       + ", ".join(o["name"] for o in OBSERVABLES if o["cage_relative"]))
+    return kind + CAGE_RELATIVE
+
+
 def kinds():
     """Every group kind a run may have: each observable and its _cr variant."""
     out = []
     for d in OBSERVABLES:
         out.append(d["name"])
         if d["cage_relative"]:
-            out.append(d["name"] + CAGE_RELATIVE)
+            out.append(cage_relative(d["name"]))
     return out
 
 

@@ -190,15 +190,15 @@ def test_the_dry_runs_time_left_counts_only_what_a_running_run_has_not_simulated
     from dynhet.study.index import share_done
     d = tmp_path / "run"
     d.mkdir()
-    scene = {"run": {"equilibration_time": 19890.0}}
-    assert share_done(str(d), "running", scene, 21880.0) == 0.0        # no progress line yet
+    sim_time = 19890.0 + 21880.0                                       # equilibration + production
+    assert share_done(str(d), "running", sim_time) == 0.0        # no progress line yet
     (d / "sim_node.log").write_text(
         "[equilibrate] t=7830      /1.989e+04  phi=0.8000  coll/s=1.36e+06  T=0.86  Z=29.6  frames 0/212  ETA 4:57:36\n")
     # equilibration's line names the end of equilibration; the share is of both phases (one clock)
-    assert math.isclose(share_done(str(d), "running", scene, 21880.0), 7830.0 / 41770.0)
-    assert math.isclose(share_done(str(d), "interrupted", scene, 21880.0), 7830.0 / 41770.0)
+    assert math.isclose(share_done(str(d), "running", sim_time), 7830.0 / 41770.0)
+    assert math.isclose(share_done(str(d), "interrupted", sim_time), 7830.0 / 41770.0)
     for state in ("failed", "pending", "too_short", "complete"):   # these start over, or are not left
-        assert share_done(str(d), state, scene, 21880.0) == 0.0
+        assert share_done(str(d), state, sim_time) == 0.0
 
 
 def test_a_running_run_is_described_from_its_sims_last_progress_line(tmp_path):

@@ -169,6 +169,21 @@ Scene parse_scene_text(const std::string& text, const std::string& origin);
 // Read the file and parse it.
 Scene parse_scene_file(const std::string& path);
 
+// The scene as TOML with every key written out: the defaults filled in and
+// the production time the schedule needs; it reads back as the same scene.
+// Keys and defaults come from one description (common/scene_keys.cpp).
+std::string scene_toml(const Scene& s);
+// What the simulator derives from a scene, as the TOML table [model] (not a
+// scene table): the species' radii and masses, the box, G_c, the Enskog
+// collision frequency, the kick rate and amplitude the engine is given
+// (model.hpp's formulas), the number of frames and the simulated time.
+std::string model_toml(const Scene& s);
+// Every key of every table with its default, the values allowed and its
+// meaning, as Markdown tables (the reference in docs/scenes.md).
+std::string scene_reference_markdown();
+// Every key as "table.key", table by table.
+std::vector<std::string> scene_key_names();
+
 // G_c of the scene: its number, or its recipe at its phi and radius ratio.
 double scene_contact_value(const Scene& s);
 // Kicks per particle per unit time: the scene's number, or the paper's

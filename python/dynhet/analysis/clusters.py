@@ -2,6 +2,8 @@
 import math
 
 import matplotlib.pyplot as plt
+from matplotlib.collections import EllipseCollection
+from matplotlib.patches import Patch
 import numpy as np
 
 from .. import collapse
@@ -160,15 +162,21 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
             continue
         shown.append(p)
         r = next(r for r in p.runs if r.get("has_frames"))
-        xy, sp, slow, fast, box, lag = snapshot(r["path"], A_MAIN, cut(r)["tau_alpha"])
-        ax[k].scatter(xy[:, 0], xy[:, 1], s=0.2, c="#dddddd")
-        ax[k].scatter(xy[slow, 0], xy[slow, 1], s=1.2, c="#b2182b", label=f"slow ({slow.mean():.2f})")
-        ax[k].scatter(xy[fast, 0], xy[fast, 1], s=1.2, c="#555555", label=f"fast ({fast.mean():.2f})")
+        xy, radii, slow, fast, box, lag = snapshot(r["path"], A_MAIN, cut(r)["tau_alpha"])
+        # every disk at its own radius (data units), slow and fast ones coloured
+        shown_as = []
+        for m, colour, label in ((~(slow | fast), "#dddddd", None), (slow, "#b2182b", f"slow ({slow.mean():.2f})"),
+                                 (fast, "#555555", f"fast ({fast.mean():.2f})")):
+            ax[k].add_collection(EllipseCollection(2 * radii[m], 2 * radii[m], 0.0, units="xy", offsets=xy[m],
+                                                   offset_transform=ax[k].transData, facecolors=colour,
+                                                   edgecolors="none"))
+            if label:
+                shown_as.append(Patch(color=colour, label=label))
         ax[k].set_aspect("equal")
         ax[k].set_xlim(0, box[0])
         ax[k].set_ylim(0, box[1])
         ax[k].set_title(f"φ = {p.phi:g}, t = {lag:.3g} (τ_α = {cut(r)['tau_alpha']:.3g})", fontsize=9)
-        ax[k].legend(fontsize=7, loc="upper right")
+        ax[k].legend(handles=shown_as, fontsize=7, loc="upper right")
     f3 = A.save(fig, "snapshots.png")
     A.row("snapshots of slow and fast particles at τ_α, three densities", "3.3, fig. SD-2", "figure only",
           ", ".join(f"φ = {p.phi:g}" for p in shown) or "no run kept its frames", "figure", f3, shown)

@@ -1,6 +1,8 @@
 """The study analysis' conventions: the paper's cutoff and restitution, the densities and ranges it names."""
 import os
 
+from ..scene import default
+
 CONVENTIONS = """(docs/analysis.md, "Study analysis"):
 - A point is (driving.pairs, restitution, packing fraction, N); its value is
   the mean over seeds, its error the standard error of that mean from the
@@ -29,8 +31,8 @@ CONVENTIONS = """(docs/analysis.md, "Study analysis"):
   xi is the whole box's OZ xi (the finest q).
 """
 
-A_MAIN = 0.6          # the paper's cutoff, "unless stated otherwise"
-EPS_MAIN = 0.9        # the paper's restitution, "unless stated otherwise"
+A_MAIN = default("observables", "cutoff_a")[0]  # the scene's, the paper's "unless stated otherwise"
+EPS_MAIN = default("system", "restitution")  # the scene's, the paper's "unless stated otherwise"
 XI_MIN_DF = 3.0      # d_f' (chi4 against xi) over xi >= 3 particle diameters
 PHI_SNAP = (0.60, 0.78, 0.805)   # the paper's snapshot densities (nearest available are used)
 PHI_AGE = (0.78, 0.805)          # the paper's ageing densities

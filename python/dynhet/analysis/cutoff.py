@@ -51,7 +51,7 @@ def cutoff_results(A):
         for a, v in zip(cuts, own):
             reached[a] = reached.get(a, 0) + int(np.isfinite(v))
     ax[0].set_xlabel("a")
-    ax[0].set_ylabel("ξ: at τ_α(a) (solid), at τ_α(0.6) (dashed)")
+    ax[0].set_ylabel(f"ξ: at τ_α(a) (solid), at τ_α({A_MAIN:g}) (dashed)")
     ax[0].set_yscale("log")
     ax[0].legend(fontsize=6, ncol=2, title="φ", title_fontsize=7)
     ax[0].set_title("ξ(τ_α(a)) against the cutoff a (paper, sec. 3.4)")
@@ -64,7 +64,7 @@ def cutoff_results(A):
     ax[1].set_xlabel("t")
     ax[1].set_ylabel("χ4(t)")
     ax[1].legend(fontsize=7)
-    ax[1].set_title(f"χ4(t) for several cutoffs a (φ = {mid.phi:g}; lags to {reach(mid):.3g} τ_α(0.6))")
+    ax[1].set_title(f"χ4(t) for several cutoffs a (φ = {mid.phi:g}; lags to {reach(mid):.3g} τ_α({A_MAIN:g}))")
     outs = []
     for a, m in zip(A_THREE, ("o", "s", "^")):
         if a not in cuts:
@@ -93,9 +93,9 @@ def cutoff_results(A):
     short = [f"{a:g}" for a in cuts if reached.get(a, 0) < len(pts)]
     lags = min(reach(p) for p in pts)
     A.row(f"ξ(τ_α) against a ({cuts[0]:g} to {cuts[-1]:g}) for all φ; χ4(t) for several a", "3.4, figs. xi-vs-a, chi4-diff-a",
-          "figure only", f"{len(cuts)} cutoffs, {len(pts)} densities (φ {pts[0].phi:g}-{pts[-1].phi:g}), study {', '.join(src)} (lags to {lags:.3g} τ_α(0.6))" +
+          "figure only", f"{len(cuts)} cutoffs, {len(pts)} densities (φ {pts[0].phi:g}-{pts[-1].phi:g}), study {', '.join(src)} (lags to {lags:.3g} τ_α({A_MAIN:g}))" +
           (f"; ξ at τ_α(a) not determined at some φ for a = {', '.join(short)} (τ_α(a) beyond the lags, "
-           f"{lags:.3g} τ_α(0.6), or ξ < {XI_MIN:g})" if short else ""), "figure", f, pts)
+           f"{lags:.3g} τ_α({A_MAIN:g}), or ξ < {XI_MIN:g})" if short else ""), "figure", f, pts)
     # At the main cutoff the same fit is the main series' d_f' row, whose
     # points may come from larger boxes (--largest-n): said beside it.
     main = A.fits.get("chi4_xi")

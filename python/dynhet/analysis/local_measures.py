@@ -7,7 +7,7 @@ import math
 import matplotlib.pyplot as plt
 import numpy as np
 
-from .config import say
+from .config import A_MAIN, EPS_MAIN, say
 from .overlap import tau_fits
 from .plotting import errorbar
 from .points import measured_error, point_error, series_arrays
@@ -49,7 +49,7 @@ def local_phi_results(A):
     ax.set_xlabel("φ")
     ax.set_ylabel("relaxation time")
     ax.legend(fontsize=8)
-    ax.set_title("τ_α, cage-relative τ_α^CR and bond-breaking τ_B (ε = 0.9, a = 0.6)")
+    ax.set_title(f"τ_α, cage-relative τ_α^CR and bond-breaking τ_B (ε = {EPS_MAIN:g}, a = {A_MAIN:g})")
     f = A.save(fig, "tau_local_phi.png")
     for p in pts:
         cells = [f"{label.split(' ')[0]} {fmt(*p.mean(fn)[:2])}" for label, fn, _, _ in MEASURES if measured(p, fn)]

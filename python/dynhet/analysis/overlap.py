@@ -5,7 +5,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from .. import fits as sf
-from .config import PHI_AGE
+from .config import A_MAIN, EPS_MAIN, PHI_AGE
 from .points import fit_series, series_arrays
 from .quantities import cut, tau
 from .verdicts import fit_verdict, fixed_xc_row, fmt, verdict
@@ -29,7 +29,7 @@ def overlap_results(A):
     ax[0].set_xlabel("t")
     ax[1].set_xlabel("t / τ_α")
     ax[0].legend(fontsize=7, ncol=2)
-    ax[0].set_title("Q(t), ε = 0.9, a = 0.6 (paper, sec. 3.1)")
+    ax[0].set_title(f"Q(t), ε = {EPS_MAIN:g}, a = {A_MAIN:g} (paper, sec. 3.1)")
     ax[1].set_title("Q against t/τ_α (paper, sec. 3.1)")
     allp = [p for k, p in A.points.items() if k[0] == "neighbours"]
     xs = np.linspace(-6, 6, 200)

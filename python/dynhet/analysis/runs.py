@@ -4,6 +4,7 @@ import math
 import h5py
 import numpy as np
 
+from .. import schema
 from ..run import open_run
 
 
@@ -47,10 +48,11 @@ def cutoff_groups(run, kind):
     return {a: run.observable(kind, a) for a in run.cutoffs(kind)}
 
 
-def read_cutoffs(run, suffix=""):
+def read_cutoffs(run, cage_relative=False):
     """{a: the cutoff's arrays} of the overlap, chi4, S4 and clusters groups
-    (suffix "_cr": their cage-relative versions; empty where the run has none)."""
-    ov, ch, s4g, cl = (cutoff_groups(run, k + suffix) for k in ("overlap", "chi4", "s4", "clusters"))
+    (their cage-relative versions with cage_relative; empty where the run has none)."""
+    kind = schema.cage_relative if cage_relative else (lambda k: k)
+    ov, ch, s4g, cl = (cutoff_groups(run, kind(k)) for k in ("overlap", "chi4", "s4", "clusters"))
     out = {}
     for a, g in ov.items():
         c = {"lag": g["lag_time"][:], "q": last(g, "q"), "q_err": last(g, "q_err")}
@@ -113,13 +115,13 @@ def read_run(path, meta):
         r["schedule"] = run_schedule(path)
         # The same of the cage-relative displacements (observables.cage_relative),
         # and their tau_alpha beside the standard one.
-        r["cut_cr"] = read_cutoffs(run, "_cr")
+        r["cut_cr"] = read_cutoffs(run, cage_relative=True)
         for a, c in r["cut"].items():
             if a in r["cut_cr"]:
                 c["tau_cr"], c["tau_cr_err"] = r["cut_cr"][a]["tau_alpha"], r["cut_cr"][a]["tau_alpha_err"]
                 c["q_cr"] = r["cut_cr"][a]["q"]
-        if "msd_cr" in obs:  # the cage-relative D (observables.cage_relative), which the cage-relative view takes
-            mc = run.observable("msd_cr")
+        if schema.cage_relative("msd") in obs:  # the cage-relative D, which the cage-relative view takes
+            mc = run.observable(schema.cage_relative("msd"))
             r["D_cr"], r["D_cr_err"] = fnum(last(mc, "diffusion")), fnum(last(mc, "diffusion_err"))
         m = run.msd() if "msd" in obs else None
         if m is not None:
@@ -149,16 +151,18 @@ def read_run(path, meta):
 
 def snapshot(path, a, t_target):
     """Positions at an origin frame and slow/fast flags over the pair whose lag
-    is nearest t_target: (xy, radius class, slow, fast, box, lag)."""
+    is nearest t_target: (xy, radius of each disk, slow, fast, box, lag). The
+    radii are the run's own (parameters/run_info, as the simulator resolved
+    them), whatever its radius ratio."""
     with h5py.File(path, "r") as f:
         pos = f["particles/all/position/value"]
         img = f["particles/all/image/value"]
         ftime = f["particles/all/position/time"][:]
         box = f["particles/all/box/edges"][:]
-        species = f["particles/all/species"][:]
+        radii = np.asarray(f["parameters/run_info"].attrs["radius"], float)[f["particles/all/species"][:]]
         i0 = 0
         j = int(np.argmin(np.abs(np.log(np.maximum(ftime - ftime[i0], 1e-300)) - math.log(t_target))))
         u0 = pos[i0].reshape(-1, 2) + img[i0].reshape(-1, 2) * box
         u1 = pos[j].reshape(-1, 2) + img[j].reshape(-1, 2) * box
         d = np.linalg.norm(u1 - u0, axis=1)
-        return pos[i0].reshape(-1, 2), species, d < a, d > 3 * a, box, float(ftime[j] - ftime[i0])
+        return pos[i0].reshape(-1, 2), radii, d < a, d > 3 * a, box, float(ftime[j] - ftime[i0])

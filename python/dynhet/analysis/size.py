@@ -359,7 +359,7 @@ def tau_n_results(A):
     ax.set_xscale("log")
     ax.set_yscale("log")
     ax.set_xlabel("N")
-    ax.set_ylabel("τ_α (ε = 0.9, a = 0.6)")
+    ax.set_ylabel(f"τ_α (ε = {EPS_MAIN:g}, a = {A_MAIN:g})")
     ax.legend(fontsize=8)
     ax.set_title("τ_α against the number of particles")
     f = A.save(fig, "tau_alpha_N.png")

@@ -8,6 +8,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 from ..archive import Archive, ArchiveError
+from ..scene import default
 from ..study.model import RUN_LENGTH_DEFAULTS
 from .config import A_MAIN, EPS_MAIN
 from .runs import read_run
@@ -148,7 +149,7 @@ class Analysis:
         for name, m in sorted(runs.items()):
             path = run_file(sdir, name, m, archive)
             try:
-                key = (m.get("pairs", "neighbours"), float(m["restitution"]), float(m["packing_fraction"]),
+                key = (m.get("pairs", default("driving", "pairs")), float(m["restitution"]), float(m["packing_fraction"]),
                        int(m["n_particles"]))
             except (KeyError, TypeError, ValueError):
                 key = None

@@ -14,6 +14,7 @@ from .common import pm, legend_below, save, tidy_log
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .. import schema
 from ..run import open_run
 
 
@@ -127,7 +128,8 @@ def main(path, png):
         fig, axes = plt.subplots(len(groups), 4, figsize=(18, 5.2 * len(groups)), squeeze=False,
                                  layout="constrained")
         for row, (name, g) in zip(axes, groups):
-            cr = run.observable("clusters_cr", name) if name in run.cutoffs("clusters_cr") else None
+            clusters_cr = schema.cage_relative("clusters")
+            cr = run.observable(clusters_cr, name) if name in run.cutoffs(clusters_cr) else None
             plot_g(row[0], g)
             plot_rg(row[1], g)
             plot_p(row[2], g, cr)

@@ -13,6 +13,7 @@ from .common import pm, legend_right, save, tidy_log
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .. import schema
 from ..run import open_run
 
 
@@ -53,7 +54,8 @@ def main(path, png):
             return 1
         g = run.msd()
         t = g["lag_time"][()]
-        cr = run.observable("msd_cr") if "msd_cr" in run.observables() else None
+        msd_cr = schema.cage_relative("msd")
+        cr = run.observable(msd_cr) if msd_cr in run.observables() else None
         self_part = "alpha2_all" in g
         if self_part:  # the MSD above, F_s(q, t) and alpha_2(t) below
             fig = plt.figure(figsize=(11.0, 9.0), layout="constrained")

@@ -12,6 +12,7 @@ from .common import pm, system_title, legend_below, save, tidy_log
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .. import schema
 from ..run import open_run
 
 
@@ -39,9 +40,10 @@ def main(path, png):
                 tt = np.geomspace(t[0], t[-1], 200)
                 ax.plot(tt, 1 / ((tt / tau0) ** beta + 1), "--", color=color, lw=1,
                         label=rf"fit $\beta$ = {pm(beta, g['beta_err'])}, $\tau_0$ = {pm(tau0, g['tau0_err'])}")
-            if "overlap_cr" in run.observables() and name in run.cutoffs("overlap_cr"):
+            overlap_cr = schema.cage_relative("overlap")
+            if overlap_cr in run.observables() and name in run.cutoffs(overlap_cr):
                 # The same of the cage-relative displacements (observables.cage_relative).
-                c = run.observable("overlap_cr", name)
+                c = run.observable(overlap_cr, name)
                 tau_cr, tau_cr_err = float(c["tau_alpha"]), float(c["tau_alpha_err"])
                 ax.errorbar(c["lag_time"][()], c["q"], yerr=np.nan_to_num(c["q_err"]), marker="o", ms=3, mfc="none",
                             capsize=2, color=color, ls="-.", lw=1,

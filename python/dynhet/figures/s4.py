@@ -17,7 +17,9 @@ from .common import pm, legend_below, save, tidy_log
 import matplotlib.pyplot as plt
 import numpy as np
 
+from .. import schema
 from ..run import open_run
+from ..scene import default
 
 
 def plot_cage_relative(ax, c, gi, qmin):
@@ -50,7 +52,7 @@ def no_fit_reason(g, gi):
     shells in a sub-box that small, the node's rule at the lags around t_s4,
     or a jackknife error of ξ not below ξ (the rule the node applies at t_s4)."""
     n = int(g["n_shells"][gi])
-    q_max = float(g.attrs.get("q_max", 1.0))
+    q_max = float(g.attrs.get("q_max", default("s4", "q_max")))
     if n < 3:
         return f"{n} q shell{'s' if n != 1 else ''} below q = {q_max:g} in a sub-box this small (3 needed)"
     rules = g["xi_lag_rule"]
@@ -130,7 +132,8 @@ def main(path, png):
             print(f"plot_s4: {path} has no s4 results", file=sys.stderr)
             return 1
         groups = [run.s4(a) for a in run.cutoffs("s4")]
-        crs = [run.observable("s4_cr", a) if a in run.cutoffs("s4_cr") else None for a in run.cutoffs("s4")]
+        s4_cr = schema.cage_relative("s4")
+        crs = [run.observable(s4_cr, a) if a in run.cutoffs(s4_cr) else None for a in run.cutoffs("s4")]
         # Per cutoff its grids' panels and the xi(t) panel, at most three a
         # row (two when there are four): a grid of panels, not a strip.
         panels = max(len(g["subbox_per_side"]) for g in groups) + 1

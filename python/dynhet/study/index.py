@@ -1,6 +1,8 @@
 """The study's index (index.toml), its plan and the dry run."""
 import os
 
+from .. import schema
+from ..scene import resolved
 from .toml_io import toml_value, write_atomic
 from .model import AXES
 from .estimates import estimate, fmt_time
@@ -81,8 +83,8 @@ def run_order(sd, todo, est):
 
 
 def nodes_of(sc):
-    comp = sc.get("observables", {}).get("compute", ["overlap"])
-    return len({("overlap" if c in ("chi4", "msd", "displacement") else c) for c in comp})
+    """How many analysis nodes scene sc starts (each observable's declared node)."""
+    return len({schema.declaration(c)["node"] for c in resolved(sc)["observables"]["compute"]})
 
 
 def measured_ratio(done):
@@ -100,14 +102,14 @@ def measured_ratio(done):
     return ratios, (g_all / e_all if e_all > 0 else None)
 
 
-def share_done(run_dir, state, scene, prod):
+def share_done(run_dir, state, sim_time):
     """The share of a running or interrupted run's simulated time (equilibration
     and production, one clock from 0) that its sim's last progress line has
     passed; 0 for any other state (a failed run starts over)."""
     if state not in ("running", "interrupted"):
         return 0.0
     p = sim_progress(run_dir)
-    total = float(scene.get("run", {}).get("equilibration_time", 100)) + prod
+    total = sim_time
     return min(1.0, max(0.0, p["t"] / total)) if p and total > 0 else 0.0
 
 
@@ -133,13 +135,13 @@ def dry_run(sd):
             cpu = float(got)
         else:
             cpu *= ratios.get(n, overall or 1.0)
-        sch = sc.get("schedule", {})
-        prod = (int(sch.get("origins", 10)) - 1) * float(sch.get("origin_spacing", 10)) + float(sch.get("lag_max", 100))
+        run = resolved(sc)["run"]
+        t_eq, prod = run["equilibration_time"], run["production_time"]
         tot_cpu += cpu
-        left_cpu += 0 if state == "complete" else cpu * (1 - share_done(sd.run_dir(p), state, sc, prod))
+        left_cpu += 0 if state == "complete" else cpu * (1 - share_done(sd.run_dir(p), state, t_eq + prod))
         peak = max(peak, mem)
         print(f"{sd.study.run_name(p):44s} {state:9s} {n:8d} "
-              f"{(f'{tau:.4g}' if tau else '-'):>9s} {sc.get('run', {}).get('equilibration_time', 100):9.4g} "
+              f"{(f'{tau:.4g}' if tau else '-'):>9s} {t_eq:9.4g} "
               f"{prod:9.4g} {fmt_time(cpu):>9s} {mem / 2**20:7.0f}M  {src}")
     if overall:
         print("# measured CPU over the engine's estimate, complete runs: "

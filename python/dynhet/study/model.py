@@ -4,6 +4,8 @@ import math
 import os
 import tomllib
 
+from .. import schema
+from ..scene import default
 from .toml_io import read_toml
 
 
@@ -230,9 +232,7 @@ class Study:
 
     def base_value(self, axis):
         table, key, _ = AXES[axis]
-        defaults = {"packing_fraction": 0.7, "restitution": 0.9, "n_particles": 1000, "seed": 1,
-                    "pairs": "neighbours"}
-        return self.base.get(table, {}).get(key, defaults[axis])
+        return self.base.get(table, {}).get(key, default(table, key))
 
     def points(self):
         """Every run: a dict of axis values, in a fixed order (phi slowest)."""
@@ -289,7 +289,7 @@ class Study:
                 eq, origins = min(eq, 5.0), min(origins, 4)
                 cap = rl["pilot_particles_cr"] if unit != rl["unit"] else rl["pilot_particles"]
                 sc["system"]["n_particles"] = min(int(sc["system"]["n_particles"]), cap)
-                sc["observables"] = {"compute": ["overlap"], "cutoff_a": sc.get("observables", {}).get("cutoff_a", [0.6])}
+                sc["observables"] = {"compute": ["overlap"], "cutoff_a": self.cutoffs(sc)}
                 for t in ("chi4", "s4", "clusters", "msd", "displacement"):
                     sc.pop(t, None)
             sc.setdefault("run", {})["equilibration_time"] = round(eq * (tau_eq if tau_eq and not pilot else tau), 6)
@@ -306,7 +306,11 @@ class Study:
 
     def tau_group(self, unit=None):
         """The run.h5 group whose tau_alpha the run lengths (or unit's) are counted in."""
-        return "overlap_cr" if (unit or self.run_length["unit"]) == "tau_alpha_cr" else "overlap"
+        return schema.cage_relative("overlap") if (unit or self.run_length["unit"]) == "tau_alpha_cr" else "overlap"
+
+    @staticmethod
+    def cutoffs(sc):
+        return sc.get("observables", {}).get("cutoff_a", default("observables", "cutoff_a"))
 
     def first_cutoff(self, sc):
-        return sc.get("observables", {}).get("cutoff_a", [0.6])[0]
+        return self.cutoffs(sc)[0]

@@ -7,6 +7,7 @@ import re
 import time
 
 from .paths import SIM
+from ..scene import default
 from .toml_io import toml_dump, write_atomic
 from .model import StudyError, StudyInterrupted
 from .rundir import read_status, run_h5_result, write_status
@@ -24,7 +25,8 @@ def prepared_state(sd, sc):
         return
     sy = sc["system"]
     key = (f"n{int(sy['n_particles'])}_phi{float(sy['packing_fraction']):.6g}"
-           f"_r{float(sy.get('radius_ratio', 1.43)):.6g}_seed{int(sy.get('seed', 1))}")
+           f"_r{float(sy.get('radius_ratio', default('system', 'radius_ratio'))):.6g}"
+           f"_seed{int(sy.get('seed', default('system', 'seed')))}")
     d = os.path.join(sd.dir, "states")
     os.makedirs(d, exist_ok=True)
     path = os.path.join(d, key + ".h5")
@@ -56,10 +58,11 @@ def equilibrated_state(sd, sc):
     if not sd.study.equilibrated_states:
         return
     sy = {k: v for k, v in sc["system"].items() if k != "initial_state"}
-    interval = float(sc.get("run", {}).get("checkpoint_interval", 10.0))  # the scene default
+    interval = float(sc.get("run", {}).get("checkpoint_interval", default("run", "checkpoint_interval")))
     dyn = toml_dump({"system": sy, "driving": sc.get("driving", {}), "run": {"checkpoint_interval": interval}})
     key = (f"eq_n{int(sy['n_particles'])}_phi{float(sy['packing_fraction']):.6g}"
-           f"_eps{float(sy.get('restitution', 1.0)):.6g}_seed{int(sy.get('seed', 1))}_"
+           f"_eps{float(sy.get('restitution', default('system', 'restitution'))):.6g}"
+           f"_seed{int(sy.get('seed', default('system', 'seed')))}_"
            + hashlib.sha1(dyn.encode()).hexdigest()[:10])
     d = os.path.join(sd.dir, "states")
     t_eq = float(sc["run"]["equilibration_time"])
