@@ -75,7 +75,7 @@ def main(path, png):
         legend_below(ax, ncol=2)
         ax2.set_xlabel("waiting time $t_0$")
         ax2.set_ylabel(r"$\tau_\alpha(t_0)$")
-        ax2.set_title("aging check: flat if stationary\n(one origin each, with the spread of one origin's; band: "
+        ax2.set_title("aging check: flat if stationary\n(bars: the spread of one origin's; band: "
                       r"$\tau_\alpha$ ± its error)")
         ax2.legend()
         save(fig, run, png, 110)
