@@ -283,6 +283,7 @@ private:
       fit_q(s.acc[c], r, m);
       for (int k = 0; k < info().n_origins; ++k) m.t0.push_back(info().frame_time[info().origin_frame[k]]);
       m.tau_alpha_t0 = an::tau_alpha_per_origin(s.acc[c], info().lag_time, info().n_origins);
+      m.tau_alpha_t0_err = an::tau_alpha_per_origin_error(m.t0, m.tau_alpha_t0, info().lag_time, r.tau_alpha);
       m.n_t0 = static_cast<int32_t>(m.t0.size());
       publish(dynhet::cutoff_channel(dynhet::kChanOverlap, m.cutoff_a, s.cage_relative), m);
       if (final)

@@ -13,7 +13,8 @@
 // transforms are per cutoff, so the cost per pair is the number of cutoffs
 // times that of one. One message per cutoff (cutoff_a says which). Lags: every scheduled lag by
 // default (the grid costs a few ms per pair at N = 10^4, so S4(q,t) and
-// xi(t) come at every t), or the scheduled lags nearest the times in
+// xi(t) come at every t; xi(t) and chi0(t) with errors from a jackknife
+// over blocks of origins spanning each lag), or the scheduled lags nearest the times in
 // s4.lags (to bound the cost at N = 10^5, ~70 ms per pair for six grids).
 // The fits with jackknife errors and the chi4 comparison are made, per
 // cutoff, at t_s4 = that cutoff's running tau_alpha of the node's own (Q(t)
@@ -83,6 +84,7 @@ private:
   void start(const dynhet::run_info_t& m) override {
     const dynhet::Scene scene = dynhet::parse_scene_text(m.scene_toml, "the run's scene");
     q_max_ = scene.s4_q_max;
+    origin_spacing_ = dynhet::origin_spacing(m);
     const std::vector<int> sizes = scene.s4_subbox_particles.empty()
                                        ? std::vector<int>(m.chi4_subbox_particles.begin(), m.chi4_subbox_particles.end())
                                        : scene.s4_subbox_particles;
@@ -185,10 +187,15 @@ private:
   }
 
   void publish_results(bool final) override {
-    // Fits with jackknife errors are some ms: at most once a second.
-    if (!final && Clock::now() - last_publish_ < std::chrono::seconds(1)) return;
+    // Fits with jackknife errors cost tens of ms per cutoff (at every lag
+    // and grid, one fit per block of origins: ~0.3 ms per lag and grid with
+    // 20 origins): at most once a second, and at most a tenth of the
+    // node's time (with many cutoffs a message set can take a second).
+    const auto since = Clock::now() - last_publish_;
+    if (!final && (since < std::chrono::seconds(1) || since < 9 * publish_cost_)) return;
     last_publish_ = Clock::now();
     for (const Cutoff& c : cuts_) publish_cutoff(c, final);
+    publish_cost_ = Clock::now() - last_publish_;
   }
 
   // One message: cutoff c's S4, fits and chi4.
@@ -216,13 +223,11 @@ private:
         m.s4_lag.insert(m.s4_lag.end(), s4.begin(), s4.end());
         // One rule for xi wherever it is reported: the fit at each lag
         // gives no xi where the whole box's fit at t_s4 would give none
-        // (no per-lag errors here, so not the error rule).
-        an::OzFit f = an::fit_oz(c.acc[g].q(), s4, {}, kQxiMax);
-        const bool fitted = std::isfinite(f.xi);
-        const bool range_ok = f.range_ok;
-        const bool kept = an::keep_determined_xi(f, kQxiMax, false);
-        m.xi_lag.push_back(f.xi), m.chi0_lag.push_back(f.chi0);
-        m.xi_lag_rule.push_back(!fitted ? 3 : kept ? 0 : !range_ok ? 1 : 2);
+        // (but for the error rule: xi(t) is drawn with its error bar).
+        const an::S4LagFit f = an::fit_s4_lag(c.acc[g], static_cast<int>(t), lags_[t], origin_spacing_, kQxiMax);
+        m.xi_lag.push_back(f.oz.xi), m.chi0_lag.push_back(f.oz.chi0);
+        m.xi_lag_err.push_back(f.oz.xi_err), m.chi0_lag_err.push_back(f.oz.chi0_err);
+        m.xi_lag_rule.push_back(static_cast<int8_t>(f.rule));
       }
     m.n_grids = static_cast<int32_t>(grids_.size());
     m.scan_qxi_max = an::kOzRangeScan;
@@ -311,6 +316,7 @@ private:
   }
 
   double q_max_ = 1;
+  double origin_spacing_ = 0; // the time between origins: the per-lag jackknife's blocks span the lag
   bool interpolate_ = true;   // at tau_alpha between computed lags (false: the scene lists s4.lags)
   std::vector<int> slot_;     // per scheduled lag: index among the computed lags, or -1
   std::vector<double> lags_;  // the computed lags
@@ -322,6 +328,7 @@ private:
   std::unique_ptr<dynhet::Cages> cages_;         // the cages of the held origins (cage_)
   std::vector<double> dr_, pos_cr_, d2_cr_;      // per pair, reused: the cage-relative |dr|^2
   Clock::time_point last_publish_{};
+  Clock::duration publish_cost_{}; // how long the last set of messages took
 };
 
 } // namespace

@@ -17,6 +17,27 @@ from check_common import check, crossing_time, failures, jackknife, origin_mean,
 from check_spatial import check_clusters, check_s4
 
 
+def tau_t0_error(t0, tau_t0, lag, tau):
+    """The error of each origin's tau_alpha(t0), by its definition: the
+    window is the first lag >= tau_alpha; each origin pairs with the first
+    origin at least a window later; sigma^2 = sum of squared differences
+    over 2 x pairs, given to every origin with a value; NaN with fewer than
+    3 pairs."""
+    out = np.full(len(tau_t0), np.nan)
+    later = lag[lag >= tau] if math.isfinite(tau) else []
+    if len(later) == 0:
+        return out
+    window = later[0]
+    d2 = []
+    for i in range(len(t0)):
+        j = next((j for j in range(i + 1, len(t0)) if t0[j] - t0[i] >= window * (1 - 1e-12)), None)
+        if j is not None and math.isfinite(tau_t0[i]) and math.isfinite(tau_t0[j]):
+            d2.append((tau_t0[i] - tau_t0[j]) ** 2)
+    if len(d2) >= 3:
+        out[np.isfinite(tau_t0)] = math.sqrt(sum(d2) / (2 * len(d2)))
+    return out
+
+
 def check_msd_extremes(g, d2, species, scene):
     """The instantaneous fastest and slowest subsets: at every (origin, lag) the particles of the set
     sorted by their own |dr|^2 over that lag, the top and bottom k = round(fraction * set size)."""
@@ -332,6 +353,12 @@ def main(path, scene_path):
         tau_t0_bf = np.array([crossing_time(lag, q_k[k], math.exp(-1)) for k in range(len(origin_frame))])
         same = np.allclose(tau_t0, tau_t0_bf, rtol=1e-9, atol=0, equal_nan=True)
         check(same, f"{name}: tau_alpha(t0) per origin equals brute force")
+        if "tau_alpha_t0_err" in g:
+            err_rec = g["tau_alpha_t0_err"]["value"][-1]
+            err_bf = tau_t0_error(frame_time[origin_frame], tau_t0_bf, lag, tau_bf)
+            check(np.allclose(err_rec, err_bf, rtol=1e-9, atol=0, equal_nan=True),
+                  f"{name}: tau_alpha(t0) error {err_rec[0]:.4g} is the spread of origins a window apart "
+                  f"(brute force {err_bf[0]:.4g})")
         beta, tau0 = float(g["beta"]["value"][-1]), float(g["tau0"]["value"][-1])
         # The fit is a least-squares minimum of the node's objective: nudging
         # either parameter by 0.1% does not lower the residual. The node fits

@@ -100,6 +100,25 @@ def check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, sched_lag, dr_o
             fin = np.isfinite(bf) & (bf > 0)
             worst = max(worst, np.max(np.abs(rec[fin] - bf[fin]) / bf[fin]))
     check(True, f"s4 {name}: every grid and lag within the grid's error bound of the direct sum (max rel diff {worst:.2g})")
+    # xi(t)'s errors: the jackknife over blocks of origins spanning the lag,
+    # so none where xi is NaN or such blocks do not fit four times into the
+    # origins measured at that lag; positive where given.
+    if "xi_lag_err" in g:
+        xi_lag, xi_err = g["xi_lag"]["value"][-1], g["xi_lag_err"]["value"][-1]
+        frame_time = f["observables/schedule/frame_time"][()]
+        spacing = float(np.median(np.diff(frame_time[origin_frame]))) if len(origin_frame) > 1 else 0.0
+        bad = []
+        for li, t in enumerate(lags):
+            j = int(np.argmin(np.abs(np.log(sched_lag / t))))
+            measured = int(np.sum(np.asarray(pair_frame)[:, j] >= 0))
+            span = spacing <= 0 or math.ceil(t / spacing - 1e-9) <= max(1, measured // 4)
+            for gi in range(len(sides)):
+                e = xi_err[li, gi]
+                if np.isfinite(e) and not (np.isfinite(xi_lag[li, gi]) and span and e > 0):
+                    bad.append((t, gi, e))
+        given = int(np.isfinite(xi_err).sum())
+        check(not bad, f"s4 {name}: xi(t) errors only where xi is and blocks span the lag ({given} given)"
+              + (f"; not so at {bad[:3]}" if bad else ""))
     # The lag of the fits: nearest the node's tau_alpha, which is the overlap node's for this cutoff.
     tau = float(g["tau_alpha"]["value"][-1])
     tau_ov = float(f[f"observables/{overlap}/a{a:g}/tau_alpha"]["value"][-1])

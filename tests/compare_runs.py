@@ -14,8 +14,10 @@ def final_results(path):
     with h5py.File(path, "r") as f:
         out = {}
         for name, g in f["observables/overlap"].items():
-            for obs in ("q", "q_err", "qr_var", "tau_alpha", "tau_alpha_err", "beta", "tau0", "tau_alpha_t0"):
-                out[f"{name}/{obs}"] = np.atleast_1d(g[obs]["value"][-1])
+            for obs in ("q", "q_err", "qr_var", "tau_alpha", "tau_alpha_err", "beta", "tau0", "tau_alpha_t0",
+                        "tau_alpha_t0_err"):
+                if obs in g:  # (tau_alpha_t0_err: not in runs recorded before it was computed)
+                    out[f"{name}/{obs}"] = np.atleast_1d(g[obs]["value"][-1])
         for name, g in f.get("observables/chi4", {}).items():
             for obs in ("chi4", "chi4_err", "chi4_peak", "tau4"):
                 out[f"chi4/{name}/{obs}"] = np.atleast_1d(g[obs]["value"][-1])
@@ -27,8 +29,10 @@ def final_results(path):
             for obs in ("p", "p_err", "gauss_d", "gauss_d_err", "tail_x0", "tail_x0_err", "tail_x_min"):
                 out[f"displacement/{obs}"] = np.atleast_1d(f["observables/displacement"][obs]["value"][-1])
         for name, g in f.get("observables/s4", {}).items():  # FFTW_ESTIMATE plans: the same arithmetic every run
-            for obs in ("s4", "s4_err", "s4_lag", "oz_xi", "oz_chi0", "a2_xi", "chi4", "tau_alpha"):
-                out[f"s4/{name}/{obs}"] = np.atleast_1d(g[obs]["value"][-1])
+            for obs in ("s4", "s4_err", "s4_lag", "oz_xi", "oz_chi0", "a2_xi", "chi4", "tau_alpha", "xi_lag",
+                        "xi_lag_err", "chi0_lag_err"):
+                if obs in g:
+                    out[f"s4/{name}/{obs}"] = np.atleast_1d(g[obs]["value"][-1])
         for name, g in f.get("observables/clusters", {}).items():
             for obs in ("neighbour_cutoff", "tau_alpha", "lag", "mean_size_slow", "mean_size_fast", "p_slow",
                         "p_fast", "rg_slow", "rg_fast", "slow_d_f", "slow_kappa", "fast_n0", "fast_sigma"):

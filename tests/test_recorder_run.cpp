@@ -97,6 +97,10 @@ dynhet::overlap_t overlap(double a, bool final, int frame) {
   m.qr_var = {0, 0};
   m.tau_alpha = NAN;
   m.tau_alpha_err = NAN;
+  m.n_t0 = 2;
+  m.t0 = {100, 100.5};
+  m.tau_alpha_t0 = {0.8, NAN};
+  m.tau_alpha_t0_err = {0.1, NAN};
   return m;
 }
 
@@ -209,6 +213,12 @@ TEST(RunRecorder, CompleteRunIsWrittenAndMarkedComplete) {
   const auto tau = h5read::read<double>(f, "/observables/overlap/a0.6/tau_alpha/value");
   ASSERT_EQ(tau.size(), 3u);
   EXPECT_EQ(tau[2], 0.75);
+  // tau_alpha per origin with its error, [record][t0]; t0 an axis written once.
+  EXPECT_EQ(h5read::read<double>(f, "/observables/overlap/a0.6/t0"), (std::vector<double>{100, 100.5}));
+  EXPECT_EQ(h5read::shape(f, "/observables/overlap/a0.6/tau_alpha_t0_err/value"), (Shape{3, 2}));
+  const auto t0_err = h5read::read<double>(f, "/observables/overlap/a0.6/tau_alpha_t0_err/value");
+  EXPECT_EQ(t0_err[4], 0.1);
+  EXPECT_TRUE(std::isnan(t0_err[5]));
   EXPECT_EQ(h5read::shape(f, "/observables/schedule/pair_frame"), (Shape{1, 2})); // [origin][lag]
   EXPECT_EQ(h5read::read<double>(f, "/observables/overlap/a0.6/lag_time"), (std::vector<double>{0.5, 1}));
   EXPECT_EQ(Attr(f, "/observables/overlap/a0.6", "subbox_per_side").values<int32_t>(),
@@ -278,6 +288,8 @@ dynhet::s4_t s4(double a, bool final, int frame) {
   m.s4_lag.assign(8, a);
   m.n_lag_fits = 4;
   m.xi_lag.assign(4, a), m.chi0_lag.assign(4, a), m.xi_lag_rule.assign(4, 0);
+  m.xi_lag_err = {0, 1, 10, 11}, m.chi0_lag_err = {0, 1, 10, 11}; // [l * 2 + g] = 10 l + g
+  m.xi_lag_err[3] = NAN;                                           // no error at that lag and grid
   return m;
 }
 
@@ -309,6 +321,11 @@ TEST(RunRecorder, S4IsRecordedPerCutoff) {
     EXPECT_EQ(h5read::read<int32_t>(f, g + "/subbox_per_side"), (std::vector<int32_t>{2, 1}));
     EXPECT_EQ(h5read::shape(f, g + "/s4_lag/value"), (Shape{2, 2, 4})); // [record][lag][value]
     EXPECT_EQ(h5read::shape(f, g + "/xi_lag/value"), (Shape{2, 2, 2})); // [record][lag][grid]
+    EXPECT_EQ(h5read::shape(f, g + "/xi_lag_err/value"), (Shape{2, 2, 2}));
+    const std::vector<double> xi_err = h5read::read<double>(f, g + "/xi_lag_err/value");
+    EXPECT_EQ(std::vector<double>(xi_err.begin() + 4, xi_err.begin() + 7), (std::vector<double>{0, 1, 10}));
+    EXPECT_TRUE(std::isnan(xi_err[7]));
+    EXPECT_EQ(h5read::shape(f, g + "/chi0_lag_err/value"), (Shape{2, 2, 2}));
     EXPECT_EQ(h5read::shape(f, g + "/oz_xi/value"), (Shape{2, 2}));
     EXPECT_EQ(h5read::read<double>(f, g + "/xi/value"), (std::vector<double>{a, a}));
     EXPECT_EQ(h5read::read<int64_t>(f, g + "/chi0/step"), (std::vector<int64_t>{1, 2}));

@@ -33,3 +33,8 @@ gtest_discover_tests(test_cut_coordinator DISCOVERY_TIMEOUT 30 PROPERTIES LABELS
 add_executable(test_reanalysis ${CMAKE_CURRENT_SOURCE_DIR}/test_reanalysis.cpp)
 target_link_libraries(test_reanalysis PRIVATE dynhet_common GTest::gtest_main)
 gtest_discover_tests(test_reanalysis DISCOVERY_TIMEOUT 30 PROPERTIES LABELS unit)
+# Quoted errors against the scatter of independent seeds of the real system
+# (in-process engine and kernels): tau_alpha(t0) per origin, xi(t) per lag.
+add_executable(test_seed_errors ${CMAKE_CURRENT_SOURCE_DIR}/test_seed_errors.cpp)
+target_link_libraries(test_seed_errors PRIVATE dynhet_engine dynhet_analysis GTest::gtest_main)
+gtest_discover_tests(test_seed_errors DISCOVERY_TIMEOUT 30 PROPERTIES LABELS unit TIMEOUT 120)

@@ -23,6 +23,29 @@ std::vector<double> tau_alpha_per_origin(const OverlapAccumulator& acc, const st
   return tau;
 }
 
+std::vector<double> tau_alpha_per_origin_error(const std::vector<double>& t0, const std::vector<double>& tau_t0,
+                                               const std::vector<double>& lag_time, double tau_alpha) {
+  std::vector<double> err(tau_t0.size(), kNaN);
+  // The window: the lag just past the run's crossing.
+  const auto past = std::lower_bound(lag_time.begin(), lag_time.end(), tau_alpha);
+  if (!std::isfinite(tau_alpha) || past == lag_time.end()) return err;
+  const double window = *past;
+  double sum2 = 0;
+  int pairs = 0;
+  for (size_t i = 0; i < tau_t0.size() && i < t0.size(); ++i) {
+    size_t j = i + 1; // the nearest origin at least a window later
+    while (j < t0.size() && t0[j] - t0[i] < window * (1 - 1e-12)) ++j;
+    if (j >= tau_t0.size() || !std::isfinite(tau_t0[i]) || !std::isfinite(tau_t0[j])) continue;
+    sum2 += (tau_t0[i] - tau_t0[j]) * (tau_t0[i] - tau_t0[j]);
+    ++pairs;
+  }
+  if (pairs < kMinSpreadPairs) return err;
+  const double sigma = std::sqrt(sum2 / (2.0 * pairs));
+  for (size_t k = 0; k < tau_t0.size(); ++k)
+    if (std::isfinite(tau_t0[k])) err[k] = sigma;
+  return err;
+}
+
 namespace {
 // The parabola in ln t through the largest point and its neighbours.
 Peak three_point_peak(const std::vector<double>& t, const std::vector<double>& y, int best) {

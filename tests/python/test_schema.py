@@ -22,19 +22,45 @@ RUN = (Archive(QUICK).path("phi0.8000_eps0.900_n4096_seed1_any")
        if "phi0.8000_eps0.900_n4096_seed1_any" in Archive(QUICK).runs() else "")
 
 
+# Datasets declared after the archived run was recorded (the errors of
+# tau_alpha(t0) per origin and of xi(t), chi0(t) per lag), each with the
+# dataset of the same shape it is the error of. A run recorded now has
+# them (check_h5md.py checks the tiny scene's run against the schema).
+NEWER = {"overlap": {"tau_alpha_t0_err": "tau_alpha_t0"},
+         "s4": {"xi_lag_err": "xi_lag", "chi0_lag_err": "chi0_lag"}}
+
+
+def add_newer(path):
+    """The archived run with the NEWER datasets added, shaped and typed as
+    the dataset each is the error of (NaN: no error)."""
+    with h5py.File(path, "a") as f:
+        for kind, fields in NEWER.items():
+            for base in (kind, kind + "_cr"):
+                for g in (f[f"observables/{base}"].values() if f"observables/{base}" in f else []):
+                    for name, like in fields.items():
+                        if like in g and name not in g:
+                            f.copy(g[like], g, name)
+                            g[name]["value"][...] = np.nan
+
+
 @pytest.fixture
 def run_copy(tmp_path):
     if not os.path.exists(RUN):
         pytest.skip(f"no {RUN}")
     p = tmp_path / "run.h5"
     shutil.copy(RUN, p)
+    add_newer(str(p))
     return str(p)
 
 
-def test_a_real_run_fits():
+def test_a_real_run_fits_but_for_what_was_declared_after_it(run_copy):
     if not os.path.exists(RUN):
         pytest.skip(f"no {RUN}")
-    assert schema.check(RUN) == []
+    newer = {name for fields in NEWER.values() for name in fields}
+    problems = schema.check(RUN)
+    assert problems and all(p.endswith(": missing") and p.split(": ")[0].rsplit("/", 1)[1] in newer
+                            for p in problems), problems
+    assert schema.check(run_copy) == []
 
 
 def test_a_missing_dataset_is_refused(run_copy):

@@ -2,7 +2,8 @@
 bars, the 1/e line, tau_alpha and the fit 1/((t/tau0)^beta + 1), one curve
 per cutoff a (and the cage-relative Q(t), open markers, where the run has
 it) and the bond-breaking C_B(t) (where the run has it); beside it
-tau_alpha against the waiting time t0 (aging check).
+tau_alpha against the waiting time t0 (aging check), each origin's with its
+error, and the run's tau_alpha with its error as a band.
 
 """
 import math
@@ -50,7 +51,11 @@ def main(path, png):
                             label=f"a = {a}, cage-relative" +
                             (rf", $\tau_\alpha$ = {pm(tau_cr, tau_cr_err)}" if math.isfinite(tau_cr) else ""))
             if "tau_alpha_t0" in g:
-                ax2.plot(g["t0"], g["tau_alpha_t0"], "o-", ms=3, color=color, label=label.split(",")[0])
+                # Each origin's tau_alpha with its error: the spread of one
+                # origin's (runs recorded before it was computed have none).
+                t0_err = g["tau_alpha_t0_err"] if "tau_alpha_t0_err" in g else None
+                ax2.errorbar(g["t0"], g["tau_alpha_t0"], yerr=None if t0_err is None else np.nan_to_num(t0_err),
+                             marker="o", ms=3, capsize=2, color=color, label=label.split(",")[0])
                 if math.isfinite(tau):  # the run's tau_alpha with its error: where each origin's should lie
                     ax2.axhline(tau, color=color, ls=":", lw=1)
                     if math.isfinite(tau_err):
@@ -72,7 +77,7 @@ def main(path, png):
         legend_below(ax, ncol=2)
         ax2.set_xlabel("waiting time $t_0$")
         ax2.set_ylabel(r"$\tau_\alpha(t_0)$")
-        ax2.set_title("aging check: flat if stationary\n(one origin each, no error of its own; band: "
+        ax2.set_title("aging check: flat if stationary\n(bars: the spread of one origin's; band: "
                       r"$\tau_\alpha$ ± its error)")
         ax2.legend()
         save(fig, run, png, 110)

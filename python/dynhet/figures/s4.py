@@ -3,7 +3,8 @@ of panels (at most three a row), one per sub-box grid: S4(q) at the lag
 t_s4 nearest that cutoff's tau_alpha, log-log, with the OZ fit
 chi0/(1 + (q xi)^2) and the fit with A^2 (q xi)^4 over their ranges (the
 dotted lines end them), chi4 at the same t as a square at the left; and a
-last panel with xi(t) of the OZ fit of every grid at every computed lag.
+last panel with xi(t) of the OZ fit of every grid at every computed lag,
+with its error.
 Where the run has s4_cr (observables.cage_relative), the cage-relative S4(q)
 at its own t_s4 (the cage-relative tau_alpha) is in the same panels, open
 markers, with its OZ fit (dash-dot) and chi4 (open square); its xi(t) dashed.
@@ -106,22 +107,33 @@ def plot_grid(ax, g, gi, start, cr=None):
     legend_below(ax)
 
 
+def lag_error(g, gi):
+    """xi_lag's error of grid gi per lag (0 where the node quotes none: the
+    blocks of its jackknife cannot span the lag), or None for a run recorded
+    before the node computed it."""
+    return np.nan_to_num(g["xi_lag_err"][:, gi]) if "xi_lag_err" in g else None
+
+
 def plot_xi(ax, g, cr=None):
-    """OZ xi(t) of every grid at every computed lag, t_s4 marked (and the
-    cage-relative xi(t), dashed)."""
+    """OZ xi(t) of every grid at every computed lag with its error (a
+    jackknife over blocks of origins spanning the lag; none where they
+    cannot), t_s4 marked (and the cage-relative xi(t), dashed)."""
     sizes, lags = g["subbox_particles"][()], g["lag_time"][()]
     t_s4, tau_alpha = float(g["t_s4"]), float(g["tau_alpha"])
     xi_lag = g["xi_lag"]  # [lag][grid]
     for gi in range(len(sizes)):
-        line = ax.plot(lags, xi_lag[:, gi], "o-", ms=3, label=f"sub-boxes of N = {sizes[gi]:.0f}")
+        line = ax.errorbar(lags, xi_lag[:, gi], yerr=lag_error(g, gi), marker="o", ms=3, capsize=2,
+                           label=f"sub-boxes of N = {sizes[gi]:.0f}")
         if cr is not None and gi < cr["xi_lag"].shape[1]:
-            ax.plot(cr["lag_time"][()], cr["xi_lag"][:, gi], "o--", ms=3, mfc="none", color=line[0].get_color(),
-                    label=f"N = {sizes[gi]:.0f}, cage-relative")
+            ax.errorbar(cr["lag_time"][()], cr["xi_lag"][:, gi], yerr=lag_error(cr, gi), marker="o", ls="--", ms=3,
+                        mfc="none", capsize=2, color=line[0].get_color(), label=f"N = {sizes[gi]:.0f}, cage-relative")
     ax.axvline(t_s4, color="k", lw=0.8, ls=":", label=rf"$t_{{s4}}$ = {t_s4:.3g} ($\tau_\alpha$ = {tau_alpha:.3g})")
     ax.set_xscale("log")
     ax.set_xlabel("t")
     ax.set_ylabel(r"OZ $\xi(t)$")
-    ax.set_title(f"a = {g.attrs['cutoff_a']:g}: OZ $\\xi$ against the lag")
+    ax.set_title(f"a = {g.attrs['cutoff_a']:g}: OZ $\\xi$ against the lag" +
+                 ("\n(bars: jackknife over blocks of origins spanning the lag;\nnone where the origins hold too few)"
+                  if "xi_lag_err" in g else ""))
     tidy_log(ax)
     legend_below(ax)
 

@@ -26,7 +26,9 @@ public:
     int n_origins;
   };
   // Over the origins measured at lag j, leaving out origin `skip` (-1: none).
-  Mean mean(int j, int skip = -1) const;
+  Mean mean(int j, int skip = -1) const { return mean(j, skip, skip); }
+  // The same, leaving out the origins skip_lo..skip_hi (a block).
+  Mean mean(int j, int skip_lo, int skip_hi) const;
   bool has(int k, int j) const;
 
   const std::vector<double>& q() const { return q_; }
@@ -60,6 +62,27 @@ struct S4FitAtLag {
   int n_origins;
 };
 S4FitAtLag fit_s4_at_lag(const S4Accumulator& acc, int j, double qxi_max = 1.0);
+
+// The OZ fit (eq. 18) to the origin mean of S4 at lag j, time lag_time,
+// with the errors of xi and chi0 from a jackknife over blocks of
+// consecutive origins measured at that lag, each block spanning the lag
+// (origin_block, fits.hpp: origins closer than the lag measure overlapping
+// windows of the same trajectories, so single origins left out would miss
+// their correlation). xi(t) at every lag, where fit_s4_at_lag gives it at
+// t_s4 alone. xi follows keep_determined_xi without its error rule (the
+// lag's xi is reported whatever its error; `rule` says why it is NaN: 0
+// kept, 1 too few shells, 2 below the q range, 3 no fit). An error is NaN
+// where its value is, where fewer than 3 blocks remain, where a
+// replicate's fit fails, and where blocks spanning the lag do not fit
+// kMinJackknifeBlocks times into the origins (origin_blocks_span: the
+// capped blocks would be correlated and the error too small; the rule of
+// tau_alpha's error).
+struct S4LagFit {
+  OzFit oz; // chi0, xi and their jackknife errors (no A^2 form)
+  int rule;
+  int block; // origins per jackknife block
+};
+S4LagFit fit_s4_lag(const S4Accumulator& acc, int j, double lag_time, double origin_spacing, double qxi_max = 1.0);
 
 // The same rules for one fit, wherever a xi is reported (the fit at every
 // lag included): xi (and chi0 where the sub-box cannot hold it) set to NaN

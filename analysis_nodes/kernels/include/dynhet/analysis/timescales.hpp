@@ -15,6 +15,26 @@ namespace dynhet::analysis {
 std::vector<double> tau_alpha_per_origin(const OverlapAccumulator& acc, const std::vector<double>& lag_time,
                                          int n_origins);
 
+// The error of each origin's tau_alpha(t0) (tau_alpha_per_origin). Each is
+// one origin's crossing, and every origin of a steady run draws from the
+// same distribution, so the error of each is that distribution's standard
+// deviation: how far the same origin of independent runs scatters. It is
+// estimated from pairs of origins whose windows do not overlap (t0 at
+// least the lag just past the run's tau_alpha apart, the window the
+// crossing reads and the span of tau_alpha's jackknife blocks; closer
+// origins measure the same stretch of trajectory and differ less), each
+// origin with its nearest such partner later in the run:
+//   sigma^2 = sum over pairs (tau_i - tau_j)^2 / (2 n_pairs).
+// The nearest partner keeps a slow drift of tau_alpha(t0) (ageing, which the
+// figure is there to show) out of the estimate but for (drift over one
+// window)^2 / 2, where the variance of all origins would hold all of it.
+// One value for every origin with a tau_alpha(t0); all NaN where tau_alpha
+// is not known or fewer than kMinSpreadPairs pairs exist (origins spanning
+// too few windows to say).
+constexpr int kMinSpreadPairs = 3;
+std::vector<double> tau_alpha_per_origin_error(const std::vector<double>& t0, const std::vector<double>& tau_t0,
+                                               const std::vector<double>& lag_time, double tau_alpha);
+
 // The peak of y(t), such as chi4^P at tau4: the vertex of the parabola in
 // ln t fitted by weighted least squares to the peak above its half maximum
 // (the lags around the largest point where y > y_max / 2, each weighted by
