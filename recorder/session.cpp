@@ -61,6 +61,7 @@ void Session::take_run(const dynhet::run_info_t &m) {
     return;
   }
   last_sim_ = last_progress_ = Clock::now();
+  if (!replaying_) sim_heard_live_ = true;
   // Its socket gets every frame's datagrams, kept or not (results arrive
   // between them): a buffer that holds a whole frame, as the nodes ask.
   const int64_t got =
@@ -75,6 +76,7 @@ void Session::take_sim(const dynhet::sim_status_t &m) {
   if (!rec_.has_run() && m.phase == "failed") early_failure_ = m.message;
   if (!rec_.on_sim_status(m)) return;
   if (!replaying_) sim_interrupted_ = m.phase == "interrupted";
+  if (!replaying_) sim_heard_live_ = true;
   last_sim_ = Clock::now();
   if (rec_.completion().sim_ended()) last_progress_ = Clock::now();
 }
@@ -222,9 +224,15 @@ int Session::step() {
       signalled_ = Clock::now();
       std::fprintf(stderr, "recorder: signal %d: stopping after the sim's next checkpoint cut\n", signal_.load());
     }
-    if (cuts_->stop_cut_saved() || sim_interrupted_ || rec_.completion().sim_ended() ||
+    // A resumed recorder signalled before any sim spoke (the launch script
+    // stopped before starting the sim, or the sim stopped before its first
+    // word): no cut will come, and nothing has changed since the cut it
+    // resumed from.
+    const bool no_sim = !sim_heard_live_ && since(*signalled_) > kNoSimGrace;
+    if (cuts_->stop_cut_saved() || sim_interrupted_ || rec_.completion().sim_ended() || no_sim ||
         since(*signalled_) > opt_.cut_wait)
-      return finish("interrupted by signal " + std::to_string(signal_.load()) + "; " + resumable());
+      return finish("interrupted by signal " + std::to_string(signal_.load()) +
+                    (no_sim ? " before the sim spoke in this attempt" : "") + "; " + resumable());
     return -1;
   }
   if (signal_) return finish("interrupted by signal " + std::to_string(signal_.load()));

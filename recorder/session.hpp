@@ -87,6 +87,10 @@ private:
   // Checkpoint cuts (--checkpoint-dir): the journal and the cuts' bookkeeping.
   std::unique_ptr<dynhet::RecorderCuts> cuts_;
   bool replaying_ = false, sim_interrupted_ = false;
+  // Whether the sim has spoken on the bus in this process's life (a resumed
+  // recorder has its run info from its journal, before any sim runs).
+  bool sim_heard_live_ = false;
+  static constexpr double kNoSimGrace = 10; // s after a signal, the sim still silent: it is not running
   std::string resumable() const {
     return cuts_->saved_cut() >= 0 ? "resumable: this recorder's last saved cut is " + std::to_string(cuts_->saved_cut())
                                    : "this recorder saved no cut";
