@@ -6,6 +6,9 @@
 // With --tile-from B, a system of N = k^2 B particles starts from the
 // compressed B-particle state tiled k x k (velocities redrawn), instead of
 // compressing N particles from scratch (which takes hours at N = 10^6).
+// With --cache DIR, prepared states (compressed or tiled) are kept in DIR
+// and read by the next run, of this build or of another: both start from
+// the same state.
 // Rates are per second of this thread's CPU time, so that another process on
 // the machine does not change them (wall time is printed too).
 #include <chrono>
@@ -53,6 +56,15 @@ dynhet::engine::State tile_state(const dynhet::engine::State& s, long b, double 
   for (int r = 0; r < 4; ++r) t.rng[r] = s.rng[r];
   t.kick_in = s.kick_in;
   return t;
+}
+
+// A prepared (compressed or tiled) state kept in the cache directory, so
+// that the next run, of this build or another, starts from the same state.
+void write_cached(const std::string& path, const std::string& dir, const dynhet::engine::State& s) {
+  std::filesystem::create_directories(dir);
+  dynhet::Checkpoint c;
+  c.state = s;
+  dynhet::write_checkpoint(path, c);
 }
 
 double cpu_seconds() {
@@ -138,15 +150,13 @@ int main(int argc, char** argv) {
           if (const double ov = e.max_overlap(); ov > 1e-9)
             throw std::runtime_error("tiled state overlaps by " + std::to_string(ov));
           prep = seconds(t0);
+          if (!cached.empty()) write_cached(cached, cache, e.state()); // another build then starts from it too
         } else {
           e.prepare();
           prep = seconds(t0);
           if (!cached.empty()) {
-            std::filesystem::create_directories(cache);
             e.synchronize();
-            dynhet::Checkpoint c;
-            c.state = e.state();
-            dynhet::write_checkpoint(cached, c);
+            write_cached(cached, cache, e.state());
           }
         }
       } catch (const std::exception& ex) {

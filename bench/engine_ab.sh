@@ -12,6 +12,8 @@
 # per run, then the table of medians with the ratios new / old and, for the
 # driven rows of the new build, neighbours / any.
 # Usage: bench/engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS=5] [CACHE=/tmp/dynhet-bench]
+#        ROWS='elastic 10000 0.78 50;neighbours 1000000 0.78 4' bench/engine_ab.sh ...  (other rows:
+#        "mode N phi collisions-per-particle", separated by ';')
 #        bench/engine_ab.sh --table RUNS_FILE   (the table again from a run's file of runs)
 set -euo pipefail
 table() { # the medians of a file of runs "build mode N phi rate"
@@ -47,6 +49,7 @@ rows=("elastic 10000 0.78 200" "elastic 10000 0.805 200" "elastic 100000 0.78 20
       "elastic 1000000 0.78 5" "elastic 1000000 0.805 5"
       "neighbours 100000 0.78 20" "neighbours 100000 0.80 20" "any 100000 0.78 20" "any 100000 0.80 20"
       "neighbours 1000000 0.78 5" "neighbours 1000000 0.80 5" "any 1000000 0.78 5" "any 1000000 0.80 5")
+if [[ -n ${ROWS:-} ]]; then IFS=';' read -r -a rows <<<"$ROWS"; fi
 run() { # which build mode N phi coll
   local a=(--n "$4" --phi "$5" --coll "$6" --sync 10 --tile-from 10000 --cache "$cache")
   case $3 in

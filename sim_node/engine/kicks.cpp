@@ -93,7 +93,7 @@ int Engine::kick_candidates(int i, int32_t* out) const {
       const int j = c[k];
       const Particle& b = part_[j];
       const double dx = min_image(ax - (b.x + b.vx * (now_ - b.t))), dy = min_image(ay - (b.y + b.vy * (now_ - b.t)));
-      const double reach = ri + radius_[species_[j]];
+      const double reach = ri + radius_[b.species];
       if (j != i && dx * dx + dy * dy <= reach * reach) {
         if (m == kMaxKickCandidates) throw std::logic_error("engine: more than 512 particles within kick reach");
         out[m++] = j;
@@ -107,7 +107,9 @@ bool Engine::within_kick_reach(int i, int j) const {
   const Particle &a = part_[i], &b = part_[j];
   const double dx = min_image((a.x + a.vx * (now_ - a.t)) - (b.x + b.vx * (now_ - b.t)));
   const double dy = min_image((a.y + a.vy * (now_ - a.t)) - (b.y + b.vy * (now_ - b.t)));
-  const double reach = radius_[a.species] + p_.kick_reach + radius_[species_[j]];
+  // The species from j's line, read anyway for its position (species_[j]
+  // would be one more miss per trial at large N).
+  const double reach = radius_[a.species] + p_.kick_reach + radius_[b.species];
   return dx * dx + dy * dy <= reach * reach;
 }
 
