@@ -220,7 +220,7 @@ if ((${#cuts[@]} >= 2)); then
   finish_run "$out" || true
   check 'grep -q "refused: $part: corrupt" "$out.log"' "a corrupted part is refused, its file named"
   newest=$((10#${cuts[-1]##*cut-}))
-  used=$(grep -o "resuming run $run_id from checkpoint cut [0-9]*" "$out.log" | tail -1 | awk '{print $NF}')
+  used=$(grep -o "resuming run $run_id from checkpoint cut [0-9]*" "$out.log" | tail -1 | awk '{print $NF}' || true)
   check '[[ -n $used && $used -lt $newest ]]' "an older whole cut is used (cut ${used:-none}, not $newest)"
   check 'complete "$out/run.h5" && same "$out"' "resumed from the older cut: run.h5 equals the uninterrupted run's"
 else

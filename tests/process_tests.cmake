@@ -123,7 +123,7 @@ set_tests_properties(fuzz_scenes PROPERTIES LABELS process TIMEOUT 300)
 # uninterrupted run's.
 add_test(NAME kill_resume
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/kill_resume.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
-set_tests_properties(kill_resume PROPERTIES LABELS process TIMEOUT 400)
+set_tests_properties(kill_resume PROPERTIES LABELS process TIMEOUT 600)
 
 add_test(NAME full_disk
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/full_disk.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
