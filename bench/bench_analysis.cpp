@@ -28,6 +28,7 @@
 #include "dynhet/analysis/displacement_distribution.hpp"
 #include "dynhet/analysis/overlap.hpp"
 #include "dynhet/analysis/s4.hpp"
+#include "dynhet/model.hpp"
 
 namespace an = dynhet::analysis;
 
@@ -62,7 +63,7 @@ Frames make_frames(long n, double phi, unsigned seed) {
   std::mt19937_64 gen(seed);
   std::uniform_real_distribution<double> u(0, 1);
   std::normal_distribution<double> g(0, 1);
-  const double r2 = 1.43;
+  const double r2 = dynhet::kPaperRadiusRatio;
   Frames f{n, std::sqrt(n * kPi * (1 + r2 * r2) / 2 / phi), std::vector<double>(2 * n),
            std::vector<double>(2 * n), std::vector<std::uint8_t>(n)};
   const long side = static_cast<long>(std::ceil(std::sqrt(double(n))));

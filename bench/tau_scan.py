@@ -24,8 +24,10 @@ import os
 import subprocess
 import sys
 
-import h5py
 import numpy as np
+
+import dynhet
+import dynhet.scene
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 
@@ -55,21 +57,20 @@ lags_per_decade = 8
 
 [observables]
 compute = ["overlap"]
-cutoff_a = [0.6]
+cutoff_a = [{dynhet.scene.default("observables", "cutoff_a")[0]}]
 """
 
 
 def read_run(path, t_eq):
-    with h5py.File(path, "r") as f:
-        complete = int(f.attrs.get("complete", 0))
-        g = f["observables/overlap/a0.6"]
-        tau = float(g["tau_alpha/value"][-1])
-        tau_err = float(g["tau_alpha_err/value"][-1])
-        ke = f["observables/sim/kinetic_energy"]
-        t, v = ke["time"][()], ke["value"][()].ravel()
+    """(complete, tau_alpha, its error, the mean kinetic energy after t_eq)
+    of a run, through the package's reader (the scene's cutoff)."""
+    with dynhet.open_run(path, allow_incomplete=True) as run:
+        tau, tau_err = run.tau_alpha()
+        t, v = run.observable("sim").history("kinetic_energy")
+        v = np.asarray(v, float).ravel()
         sel = t >= t_eq
         temp = float(np.mean(v[sel])) if sel.any() else float("nan")
-    return complete, tau, tau_err, temp
+        return int(run.complete), tau, tau_err, temp
 
 
 def read_result(path):

@@ -5,13 +5,16 @@
 
 #include <toml++/toml.h>
 
+#include "dynhet/observables.hpp"
+#include "scene_check.hpp"
+
 namespace dynhet {
 
 namespace {
 
-// Tables whose every key is analysis: what is computed from frames the
-// recording has, and how.
-const char* const kAnalysisTables[] = {"overlap", "chi4", "s4", "clusters", "msd", "displacement", "bond_breaking"};
+// Tables whose every key is analysis, what is computed from frames the
+// recording has and how: an observable's own table ([overlap], [s4], ...).
+bool analysis_table(const std::string& t) { return find_observable(t) != nullptr; }
 // The analysis keys of [observables] (keep_frames is not one: the recording
 // decided which frames a file may keep).
 const char* const kObservableKeys[] = {"compute", "cutoff_a", "cage_relative", "cage"};
@@ -22,30 +25,19 @@ template <size_t N> bool among(const char* const (&list)[N], const std::string& 
   return std::find(std::begin(list), std::end(list), s) != std::end(list);
 }
 
-toml::table parse_or_throw(const std::string& text, const std::string& origin) {
-  try {
-    return toml::parse(text, origin);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream m;
-    m << origin << ":" << e.source().begin.line << ":" << e.source().begin.column
-      << ": not valid TOML: " << e.description();
-    throw SceneError(m.str());
-  }
-}
-
 } // namespace
 
 std::string reanalysis_keys() {
   std::string s = "[observables] ";
   for (const char* k : kObservableKeys) s += std::string(k) + (k == kObservableKeys[3] ? "" : ", ");
-  for (const char* t : kAnalysisTables) s += std::string("; [") + t + "]";
+  for (const ObservableInfo& o : kObservables) s += std::string("; [") + o.name + "]";
   return s;
 }
 
 std::string reanalysis_scene_text(const std::string& recorded_toml, const std::string& analysis_toml,
                                   const std::string& origin) {
-  const toml::table recorded = parse_or_throw(recorded_toml, "the recorded scene");
-  const toml::table analysis = parse_or_throw(analysis_toml, origin);
+  const toml::table recorded = scene_detail::parse_toml(recorded_toml, "the recorded scene");
+  const toml::table analysis = scene_detail::parse_toml(analysis_toml, origin);
 
   // Refused by name: every key that decided which frames exist. Keys and
   // tables the scene does not know are left to the scene's own check below.
@@ -54,7 +46,7 @@ std::string reanalysis_scene_text(const std::string& recorded_toml, const std::s
   for (const auto& [tname, node] : analysis) {
     const std::string t(tname.str());
     const auto* table = node.as_table();
-    if (among(kAnalysisTables, t) || !table) continue;
+    if (analysis_table(t) || !table) continue;
     if (t == "observables") {
       for (const auto& [key, v] : *table)
         if (std::string(key.str()) == "keep_frames") refuse(t + ".keep_frames");
@@ -87,7 +79,7 @@ std::string reanalysis_scene_text(const std::string& recorded_toml, const std::s
      << toml::toml_formatter(merged) << "\n";
   // What is written must read back as what was merged (every number to
   // its last bit), or the nodes and the file would go by another scene.
-  if (parse_or_throw(os.str(), "the re-analysis scene") != merged)
+  if (scene_detail::parse_toml(os.str(), "the re-analysis scene") != merged)
     throw SceneError(origin + ": the merged scene does not read back as itself");
   parse_scene_text(os.str(), origin + " over the recorded scene"); // the scene's own checks
   return os.str();

@@ -73,17 +73,6 @@ std::vector<std::string> Scene::computed_observables() const {
 
 namespace {
 
-toml::table parse_toml(const std::string& text, const std::string& origin) {
-  try {
-    return toml::parse(text, origin);
-  } catch (const toml::parse_error& e) {
-    std::ostringstream m;
-    m << origin << ":" << e.source().begin.line << ":" << e.source().begin.column
-      << ": not valid TOML: " << e.description();
-    throw SceneError(m.str());
-  }
-}
-
 // Every table's keys (scene_keys.cpp), each bound to its place in s.
 std::map<std::string, Table> bind_schema(Checker& c, Scene& s) {
   std::map<std::string, Table> schema;

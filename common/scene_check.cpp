@@ -22,6 +22,17 @@ const char* type_name(const toml::node& n) {
 
 // The shortest text that reads back as the same double (0.9,
 // 1.0000000000000002, 1e+300): what the file says, never rounded away.
+toml::table parse_toml(const std::string& text, const std::string& origin) {
+  try {
+    return toml::parse(text, origin);
+  } catch (const toml::parse_error& e) {
+    std::ostringstream m;
+    m << origin << ":" << e.source().begin.line << ":" << e.source().begin.column
+      << ": not valid TOML: " << e.description();
+    throw SceneError(m.str());
+  }
+}
+
 std::string num(double v) {
   char buf[64];
   const auto r = std::to_chars(buf, buf + sizeof buf, v);

@@ -23,6 +23,8 @@ std::string toml_float(double v);
 // A node's value as the file wrote it (tables as {...}).
 std::string show(const toml::node& n);
 const char* type_name(const toml::node& n);
+// TOML text parsed, or SceneError naming origin:line:column and the problem.
+toml::table parse_toml(const std::string& text, const std::string& origin);
 
 // Collects every problem of a scene, then throws them together.
 class Checker {

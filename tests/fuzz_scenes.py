@@ -1,8 +1,8 @@
 #!/usr/bin/python3
 """Mutated scenes: every one is refused with a message or runs.
 
-From scenes/tiny.toml, COUNT scenes (fixed seed), each with one to three
-keys set to hostile values (0, negatives, 2^31, 2^53 + 1, 2^62, 1e300,
+From scenes/tiny.toml, COUNT scenes (fixed seed), each with one to three of the scene's
+keys (as `sim_node - --resolved` lists them) set to hostile values (0, negatives, 2^31, 2^53 + 1, 2^62, 1e300,
 1e-300, nan, inf, 1.0000000000000002, strings, booleans, arrays, tables)
 or unknown keys and tables added. Each goes to `sim_node --check`:
 refused means exit 2 with "invalid scene" (or "sim_node:") and the key
@@ -20,21 +20,17 @@ import re
 import subprocess
 import sys
 import tempfile
+import tomllib
 
-KEYS = {
-    "system": ["n_particles", "packing_fraction", "restitution", "radius_ratio", "seed", "tc_time"],
-    "driving": ["kick_rate", "pairs", "reach", "contact_value"],
-    "run": ["equilibration_time", "production_time", "checkpoint_interval"],
-    "schedule": ["origins", "origin_spacing", "lag_min", "lag_max", "lags_per_decade"],
-    "observables": ["compute", "cutoff_a", "keep_frames"],
-    "overlap": ["subbox_particles"],
-    "chi4": ["subbox_particles"],
-    "s4": ["lags", "q_max", "grid_spacing", "half_width", "subbox_particles"],
-    "clusters": ["lag", "neighbour_cutoffs", "cutoff_frames", "gr_r_max", "gr_bin", "gr_smoothing",
-                 "bins_per_decade", "power_law_sizes", "min_bin_count", "fractal_min_size", "error_blocks"],
-    "displacement": ["bin_width", "min_bin_count", "tail_sigmas"],
-    "transport": ["chunk_particles"],
-}
+
+
+def scene_keys(sim):
+    """Every table and key of a scene, as the simulator describes them (the
+    default scene resolved: sim_node - --resolved), less the derived [model]."""
+    r = subprocess.run([sim, "-", "--resolved"], input="", capture_output=True, text=True, check=True)
+    return {t: sorted(keys) for t, keys in tomllib.loads(r.stdout).items() if t != "model" and isinstance(keys, dict)}
+
+
 VALUES = ["0", "-1", "1", "2", "3", "7", "2147483648", "9007199254740993", "4611686018427387904", "1e300",
           "-1e300", "1e-300", "nan", "inf", "-inf", "0.5", "0.05", "3.7", "1.0000000000000002", "0.9999999999",
           '"x"', '"all"', '"tau_alpha"', '"g_ab"', "true", "false", "[]", "[1, 2]", "[0.5, 0.5]", '["overlap"]',
@@ -42,15 +38,15 @@ VALUES = ["0", "-1", "1", "2", "3", "7", "2147483648", "9007199254740993", "4611
 RUN_SECONDS = 6
 
 
-def mutate(text, rng):
+def mutate(text, rng, keys):
     lines = text.split("\n")
     for _ in range(rng.randint(1, 3)):
         r = rng.random()
         if r < 0.06:
             lines.append(f"\n[{rng.choice(['sytem', 'extra', 'run'])}]\nbogus_key = 1")
             continue
-        table = rng.choice(list(KEYS))
-        key = rng.choice(KEYS[table])
+        table = rng.choice(list(keys))
+        key = rng.choice(keys[table])
         value = rng.choice(VALUES)
         # Half the time a plausible value: the current number scaled by up to
         # 10^3 either way (or a small integer), so that many scenes run.
@@ -80,12 +76,13 @@ def main():
     sim, root = sys.argv[1], sys.argv[2]
     count = int(sys.argv[3]) if len(sys.argv) > 3 else 300
     base = open(os.path.join(root, "scenes", "tiny.toml")).read()
+    keys = scene_keys(sim)
     rng = random.Random(20261123)
     tmp = tempfile.mkdtemp()
     url = "udpm://239.255.76.67:7696?ttl=0"
     refused = ran = fail = 0
     for n in range(count):
-        text = mutate(base, rng)
+        text = mutate(base, rng, keys)
         # TOML allows a table once: a duplicate table is itself a refusal to test.
         path = os.path.join(tmp, f"s{n}.toml")
         with open(path, "w") as f:

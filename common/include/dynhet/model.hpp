@@ -8,6 +8,10 @@
 
 namespace dynhet {
 
+// The paper's mixture: the large radius over the small one (the scene's
+// default system.radius_ratio, and the engine's Params).
+inline constexpr double kPaperRadiusRatio = 1.43;
+
 struct Model {
   double radius[2];
   double mass[2];

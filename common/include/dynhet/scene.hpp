@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "dynhet/model.hpp"
+
 namespace dynhet {
 
 struct SceneError : std::runtime_error {
@@ -39,7 +41,7 @@ struct Scene {
   int64_t n_particles = 1000;
   double packing_fraction = 0.7;
   double restitution = 0.9;
-  double radius_ratio = 1.43; // r2 / r1; 1 is monodisperse
+  double radius_ratio = kPaperRadiusRatio; // r2 / r1; 1 is monodisperse
   uint64_t seed = 1;
   double tc_time = 0.0; // TC model: collisions within tc of a particle's previous one are elastic; 0 off
   // Start from this state instead of compressing (path, relative to the

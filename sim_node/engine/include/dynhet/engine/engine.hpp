@@ -48,7 +48,7 @@ struct Params {
   long n_particles = 1000;
   double packing_fraction = 0.7;
   double restitution = 1.0;  // eps
-  double radius_ratio = 1.43; // r2 / r1
+  double radius_ratio = kPaperRadiusRatio; // r2 / r1
   uint64_t seed = 1;
   bool driving = false;
   double kick_rate = 0.0; // kicks per particle per unit time (a pair kick counts for both)
@@ -87,7 +87,7 @@ inline double auto_skin(double phi) {
   return s[k - 1];
 }
 
-// The paper's system: radius ratio 1.43, kicks (if driven) to neighbour
+// The paper's system: radius ratio kPaperRadiusRatio, kicks (if driven) to neighbour
 // pairs at the Enskog frequency with the mixture's contact value.
 inline Params paper_params(long n, double phi, double eps, bool driven, KickPairs pairs = KickPairs::neighbours) {
   Params p;
