@@ -10,12 +10,10 @@ Usage: lcmlog_runs.py LOG              one line per run: id, N, frames in the lo
        lcmlog_runs.py LOG --only       the id of the only run; exit 1 (with the list) if there are several
        lcmlog_runs.py LOG --channels   the messages per channel, one 'CHANNEL COUNT' a line
 """
-import os
 import struct
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from dynhet.lcmlog import events  # noqa: E402
+from dynhet.lcmlog import events
 
 HEAD = 128  # the bytes of a message its headers need (run_info_t: 92, frame_chunk_t: 60)
 

@@ -8,8 +8,7 @@ Usage: lcmlog_verify.py LOG --key-file KEY               counts; exit 1 if any m
 import os
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from dynhet import bus  # noqa: E402
+from dynhet import bus
 
 
 def main(argv):

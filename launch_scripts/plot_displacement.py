@@ -7,15 +7,12 @@ with the Gaussian fit (dash-dotted, D free) and the exponential-tail fit
 
 Usage: plot_displacement.py RUN.h5 OUT.png
 """
-import os
-import sys
 
 import matplotlib
 
 matplotlib.use("Agg")  # figures to files: no display needed
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from dynhet.figures.common import cli  # noqa: E402
-from dynhet.figures.displacement import main  # noqa: E402
+from dynhet.figures.common import cli  # noqa: E402 (after matplotlib.use)
+from dynhet.figures.displacement import main  # noqa: E402 (after matplotlib.use)
 
 if __name__ == "__main__":
     cli(main, __doc__)

@@ -6,15 +6,12 @@ its fit range, and the MSD of the instantaneous fastest (red) and slowest
 
 Usage: plot_msd.py RUN.h5 OUT.png
 """
-import os
-import sys
 
 import matplotlib
 
 matplotlib.use("Agg")  # figures to files: no display needed
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from dynhet.figures.common import cli  # noqa: E402
-from dynhet.figures.msd import main  # noqa: E402
+from dynhet.figures.common import cli  # noqa: E402 (after matplotlib.use)
+from dynhet.figures.msd import main  # noqa: E402 (after matplotlib.use)
 
 if __name__ == "__main__":
     cli(main, __doc__)

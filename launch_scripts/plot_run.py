@@ -7,15 +7,12 @@ One figure alone: launch_scripts/plot_<observable>.py RUN.h5 OUT.png.
 
 Usage: plot_run.py RUN.h5 OUTDIR
 """
-import os
-import sys
 
 import matplotlib
 
 matplotlib.use("Agg")  # figures to files: no display needed
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from dynhet.figures.common import cli  # noqa: E402
-from dynhet.figures.run_figures import draw_all  # noqa: E402
+from dynhet.figures.common import cli  # noqa: E402 (after matplotlib.use)
+from dynhet.figures.run_figures import draw_all  # noqa: E402 (after matplotlib.use)
 
 if __name__ == "__main__":
     cli(draw_all, __doc__)

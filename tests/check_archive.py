@@ -19,8 +19,7 @@ import tomllib
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from dynhet.archive import MAX_BYTES, Archive, sha256_of  # noqa: E402
+from dynhet.archive import MAX_BYTES, Archive, sha256_of
 
 fails = []
 

@@ -3,14 +3,11 @@ check_spatial.py, check_cage_relative.py): one list of failures, the node's
 definitions of tau's crossing and of the lag bracket, and the estimators
 over origins, and a run's scene with its defaults filled in."""
 import math
-import os
-import sys
 import tomllib
 
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from dynhet.scene import DEFAULTS  # noqa: E402
+from dynhet.scene import DEFAULTS
 
 failures = []
 

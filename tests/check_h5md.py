@@ -22,13 +22,11 @@ Usage: check_h5md.py RUN.h5 [--author NAME]
 import argparse
 import sys
 
-import os
 
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from dynhet import schema  # noqa: E402
+from dynhet import schema
 
 failures = []
 

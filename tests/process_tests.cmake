@@ -145,7 +145,7 @@ set_tests_properties(replay_runs_from_one_log PROPERTIES LABELS process TIMEOUT 
 # known parameters: recovered within its jackknife error over seeds, and
 # the error honest (tests/test_study_fits.py).
 add_test(NAME study_fits_synthetic
-  COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/test_study_fits.py ${PROJECT_SOURCE_DIR}/python)
+  COMMAND /usr/bin/python3 ${CMAKE_CURRENT_SOURCE_DIR}/test_study_fits.py)
 set_tests_properties(study_fits_synthetic PROPERTIES LABELS unit TIMEOUT 120)
 
 # LCM's GUI log player through logplayer.sh on Xvfb: --inputs plays exactly

@@ -13,14 +13,13 @@ the sub-box bias of eq. (14), which the pooled estimator does not have;
 critical fits on the edge of the data not judged, and with phi_c held
 fixed. Also: the ln t interpolation is exact for a line in
 ln t and its error estimate is zero there; fits with too few points say so.
-Usage: test_study_fits.py PYTHON_DIR (the repository's python/)"""
+Usage: test_study_fits.py (the package is the repository's python/dynhet, beside it as tests/dynhet)"""
 import math
 import sys
 
 import numpy as np
 
-sys.path.insert(0, sys.argv[1] if len(sys.argv) > 1 else "python")
-from dynhet import fits as sf  # noqa: E402
+from dynhet import fits as sf
 
 K, R, S = 6, 60, 0.03
 fails = []
@@ -123,7 +122,7 @@ check(all(math.isnan(x) for x in sf.interp_ln_t(t, t, 1000.0)), "interp_ln_t out
 
 # --- The analysis path itself (analyse_study.fit_series on Points of runs):
 # chi4 ~ xi^d_f with errors on both axes and a known sub-box bias.
-from dynhet.analysis import config, points  # noqa: E402
+from dynhet.analysis import config, points
 
 DF, XI_S, CHI_S = 1.6, 0.25, 0.03   # true d_f'; relative error of one run's xi and chi4
 xi_true = np.geomspace(1.2, 12.0, 10)
