@@ -88,7 +88,7 @@ for n in "${ns[@]}"; do
   $py - "$work/with_$n" "$n" "$with" "$without" "$stop" "$rc" <<'PY'
 import re, statistics, sys, glob
 d, n, with_, without, stop, rc = sys.argv[1], int(sys.argv[2]), float(sys.argv[3]), float(sys.argv[4]), float(sys.argv[5]), sys.argv[6]
-pat = re.compile(r"(\w+?)(?:_node)?: checkpoint: cut (\d+).*?\((?:sim part )?([\d.]+) MB in ([\d.]+) s\)")
+pat = re.compile(r"(\w+?)(?:_node)?: checkpoint: cut (\d+).*?\((?:sim part )?([\d.]+) MB in ([\d.]+) s[,)]")
 rows = {}
 for f in glob.glob(d + "/*.log"):
     for line in open(f, errors="replace"):

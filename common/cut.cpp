@@ -49,7 +49,7 @@ std::vector<std::string> mark_cut_whole(const std::string& root, const CutInfo& 
     PartHeader h;
     try {
       const std::string path = part_path(root, c.cut, p, c.frame);
-      read_part(path, p, c.run_id, scene, &h);
+      check_part(path, p, c.run_id, scene, &h);
       if (h.frame != c.frame || (p == "sim" && h.cut != c.cut))
         throw BadPart(path + ": saved for cut " + std::to_string(h.cut) + " after frame " + std::to_string(h.frame) +
                       ", not cut " + std::to_string(c.cut) + " after frame " + std::to_string(c.frame));
@@ -96,7 +96,7 @@ std::optional<CutInfo> latest_whole_cut(const std::string& root, uint64_t scene,
       for (const std::string& p : c->parts) {
         PartHeader h;
         const std::string path = part_path(root, c->cut, p, c->frame);
-        read_part(path, p, c->run_id, scene, &h);
+        check_part(path, p, c->run_id, scene, &h);
         if (h.frame != c->frame || (p == "sim" && h.cut != c->cut))
           throw BadPart(path + ": saved for another cut or frame");
       }

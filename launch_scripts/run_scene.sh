@@ -445,7 +445,7 @@ elif [[ -n $cuts ]]; then
         if [[ $rc -gt 128 && -z $stop_signal ]]; then died="${names[$i]} (exit $rc)"; break 2; fi
       fi
     done
-    sleep 0.2
+    sleep 0.1
   done
   if [[ -n $died ]]; then
     echo "run_scene: $died died: stopping the run (it resumes from its last whole checkpoint cut)" >&2

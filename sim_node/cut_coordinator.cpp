@@ -45,16 +45,28 @@ int CutCoordinator::take(int frame, double t, const std::vector<uint8_t>& sim_pa
   const int cut = next_cut_++;
   last_take_ = Clock::now();
   std::filesystem::create_directories(cut_dir(dir_, cut));
-  PartHeader h;
-  h.process = "sim", h.run_id = run_id_, h.cut = cut, h.frame = frame, h.scene_hash = scene_hash_;
-  write_part(part_path(dir_, cut, "sim", frame), h, sim_payload);
   // Older cuts stay open: nodes behind the sim (up to its pacing window)
   // save them in turn.
   while (pending_.size() >= kMaxOpen) pending_.erase(pending_.begin());
   Pending& p = pending_[cut];
   p.frame = frame, p.time = t, p.stop = stop;
-  p.saved.insert("sim");
+  // The request first, then the sim's own part: the nodes and the recorder
+  // write theirs while the sim writes its own (at N = 10^6 a stop's sim
+  // part takes seconds), instead of after it. The cut is whole only once
+  // the sim's part, too, is on disk and reads back (complete()); its
+  // answers wait in the subscription's queue meanwhile.
   request(cut, p);
+  PartHeader h;
+  h.process = "sim", h.run_id = run_id_, h.cut = cut, h.frame = frame, h.scene_hash = scene_hash_;
+  try {
+    write_part(part_path(dir_, cut, "sim", frame), h, sim_payload);
+  } catch (...) {
+    // Not a cut: the others' parts of this frame boundary stay unused (and
+    // go with the pruning), the restart point stays where it was.
+    pending_.erase(cut);
+    throw;
+  }
+  pending_[cut].saved.insert("sim");
   return cut;
 }
 

@@ -1,8 +1,9 @@
 // The sim's side of a checkpoint cut (dynhet/cut.hpp, docs/checkpoints.md),
 // in the spirit of Chandy and Lamport's marker: at a synchronised time
-// between frames k and k + 1 the sim saves its own part, then asks on
-// DYNHET_CHECKPOINT that every process save its part with frame k folded
-// in. Frames and the request leave one socket in order, so each node sees
+// between frames k and k + 1 (or on a signal, anywhere between them) the
+// sim asks on DYNHET_CHECKPOINT that every process save its part with
+// frame k folded in, then saves its own while they save theirs. Frames and
+// the request leave one socket in order, so each node sees
 // the request before frame k + 1. Each process answers on
 // DYNHET_CHECKPOINT_<process>; the recorder answers last (it saves once
 // every node has said so, so its results hold every node's up to frame k).
@@ -36,10 +37,10 @@ public:
                  std::vector<std::string> parts);
   ~CutCoordinator();
 
-  // Writes the sim's part (its payload) for a cut after frame `frame` at
-  // simulation time t, and asks every other process for theirs. Returns the
+  // Asks every other process for its part of a cut after frame `frame` at
+  // simulation time t, then writes the sim's part (its payload). Returns the
   // cut's number. Throws if the sim's part cannot be written (a full disk):
-  // the previous cut stays the restart point.
+  // that cut is dropped, and the previous cut stays the restart point.
   // `stop`: the sim stops after this cut (a signal): the request says so
   // ("stop"), and every process that has had a signal stops after saving it.
   // Returns -1 (and takes nothing) once cuts are off (broken()).

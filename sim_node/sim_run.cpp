@@ -272,11 +272,13 @@ int SimRun::take_cut(bool stop, bool between) {
     out(st);
   }
   out(rep_);
+  const double serialised = seconds_since(t0);
   const int c = cuts_->take(next_frame_ - 1, eng_.time(), out.bytes(), stop);
   if (c < 0) return c; // cuts are off (said once)
-  std::fprintf(stderr, "%ssim_node: checkpoint: cut %d after frame %d at t=%.10g (sim part %.1f MB in %.2f s)\n",
+  std::fprintf(stderr, "%ssim_node: checkpoint: cut %d after frame %d at t=%.10g (sim part %.1f MB in %.2f s, "
+               "%.2f s of it to serialise)\n",
                isatty(STDERR_FILENO) ? "\n" : "", c, next_frame_ - 1, eng_.time(), out.bytes().size() / 1e6,
-               seconds_since(t0));
+               seconds_since(t0), serialised);
   return c;
 }
 
@@ -309,10 +311,14 @@ void SimRun::stop_with_cut(bool between) {
     std::fprintf(stderr, "\nsim_node: checkpoint cut not taken: %s\n", e.what());
   }
   const int before = cuts_->last_whole();
-  if (c >= 0 && cuts_->wait_whole(c, o_.cut_wait, [this] { return keep_talking(); }))
+  const auto t_wait = Clock::now();
+  if (c >= 0 && cuts_->wait_whole(c, o_.cut_wait, [this] { return keep_talking(); })) {
+    char waited[64];
+    std::snprintf(waited, sizeof waited, "%.2f", seconds_since(t_wait));
     throw std::runtime_error(interrupted() + "; checkpoint cut " + std::to_string(c) + " after frame " +
                              std::to_string(next_frame_ - 1) + " (t=" + std::to_string(eng_.time()) +
-                             ") is whole: the same command resumes the run");
+                             ") is whole, " + waited + " s after the sim's part: the same command resumes the run");
+  }
   throw std::runtime_error(interrupted() + "; the last cut was not whole within " + std::to_string(o_.cut_wait) +
                            " s: the run resumes from cut " + std::to_string(before));
 }

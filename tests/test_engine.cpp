@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "dynhet/engine/engine.hpp"
+#include "dynhet/engine/rows.hpp"
 #include "dynhet/state_archive.hpp"
 #include "engine_test_params.hpp"
 
@@ -332,6 +333,40 @@ TEST(Engine, SnapshotBetweenSynchronisedTimesContinuesBitForBit) {
       Engine d(wrong);
       EXPECT_THROW(d.restore_snapshot(snap), std::invalid_argument);
     }
+  }
+}
+
+// The packed rows of a snapshot (Rows::save_packed): every row's members
+// back in their order, whatever their distance from the base (far members
+// take more bytes, not a wrong value); bytes that are not exactly the rows
+// (cut short, left over, a member out of range) are refused.
+TEST(Rows, PackedRowsRoundTripAndRefuseMalformedBytes) {
+  using dynhet::engine::Rows;
+  const int32_t limit = 3000000;
+  for (const bool from_row : {true, false}) {
+    Rows a;
+    a.reset(6);
+    const std::vector<std::vector<int32_t>> rows = {
+        {}, {2, 0, 5, 1}, {limit - 1, 0, 7}, {3}, {}, {17, 16, 18, 2999999, 1, 0, 64, 63, 8191, 8192, 1 << 20}};
+    for (size_t r = 0; r < rows.size(); ++r)
+      for (const int32_t v : rows[r]) a.push(r, v);
+    std::vector<uint8_t> bytes;
+    a.save_packed(bytes, from_row);
+    Rows b;
+    ASSERT_TRUE(b.load_packed(rows.size(), bytes, limit, from_row));
+    for (size_t r = 0; r < rows.size(); ++r) {
+      ASSERT_EQ(b.row(r)[0], static_cast<int32_t>(rows[r].size()));
+      for (size_t k = 0; k < rows[r].size(); ++k) EXPECT_EQ(b.row(r)[k + 1], rows[r][k]) << r << " " << k;
+    }
+    EXPECT_FALSE(b.load_packed(rows.size() + 1, bytes, limit, from_row)); // a row short
+    EXPECT_FALSE(b.load_packed(rows.size() - 1, bytes, limit, from_row)); // bytes left over
+    EXPECT_FALSE(b.load_packed(rows.size(), bytes, limit - 1, from_row)); // limit - 1 out of range
+    auto cut_short = bytes;
+    cut_short.pop_back();
+    EXPECT_FALSE(b.load_packed(rows.size(), cut_short, limit, from_row));
+    auto unterminated = bytes;
+    unterminated.back() |= 0x80; // the last number never ends
+    EXPECT_FALSE(b.load_packed(rows.size(), unterminated, limit, from_row));
   }
 }
 

@@ -150,7 +150,9 @@ dynhet::PartHeader header(const std::string& process, int cut, int frame) {
 TEST(StateArchive, APartIsRefusedWhenTruncatedCorruptOrAnothers) {
   Tmp t;
   const std::string path = (t.dir / "overlap.part").string();
-  std::vector<uint8_t> payload(1000);
+  // (over 4 MiB: check_part reads the state in pieces of that size, and
+  // read_part_header the first 64 KiB)
+  std::vector<uint8_t> payload(5000000);
   for (size_t i = 0; i < payload.size(); ++i) payload[i] = static_cast<uint8_t>(i * 7);
   dynhet::write_part(path, header("overlap", 3, 17), payload);
   EXPECT_FALSE(fs::exists(path + ".tmp"));
@@ -158,13 +160,21 @@ TEST(StateArchive, APartIsRefusedWhenTruncatedCorruptOrAnothers) {
   EXPECT_EQ(dynhet::read_part(path, "overlap", 42, dynhet::scene_hash("scene"), &h), payload);
   EXPECT_EQ(h.cut, 3);
   EXPECT_EQ(h.frame, 17);
+  dynhet::PartHeader hc;
+  dynhet::check_part(path, "overlap", 42, dynhet::scene_hash("scene"), &hc);
+  EXPECT_EQ(hc.crc, h.crc);
+  EXPECT_EQ(dynhet::read_part_header(path).frame, 17);
+  // read_part and check_part refuse alike, naming the file and why.
   auto refused = [&](const std::string& process, int64_t run, const std::string& scene, const std::string& why) {
-    try {
-      dynhet::read_part(path, process, run, dynhet::scene_hash(scene));
-      ADD_FAILURE() << "not refused: " << why;
-    } catch (const BadPart& e) {
-      EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+    for (const bool check : {false, true}) {
+      try {
+        if (check) dynhet::check_part(path, process, run, dynhet::scene_hash(scene));
+        else dynhet::read_part(path, process, run, dynhet::scene_hash(scene));
+        ADD_FAILURE() << "not refused: " << why;
+      } catch (const BadPart& e) {
+        EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(why), std::string::npos) << e.what();
+      }
     }
   };
   refused("s4", 42, "scene", "not of s4");
@@ -177,9 +187,10 @@ TEST(StateArchive, APartIsRefusedWhenTruncatedCorruptOrAnothers) {
     f.put('\x5a');
   }
   refused("overlap", 42, "scene", "corrupt");
-  // Cut short.
+  // Cut short: the header alone says so too.
   fs::resize_file(path, fs::file_size(path) - 100);
   refused("overlap", 42, "scene", "truncated");
+  EXPECT_THROW(dynhet::read_part_header(path), BadPart);
 }
 
 TEST(Cuts, TheNewestWholeCutIsUsedAndADamagedOneIsPassedOver) {

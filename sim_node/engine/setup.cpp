@@ -259,14 +259,21 @@ Snapshot Engine::snapshot() const {
   s.particles.resize(part_.size() * sizeof(Particle));
   std::memcpy(s.particles.data(), part_.data(), s.particles.size());
   s.id = id_;
-  s.image_x = image_x_;
-  s.image_y = image_y_;
+  s.images.reserve(2 * static_cast<size_t>(n_));
+  auto zigzag = [](int32_t v) { // small of either sign: small unsigned
+    const int64_t w = v;
+    return (static_cast<uint64_t>(w) << 1) ^ static_cast<uint64_t>(w >> 63);
+  };
+  for (long i = 0; i < n_; ++i) {
+    Rows::put_varint(s.images, zigzag(image_x_[i]));
+    Rows::put_varint(s.images, zigzag(image_y_[i]));
+  }
   if (p_.tc > 0) s.last_collision = last_collision_;
   s.centres.resize(2 * static_cast<size_t>(n_));
   for (long i = 0; i < n_; ++i) s.centres[2 * i] = centre_[i].x, s.centres[2 * i + 1] = centre_[i].y;
-  nbr_.save(s.neighbours);
-  if (kick_lists()) kick_nbr_.save(s.kick_lists);
-  cells_.save(s.cells);
+  nbr_.save_packed(s.neighbours, true);
+  if (kick_lists()) kick_nbr_.save_packed(s.kick_lists, true);
+  cells_.save_packed(s.cells, false);
   for (int k = 0; k < 4; ++k) s.rng[k] = rng_.state()[k];
   s.counters = count_;
   return s;
@@ -277,9 +284,23 @@ void Engine::restore_snapshot(const Snapshot& s) {
   auto refuse = [&](const std::string& why) {
     throw std::invalid_argument("engine: a snapshot that does not fit this run: " + why);
   };
-  if (s.particles.size() != n * sizeof(Particle) || s.id.size() != n || s.image_x.size() != n ||
-      s.image_y.size() != n || s.last_collision.size() != (p_.tc > 0 ? n : 0) || s.centres.size() != 2 * n)
+  if (s.particles.size() != n * sizeof(Particle) || s.id.size() != n ||
+      s.last_collision.size() != (p_.tc > 0 ? n : 0) || s.centres.size() != 2 * n)
     refuse("its arrays are not of " + std::to_string(n) + " particles");
+  std::vector<int32_t> image_x(n), image_y(n);
+  {
+    const uint8_t* p = s.images.data();
+    const uint8_t* const end = p + s.images.size();
+    auto image = [&](int32_t& out) {
+      uint64_t z = 0;
+      if (!Rows::get_varint(p, end, z)) refuse("its images are not of " + std::to_string(n) + " particles");
+      const int64_t v = static_cast<int64_t>(z >> 1) ^ -static_cast<int64_t>(z & 1);
+      if (v < INT32_MIN || v > INT32_MAX) refuse("an image is out of range");
+      out = static_cast<int32_t>(v);
+    };
+    for (size_t k = 0; k < n; ++k) image(image_x[k]), image(image_y[k]);
+    if (p != end) refuse("its images are not of " + std::to_string(n) + " particles");
+  }
   if (!std::isfinite(s.now) || !std::isfinite(s.offset) || s.events_since_rebase < 0)
     refuse("its clock is not finite");
   start_run();
@@ -302,15 +323,16 @@ void Engine::restore_snapshot(const Snapshot& s) {
     centre_[k] = Centre{s.centres[2 * k], s.centres[2 * k + 1]};
   }
   id_ = s.id;
-  image_x_ = s.image_x;
-  image_y_ = s.image_y;
+  image_x_ = std::move(image_x);
+  image_y_ = std::move(image_y);
   if (p_.tc > 0) last_collision_ = s.last_collision;
   else last_collision_.assign(n, -kNever);
   const auto limit = static_cast<int32_t>(n_);
-  if (!nbr_.load(n, s.neighbours, limit)) refuse("its neighbour lists are malformed");
-  if (!kick_nbr_.load(kick_lists() ? n : 0, s.kick_lists, limit)) refuse("its kick lists are malformed");
+  if (!nbr_.load_packed(n, s.neighbours, limit, true)) refuse("its neighbour lists are malformed");
+  if (!kick_nbr_.load_packed(kick_lists() ? n : 0, s.kick_lists, limit, true))
+    refuse("its kick lists are malformed");
   const size_t cells = static_cast<size_t>(nc_) * nc_;
-  if (!cells_.load(cells, s.cells, limit)) refuse("its cells are malformed");
+  if (!cells_.load_packed(cells, s.cells, limit, false)) refuse("its cells are malformed");
   cell_x_.assign(n, -1);
   cell_y_.assign(n, -1);
   for (size_t c = 0; c < cells; ++c) {

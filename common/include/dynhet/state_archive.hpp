@@ -195,7 +195,12 @@ void write_part(const std::string& path, PartHeader h, const std::vector<uint8_t
 // process, run and scene (run_id 0: any). Throws BadPart naming the file.
 std::vector<uint8_t> read_part(const std::string& path, const std::string& process, int64_t run_id,
                                uint64_t scene, PartHeader* header = nullptr);
-// The header only (no payload check beyond its length): for listings.
+// The same checks as read_part(), the payload not kept (a cut marked
+// whole: every part read back).
+void check_part(const std::string& path, const std::string& process, int64_t run_id, uint64_t scene,
+                PartHeader* header = nullptr);
+// The header only (no payload check beyond its length, from the file's
+// size; the payload is not read): for listings.
 PartHeader read_part_header(const std::string& path);
 
 } // namespace dynhet

@@ -55,8 +55,8 @@ def main():
     r.add_argument("--mem")
     r.add_argument("--signal-lead", type=float, default=120,
                    help="slurm: seconds before the time limit at which a task is told to checkpoint and stop "
-                        "(sbatch --signal). A stop takes the sim's whole engine to disk: 11 s at N = 10^6 and "
-                        "40 s at 4 x 10^6 measured on a loaded 2-core machine (docs/checkpoints.md); default 120")
+                        "(sbatch --signal). A stop takes the sim's whole engine to disk: 5-6 s at N = 10^6 and "
+                        "21 s at 4 x 10^6 measured on a loaded 2-core machine (docs/checkpoints.md); default 120")
     r.add_argument("--max-requeues", type=int, default=20,
                    help="slurm: a task interrupted by its time limit goes back in the queue at most this often")
 
