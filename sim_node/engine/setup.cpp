@@ -265,7 +265,7 @@ Snapshot Engine::snapshot() const {
   s.centres.resize(2 * static_cast<size_t>(n_));
   for (long i = 0; i < n_; ++i) s.centres[2 * i] = centre_[i].x, s.centres[2 * i + 1] = centre_[i].y;
   nbr_.save(s.neighbours);
-  if (kick_lists()) kick_nbr_.save(s.kick_lists);
+  if (kick_lists()) kick_beyond_.save(s.kick_lists);
   cells_.save(s.cells);
   for (int k = 0; k < 4; ++k) s.rng[k] = rng_.state()[k];
   s.counters = count_;
@@ -308,7 +308,10 @@ void Engine::restore_snapshot(const Snapshot& s) {
   else last_collision_.assign(n, -kNever);
   const auto limit = static_cast<int32_t>(n_);
   if (!nbr_.load(n, s.neighbours, limit)) refuse("its neighbour lists are malformed");
-  if (!kick_nbr_.load(kick_lists() ? n : 0, s.kick_lists, limit)) refuse("its kick lists are malformed");
+  if (!kick_beyond_.load(kick_lists() ? n : 0, s.kick_lists, limit)) refuse("its kick lists are malformed");
+  if (kick_lists() && !kick_lists_apart())
+    refuse("its kick lists repeat members of the neighbour lists (kick lists that hold every kick candidate, "
+           "not only those beyond the neighbour list, are another layout)");
   const size_t cells = static_cast<size_t>(nc_) * nc_;
   if (!cells_.load(cells, s.cells, limit)) refuse("its cells are malformed");
   cell_x_.assign(n, -1);
