@@ -382,8 +382,17 @@ def main(path, scene_path):
     if "observables/s4" in f:  # one group per cutoff, each against the direct sum with its own weights
         cutoffs = sorted(f"a{a:g}" for a in f["observables/schedule/cutoff_a"][()])
         check(sorted(f["observables/s4"].keys()) == cutoffs, f"s4: one group per cutoff {cutoffs}")
+        # The whole-box OZ fit is checked wherever the node made one. Whether
+        # it converges for a given cutoff depends on the trajectory at this
+        # size (300 disks, 4 origins: S4 may still rise at the box's smallest
+        # q, and the node then refuses the fit), so the check asks for one
+        # cutoff's fit, not every cutoff's.
+        fitted = []
         for name, g in f["observables/s4"].items():
-            check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, lag)
+            check_s4(f, name, g, unwrapped, L, origin_frame, pair_frame, lag, need_fit=False)
+            if math.isfinite(float(g["oz_xi"]["value"][-1][-1])):
+                fitted.append(name)
+        check(len(fitted) > 0, f"s4: a whole-box OZ fit at t_s4 for at least one cutoff (fitted: {fitted})")
     if "observables/clusters" in f:
         nodes = f["observables/nodes/clusters"]
         check(int(nodes["frames_lost"]["value"][-1]) == 0, "clusters node lost no frame")

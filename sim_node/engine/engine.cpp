@@ -395,7 +395,7 @@ double Engine::mean_neighbours() const {
 size_t Engine::memory_bytes() const {
   auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return b(part_) + b(species_by_id_) + b(species_) + b(id_) + b(image_x_) + b(image_y_) + b(last_collision_) +
-         cells_.bytes() + b(cell_x_) + b(cell_y_) + nbr_.bytes() + kick_nbr_.bytes() + b(centre_) + cal_.bytes();
+         cells_.bytes() + b(cell_x_) + b(cell_y_) + nbr_.bytes() + kick_beyond_.bytes() + b(centre_) + cal_.bytes();
 }
 
 double Engine::max_overlap() const { return 1.0 - min_gap_ratio(); }

@@ -1,5 +1,5 @@
 // The driving's kicks (engine.hpp, class Engine): which pair a kick takes
-// (neighbour pairs from the kick lists, or the 3 x 3-cell search they
+// (neighbour pairs from the neighbour and kick lists, or the 3 x 3-cell search they
 // replaced; pairs from the whole system) and the kick itself. The kick
 // lists are kept with the neighbour lists, in lists.cpp.
 #include "dynhet/engine/engine.hpp"
@@ -113,27 +113,29 @@ bool Engine::within_kick_reach(int i, int j) const {
   return dx * dx + dy * dy <= reach * reach;
 }
 
-// The second particle of draw d of kick k, first particle i: members of
-// i's kick list drawn uniformly (hashes of k, d and the trial) until one is
-// within reach: uniform over those within reach. After kKickTrials in vain
-// (few or none within reach) the row is searched whole and one of those
-// within reach taken uniformly (the same distribution), or -1 if none.
+// The second particle of draw d of kick k, first particle i: i's kick
+// candidates (its neighbour list, then its kick list) drawn uniformly
+// (hashes of k, d and the trial) until one is within reach: uniform over
+// those within reach. After kKickTrials in vain (few or none within reach)
+// the candidates are searched whole and one of those within reach taken
+// uniformly (the same distribution), or -1 if none.
 int Engine::kick_partner(int64_t k, int d, int i) const {
-  const int32_t* l = kick_nbr_.row(static_cast<size_t>(i));
-  const int m = l[0];
+  const int32_t* a = list(i);
+  const int32_t* b = kick_beyond_.row(static_cast<size_t>(i));
+  const int m = a[0] + b[0];
   if (m == 0) return -1;
   const uint64_t h = kick_hash(k, d, 1);
   for (int t = 0; t < kKickTrials; ++t) {
-    const int j = l[1 + below(t == 0 ? h : mix64(h + 0x9e3779b97f4a7c15ULL * static_cast<uint64_t>(t)),
-                              static_cast<uint64_t>(m))];
+    const int j = kick_candidate(
+        a, b, below(t == 0 ? h : mix64(h + 0x9e3779b97f4a7c15ULL * static_cast<uint64_t>(t)), static_cast<uint64_t>(m)));
     if (within_kick_reach(i, j)) return j;
   }
   int32_t cand[kMaxKickCandidates];
   int c = 0;
-  for (int q = 1; q <= m; ++q)
-    if (within_kick_reach(i, l[q])) {
+  for (int u = 0; u < m; ++u)
+    if (const int j = kick_candidate(a, b, u); within_kick_reach(i, j)) {
       if (c == kMaxKickCandidates) throw std::logic_error("engine: more than 512 particles within kick reach");
-      cand[c++] = l[q];
+      cand[c++] = j;
     }
   return c ? cand[below(mix64(h ^ 0x5f6c6973745f6b21ULL), static_cast<uint64_t>(c))] : -1;
 }
@@ -186,16 +188,18 @@ void Engine::kick() {
   if (neighbour_kicks_) {
     const int ni = below(kick_hash(count_.kicks, 0, 0), static_cast<uint64_t>(n_));
     if (kick_lists()) {
-      // In stages: the row of the next kick's first particle was requested
-      // a kick ago, so its first draw's particle (line, list and centre)
-      // can be requested now, with the first particle's; the row of the
-      // kick after it now.
+      // In stages: the rows of the next kick's first particle (its
+      // neighbour list and kick list) were requested a kick ago, so its
+      // first draw's particle (line, list and centre) can be requested now,
+      // with the first particle's; the rows of the kick after it now.
       prefetch_particle(ni);
-      const int32_t* l = kick_nbr_.row(ni);
-      if (l[0] > 0) prefetch_particle(l[1 + below(kick_hash(count_.kicks, 0, 1), static_cast<uint64_t>(l[0]))]);
+      const int32_t *a = list(ni), *b = kick_beyond_.row(ni);
+      if (const int m = a[0] + b[0]; m > 0)
+        prefetch_particle(kick_candidate(a, b, below(kick_hash(count_.kicks, 0, 1), static_cast<uint64_t>(m))));
       const int nn = below(kick_hash(count_.kicks + 1, 0, 0), static_cast<uint64_t>(n_));
       __builtin_prefetch(&part_[nn]);
-      kick_nbr_.prefetch(nn);
+      nbr_.prefetch(nn);
+      kick_beyond_.prefetch(nn);
     } else {
       __builtin_prefetch(&part_[ni]);
       __builtin_prefetch(&cell_x_[ni]);

@@ -3,12 +3,15 @@
 // synchronisation and one particle's lists again when it leaves its skin.
 #include "dynhet/engine/engine.hpp"
 
+#include <algorithm>
 #include <stdexcept>
 
 namespace dynhet::engine {
 
 // ---------------------------------------------------------------- lists
 
+// Whether j is one of i's kick candidates. With the list scale at 1 (the
+// run), near() implies kick_near(): the same sums with kick_reach > 0 added.
 bool Engine::kick_near(int i, int j) const {
   const double dx = min_image(centre_[i].x - centre_[j].x), dy = min_image(centre_[i].y - centre_[j].y);
   const double reach = radius_[species_[i]] + radius_[species_[j]] + p_.kick_reach + skin_ + list_margin_;
@@ -19,6 +22,15 @@ bool Engine::near(int i, int j) const {
   const double dx = min_image(centre_[i].x - centre_[j].x), dy = min_image(centre_[i].y - centre_[j].y);
   const double reach = list_scale_ * (radius_[species_[i]] + radius_[species_[j]]) + skin_ + list_margin_;
   return dx * dx + dy * dy <= reach * reach;
+}
+
+bool Engine::kick_lists_apart() const {
+  for (long i = 0; i < n_; ++i) {
+    const int32_t *a = list(static_cast<int>(i)), *b = kick_beyond_.row(static_cast<size_t>(i));
+    for (int q = 1; q <= b[0]; ++q)
+      if (b[q] == i || std::find(a + 1, a + 1 + a[0], b[q]) != a + 1 + a[0]) return false;
+  }
+  return true;
 }
 
 void Engine::wrap(int i) {
@@ -39,7 +51,7 @@ void Engine::wrap(int i) {
 
 void Engine::build_lists() {
   const bool kl = kick_lists();
-  kick_nbr_.reset(kl ? static_cast<size_t>(n_) : 0);
+  kick_beyond_.reset(kl ? static_cast<size_t>(n_) : 0);
   for (long i = 0; i < n_; ++i) {
     wrap(static_cast<int>(i));
     centre_[i] = Centre{part_[i].x, part_[i].y};
@@ -55,7 +67,7 @@ void Engine::build_lists() {
       for (int k = 1; k <= c[0]; ++k)
         if (c[k] > i) {
           if (near(i, c[k])) link(i, c[k]);
-          if (kl && kick_near(i, c[k])) link_kick(i, c[k]);
+          else if (kl && kick_near(i, c[k])) link_kick(i, c[k]);
         }
     }
   }
@@ -81,10 +93,10 @@ void Engine::rebuild(int i) {
   nbr_.clear(i);
   const bool kl = kick_lists();
   if (kl) {
-    const int32_t* l = kick_nbr_.row(i);
-    for (int k = 1; k <= l[0]; ++k) kick_nbr_.prefetch(l[k]);
-    for (int k = 1; k <= l[0]; ++k) kick_nbr_.remove(l[k], i);
-    kick_nbr_.clear(i);
+    const int32_t* l = kick_beyond_.row(i);
+    for (int k = 1; k <= l[0]; ++k) kick_beyond_.prefetch(l[k]);
+    for (int k = 1; k <= l[0]; ++k) kick_beyond_.remove(l[k], i);
+    kick_beyond_.clear(i);
   }
   centre_[i] = Centre{part_[i].x, part_[i].y};
   if (cx != cell_x_[i] || cy != cell_y_[i]) {
@@ -105,8 +117,9 @@ void Engine::rebuild(int i) {
   }
   for (int k = 0; k < nc; ++k) {
     const int j = cand[k];
-    if (j != i && near(i, j)) link(i, j);
-    if (kl && j != i && kick_near(i, j)) link_kick(i, j);
+    if (j == i) continue;
+    if (near(i, j)) link(i, j);
+    else if (kl && kick_near(i, j)) link_kick(i, j);
   }
   ++count_.rebuilds;
   predict(i);

@@ -272,7 +272,7 @@ Snapshot Engine::snapshot() const {
   s.centres.resize(2 * static_cast<size_t>(n_));
   for (long i = 0; i < n_; ++i) s.centres[2 * i] = centre_[i].x, s.centres[2 * i + 1] = centre_[i].y;
   nbr_.save_packed(s.neighbours, true);
-  if (kick_lists()) kick_nbr_.save_packed(s.kick_lists, true);
+  if (kick_lists()) kick_beyond_.save_packed(s.kick_lists, true);
   cells_.save_packed(s.cells, false);
   for (int k = 0; k < 4; ++k) s.rng[k] = rng_.state()[k];
   s.counters = count_;
@@ -329,8 +329,11 @@ void Engine::restore_snapshot(const Snapshot& s) {
   else last_collision_.assign(n, -kNever);
   const auto limit = static_cast<int32_t>(n_);
   if (!nbr_.load_packed(n, s.neighbours, limit, true)) refuse("its neighbour lists are malformed");
-  if (!kick_nbr_.load_packed(kick_lists() ? n : 0, s.kick_lists, limit, true))
+  if (!kick_beyond_.load_packed(kick_lists() ? n : 0, s.kick_lists, limit, true))
     refuse("its kick lists are malformed");
+  if (kick_lists() && !kick_lists_apart())
+    refuse("its kick lists repeat members of the neighbour lists (kick lists that hold every kick candidate, "
+           "not only those beyond the neighbour list, are another layout)");
   const size_t cells = static_cast<size_t>(nc_) * nc_;
   if (!cells_.load_packed(cells, s.cells, limit, false)) refuse("its cells are malformed");
   cell_x_.assign(n, -1);

@@ -183,7 +183,9 @@ struct Snapshot {
   std::vector<uint8_t> images;        // image_x, image_y of each slot, zigzag varints
   std::vector<double> last_collision; // empty with the TC model off (every one is -inf then)
   std::vector<double> centres;        // x0 y0 x1 y1 ...
-  std::vector<uint8_t> neighbours, kick_lists, cells; // Rows::save_packed
+  // Rows::save_packed. A kick list holds only the kick candidates its
+  // neighbour list does not (Engine::kick_lists()).
+  std::vector<uint8_t> neighbours, kick_lists, cells;
   uint64_t rng[4] = {0, 0, 0, 0};
   Counters counters;
   size_t bytes() const {
@@ -324,18 +326,26 @@ private:
   // kMaxKickCandidates); returns their number.
   static constexpr int kMaxKickCandidates = 512;
   int kick_candidates(int i, int32_t* out) const;
-  // Kick lists (neighbour pairs, in the run): row i holds every slot whose
-  // list centre is within r_i + r_j + kick_reach + skin of i's, so that it
-  // holds everyone within kick reach of i now (centres are within skin / 2
-  // of their particles), about twice as many. The second particle is drawn
-  // from it and kept if within reach (rejection: uniform over those within
-  // reach); after kKickTrials draws in vain the row is searched whole.
+  // Kick candidates (neighbour pairs, in the run): every slot whose list
+  // centre is within r_i + r_j + kick_reach + skin of i's, so that they
+  // hold everyone within kick reach of i now (centres are within skin / 2
+  // of their particles), about twice as many. Those of them that i's
+  // neighbour list holds are not kept again: i's kick list (kick_beyond_)
+  // holds only the others, and the candidates are the neighbour list
+  // followed by the kick list. (Every near pair is kick-near, so each
+  // candidate is in one of the two, once.) The second particle is drawn
+  // from them and kept if within reach (rejection: uniform over those
+  // within reach); after kKickTrials draws in vain all are searched.
   static constexpr int kKickTrials = 8;
   bool kick_lists() const { return neighbour_kicks_ && driving_ && !p_.kick_search_cells; }
   bool kick_near(int i, int j) const;
   bool within_kick_reach(int i, int j) const; // now, by the particles' positions
   int kick_partner(int64_t k, int draw, int i) const; // -1: nobody within reach
-  void link_kick(int i, int j) { kick_nbr_.push(i, j), kick_nbr_.push(j, i); }
+  // Whether no kick list repeats a member of its neighbour list, or its own slot.
+  bool kick_lists_apart() const;
+  void link_kick(int i, int j) { kick_beyond_.push(i, j), kick_beyond_.push(j, i); }
+  // Candidate u of i's kick candidates: its neighbour list a, then its kick list b.
+  static int32_t kick_candidate(const int32_t* a, const int32_t* b, int u) { return u < a[0] ? a[1 + u] : b[1 + u - a[0]]; }
   void prefetch_list(int i) const;     // i's neighbour list and list centre
   void prefetch_particle(int i) const; // its line, list and centre
   void rebase();
@@ -400,7 +410,9 @@ private:
 
   // Neighbour lists: row i holds the slots of i's neighbours.
   Rows nbr_;
-  Rows kick_nbr_; // kick lists (kick_lists())
+  // Kick lists (kick_lists()): row i holds i's kick candidates beyond its
+  // neighbour list. About 5 at phi = 0.78, so a row stays one line.
+  Rows kick_beyond_;
   struct Centre {
     double x, y;
   };
