@@ -130,6 +130,15 @@ struct OpenPart {
   explicit OpenPart(const std::string& path) {
     fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC);
     if (fd < 0) throw BadPart(path + ": cannot be read");
+    try {
+      parse(path);
+    } catch (...) { // a part refused: the destructor does not run for a constructor that threw
+      ::close(fd);
+      throw;
+    }
+  }
+  // The file's size and its header.
+  void parse(const std::string& path) {
     struct stat st {};
     if (::fstat(fd, &st) != 0 || st.st_size < 0) throw BadPart(path + ": cannot be read");
     size = static_cast<uint64_t>(st.st_size);
