@@ -22,6 +22,16 @@ check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
 check 'grep -q "4 of 4 runs complete, 0 failed" "$tmp/s.out" && [[ $(grep -c ": archived in " "$tmp/s.out") == 4 ]]' \
   "tiny study: 4 runs complete, each archived the moment it completed"
 /usr/bin/python3 "$root/tests/check_archive.py" entries "$tmp/results/tiny" "$tmp/study/tiny" || fail=1
+# A pilot's tau_alpha is the one of its last scene: a longer attempt runs again (--fresh), it does not
+# find the earlier attempt's run.h5 complete and keep its tau_alpha.
+check '/usr/bin/python3 -c "
+import glob, sys, tomllib, h5py
+ok = []
+for d in glob.glob(\"$tmp/study/tiny/pilots/*/\"):
+    want = tomllib.load(open(d + \"scene.toml\", \"rb\"))[\"schedule\"][\"lag_max\"]
+    got = float(h5py.File(d + \"run.h5\", \"r\")[\"parameters/schedule\"].attrs[\"lag_max\"])
+    ok.append(abs(got - want) < 1e-9 * want)
+sys.exit(0 if ok and all(ok) else 1)"' "each pilot's run.h5 is of its last scene (a longer attempt ran again)"
 
 # The same analysis from the archive as from the study directory.
 "${analyse[@]}" "$tmp/results/tiny" --out "$tmp/from_archive" >"$tmp/an.out" 2>&1 || { cat "$tmp/an.out"; fail=1; }

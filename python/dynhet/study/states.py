@@ -140,12 +140,18 @@ def pilot_locked(sd, p, name, d, unit):
     p = dict(p, seed=st.axes.get("seed", [st.base_value("seed")])[0])
     own = unit == st.run_length["unit"]
     g, _ = sd.guess(p, finished=False, table="tau_guess" if own else "tau_guess_cr")
+    spent_wall = spent_cpu = 0.0  # over every attempt: what the pilot cost
     for attempt in range(1, 7):
         sc = st.scene(p, g, pilot=True, unit=unit)
         prepared_state(sd, sc)
         write_atomic(os.path.join(d, "scene.toml"), toml_dump(sc, f"# pilot of {name}, tau guess {g:.6g}"))
+        # A later attempt runs its longer scene from the start (run_scene.sh
+        # --fresh): on the same directory it would find the earlier attempt's
+        # complete run.h5 and run nothing, and its tau_alpha would be the
+        # earlier, too short attempt's.
         rc, wall, cpu = run_scene(os.path.join(d, "scene.toml"), d, os.path.join(d, "run_scene.log"),
-                                  plots=st.run_plots)
+                                  fresh=attempt > 1, plots=st.run_plots)
+        spent_wall, spent_cpu = spent_wall + wall, spent_cpu + cpu
         if STOPPING.is_set():
             raise StudyInterrupted(f"pilot of {name} stopped")
         complete, tau = run_h5_result(os.path.join(d, "run.h5"), st.first_cutoff(sc), st.tau_group(unit))
@@ -155,7 +161,7 @@ def pilot_locked(sd, p, name, d, unit):
         if math.isfinite(tau) and tau <= g:
             key = st.series_key(p)
             done = {"state": "complete", "tau_alpha": tau, "guess": g, "attempts": attempt,
-                    "packing_fraction": p["packing_fraction"], "series": list(key), "wall_s": wall, "cpu_s": cpu,
+                    "packing_fraction": p["packing_fraction"], "series": list(key), "wall_s": spent_wall, "cpu_s": spent_cpu,
                     "unit": unit}
             write_status(d, done)
             archive_pilot(sd, name, done)
