@@ -40,15 +40,19 @@ def final_records_equal(run_h5, entry):
             if not isinstance(obj, h5py.Dataset):
                 return
             src = a["observables/" + name]
-            if name.endswith(("/value", "/step", "/time")) and src.shape and src.shape[0] and obj.shape[0] == 1:
-                want = src[-1:]
-            else:
-                want = src[()]
+            series = name.endswith("/value") and src.shape and src.shape[0] and obj.shape[0] == 1
+            want = src[-1:] if series else src[()]
             got = obj[()]
             if not np.array_equal(np.asarray(want), np.asarray(got), equal_nan=np.asarray(got).dtype.kind == "f"):
                 bad.append(name)
+            if series:  # the final record's step and time, as the series group's attributes
+                g_src, g_got = src.parent, obj.parent
+                if (g_got.attrs.get("step") != g_src["step"][-1]
+                        or g_got.attrs.get("time") != g_src["time"][-1]):
+                    bad.append(name + " (step, time)")
         b["observables"].visititems(visit)
-        n_a = sum(1 for _ in iter_datasets(a["observables"]))
+        # run.h5's datasets less each series' step and time (attributes in the entry)
+        n_a = sum(1 for n in iter_datasets(a["observables"]) if not n.endswith(("/step", "/time")))
         n_b = sum(1 for _ in iter_datasets(b["observables"]))
     return bad, n_a, n_b
 

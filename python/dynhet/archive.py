@@ -13,7 +13,8 @@ with a content hash.
 A reduced run.h5 keeps run.h5's layout (dynhet.run reads it as it reads a
 run): the root attributes, h5md/, parameters/, every observable group with
 each time series cut to its final record (the result; the study analysis
-reads nothing else of it), and, for a run that kept its frames, two frames
+reads nothing else of it: value with one record, its step and time the
+series group's attributes), and, for a run that kept its frames, two frames
 of particles/all (the first origin and the frame nearest tau_alpha: the
 snapshots of slow and fast particles). provenance/ holds the resolved scene,
 the build, the command, CPU and wall seconds, the dates and the original
@@ -90,17 +91,28 @@ def _copy_tree(src, dst, reduce_series):
     _copy_attrs(src, dst)
     for name, obj in src.items():
         if isinstance(obj, h5py.Group):
-            g = dst.create_group(name, track_order=True)
+            g = dst.create_group(name)
             if reduce_series and "value" in obj and isinstance(obj["value"], h5py.Dataset):
-                _copy_attrs(obj, g)
-                for part, ds in obj.items():
-                    d = _write(g, part, ds[-1:] if ds.shape and ds.shape[0] else ds[()])
-                    _copy_attrs(ds, d)
+                _final_record(obj, g)
             else:
                 _copy_tree(obj, g, reduce_series)
         else:
             d = _write(dst, name, obj[()])
             _copy_attrs(obj, d)
+
+
+def _final_record(series, g):
+    """An H5MD time series (step, time, value) reduced to its final record:
+    value keeps its record axis (one record), step and time become the
+    group's attributes (two datasets of one number each would be most of an
+    entry's size)."""
+    _copy_attrs(series, g)
+    v = series["value"]
+    d = _write(g, "value", v[-1:] if v.shape and v.shape[0] else v[()])
+    _copy_attrs(v, d)
+    for part in ("step", "time"):
+        if part in series and series[part].shape and series[part].shape[0]:
+            g.attrs[part] = series[part][-1]
 
 
 def _snapshot_frames(f):
@@ -126,7 +138,7 @@ def _copy_particles(f, out):
     if frames is None:
         return
     src = f["particles/all"]
-    dst = out.create_group("particles/all", track_order=True)
+    dst = out.create_group("particles/all")
     _copy_attrs(src, dst)
     for name, obj in src.items():
         if isinstance(obj, h5py.Group) and "value" in obj and name in ("position", "image"):
@@ -146,7 +158,7 @@ def _copy_particles(f, out):
 def reduce_run(run_h5, out_path, provenance):
     """Write the reduced copy of run_h5 to out_path (see the module's
     docstring); provenance: {name: scalar or string} stored in provenance/."""
-    with h5py.File(run_h5, "r") as f, h5py.File(out_path, "w", track_order=True) as out:
+    with h5py.File(run_h5, "r") as f, h5py.File(out_path, "w", libver="latest") as out:
         if int(f.attrs.get("complete", 0)) != 1:
             raise ArchiveError(f"{run_h5}: not complete (complete = {f.attrs.get('complete', 0)}): "
                                "only complete runs are archived")
@@ -155,8 +167,8 @@ def reduce_run(run_h5, out_path, provenance):
         _copy_attrs(f, out)
         for top in ("h5md", "parameters"):
             if top in f:
-                _copy_tree(f[top], out.create_group(top, track_order=True), reduce_series=False)
-        _copy_tree(f["observables"], out.create_group("observables", track_order=True), reduce_series=True)
+                _copy_tree(f[top], out.create_group(top), reduce_series=False)
+        _copy_tree(f["observables"], out.create_group("observables"), reduce_series=True)
         _copy_particles(f, out)
         pv = out.create_group("provenance")
         for k, v in provenance.items():

@@ -69,6 +69,8 @@ class Observable:
         d = self._g[name]
         if not isinstance(d, h5py.Group):
             raise ValueError(f"{self.name}/{name} is fixed, not a series")
+        if "time" not in d:  # a results archive's entry keeps the final record, its time an attribute
+            return np.atleast_1d(d.attrs.get("time", np.nan)), d["value"][()]
         return d["time"][()], d["value"][()]
 
     def __repr__(self):
