@@ -8,7 +8,8 @@ with a content hash.
                             [pilots."<pilot>"] (the pilots' tau_alpha and CPU)
         study.toml          the study file the runs were made by
         base_scene.toml     its base scene, as read when the study started
-        runs/<run>.h5       one reduced run.h5 per run
+        runs/<run>.h5.gz    one reduced run.h5 per run, gzip-compressed (Archive.path
+                            gives a readable copy, decompressed once into a cache)
 
 A reduced run.h5 keeps run.h5's layout (dynhet.run reads it as it reads a
 run): the root attributes, h5md/, parameters/, every observable group with
@@ -59,6 +60,39 @@ def sha256_of(path):
         for block in iter(lambda: f.read(1 << 20), b""):
             h.update(block)
     return h.hexdigest()
+
+
+def gzip_file(src, dst):
+    """dst: src gzip-compressed, synced. An entry's thousands of small HDF5
+    objects (a run of eight cutoffs has some 4000) cost more in headers than
+    their data; compressed, the headers all but vanish (1.8 MB -> 0.57 MB)."""
+    import gzip
+    import shutil
+    with open(src, "rb") as fin, open(dst, "wb") as raw:
+        with gzip.GzipFile(fileobj=raw, mode="wb", compresslevel=6, mtime=0) as out:
+            shutil.copyfileobj(fin, out, 1 << 20)
+        raw.flush()
+        os.fsync(raw.fileno())
+
+
+def readable(p, digest):
+    """An entry as a file h5py reads: a .h5.gz entry decompressed once into a
+    cache named by its hash (DYNHET_ARCHIVE_CACHE, default the system's
+    temporary directory), written atomically; a plain .h5 as it is."""
+    import gzip
+    import tempfile
+    if not p.endswith(".gz"):
+        return p
+    cache = os.environ.get("DYNHET_ARCHIVE_CACHE", os.path.join(tempfile.gettempdir(), "dynhet-archive"))
+    os.makedirs(cache, exist_ok=True)
+    out = os.path.join(cache, digest + ".h5")
+    if not os.path.exists(out):
+        tmp = f"{out}.tmp.{os.getpid()}"
+        with gzip.open(p, "rb") as fin, open(tmp, "wb") as fout:
+            for block in iter(lambda: fin.read(1 << 20), b""):
+                fout.write(block)
+        os.replace(tmp, out)
+    return out
 
 
 def is_archive(d):
@@ -265,7 +299,7 @@ class Archive:
             raise ArchiveError(f"{self.dir}: entry {name!r}: {entry['file']} does not match the index "
                                f"(size {os.path.getsize(p)} against {entry['bytes']}, or its hash): refused; "
                                "restore it from git (git checkout -- the file) or archive the run again")
-        return p
+        return readable(p, entry["sha256"])
 
     def _locked(self):
         os.makedirs(self.dir, exist_ok=True)
@@ -305,22 +339,22 @@ class Archive:
         datasets) rather than keep it."""
         rdir = os.path.join(self.dir, "runs")
         os.makedirs(rdir, exist_ok=True)
-        final = os.path.join(rdir, name + ".h5")
+        final = os.path.join(rdir, name + ".h5.gz")
         tmp = f"{final}.tmp.{socket.gethostname()}.{os.getpid()}"
         prov = provenance_of(run_dir, status, study_name, command)
         try:
-            reduce_run(os.path.join(run_dir, "run.h5"), tmp, prov)
+            reduce_run(os.path.join(run_dir, "run.h5"), tmp + ".h5", prov)
+            gzip_file(tmp + ".h5", tmp)
             size = os.path.getsize(tmp)
             if size > MAX_BYTES:
-                raise ArchiveError(f"{name}: the reduced run is {size} bytes, over {MAX_BYTES}: largest datasets "
-                                   + ", ".join(f"{n} ({b} bytes)" for n, b in largest_datasets(tmp)[:4]))
-            with open(tmp, "rb") as fh:
-                os.fsync(fh.fileno())
+                raise ArchiveError(f"{name}: the reduced run is {size} bytes compressed, over {MAX_BYTES}: largest "
+                                   "datasets " + ", ".join(f"{n} ({b} bytes)" for n, b in largest_datasets(tmp + ".h5")[:4]))
             digest = sha256_of(tmp)
-        except BaseException:
-            if os.path.exists(tmp):
-                os.remove(tmp)
-            raise
+        finally:
+            if os.path.exists(tmp + ".h5"):
+                os.remove(tmp + ".h5")
+        if not os.path.exists(tmp):
+            raise ArchiveError(f"{name}: the entry was not written")
         entry = dict(axes)
         entry.update({k: status[k] for k in RUN_KEYS if k in status})
         entry.update({"state": "complete", "file": os.path.relpath(final, self.dir), "bytes": size,
