@@ -43,6 +43,10 @@ def main():
                                                        "slurm: array tasks at once, default no limit)")
     r.add_argument("--out", help="study directory (default runs/study-<name>)")
     r.add_argument("--dry-run", action="store_true")
+    r.add_argument("--order", choices=["longest", "shortest"], default="longest",
+                   help="which runs start first: the longest estimated (default: the least wall time on a few "
+                        "cores) or the shortest (the most runs complete and archived by any moment, for a "
+                        "machine that may be lost before the study ends)")
     r.add_argument("--archive", metavar="DIR",
                    help="the results archive each complete run is reduced into (default: the study file's "
                         "[study] archive, relative to the repository; none if it names none)")
@@ -80,7 +84,7 @@ def main():
             check_scenes(sd)
             sd.claim()
             if a.executor == "local":
-                return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2))
+                return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2), a.order)
             return run_slurm(sd, a)
         sd = StudyDir(Study(os.path.join(a.dir, "study.toml"), os.path.join(a.dir, "base_scene.toml")), a.dir,
                       os.path.abspath(a.to) if getattr(a, "to", None) else None)
