@@ -8,6 +8,9 @@
 #                      each on its own private network namespace, the
 #                      longest estimated run first (low phi first when run
 #                      lengths are interpolated)
+#   --order shortest   the shortest estimated run first instead: the most
+#                      runs complete and archived by any moment, where the
+#                      machine may be lost before the study ends
 #   --executor slurm   one sbatch job array (a task per run) and a dependent
 #                      job that writes the index; --partition, --time, --mem
 #                      and --sbatch=FLAG (repeatable) pass through

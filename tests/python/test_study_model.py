@@ -123,6 +123,10 @@ def test_the_executors_take_the_longest_run_first(tmp_path):
     assert [p["packing_fraction"] for p in order[-2:]] == [0.6, 0.6]
     same = [p for p in order if p["packing_fraction"] == 0.6]
     assert [p["seed"] for p in same] == [1, 2]            # equal estimates keep the study's order
+    # --order shortest: the reverse, equal estimates still in the study's order
+    short = run_order(sd, pts, est, "shortest")
+    assert [est[sd.study.run_name(p)] for p in short] == sorted(costs)
+    assert [p["seed"] for p in short if p["packing_fraction"] == 0.6] == [1, 2]
     # interpolated run lengths need the low densities first, whatever they cost
     sd = StudyDir(study(tmp_path, text.replace('tau_alpha = "pilot"', 'tau_alpha = "interpolate"')),
                   str(tmp_path / "out2"))

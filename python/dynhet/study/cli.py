@@ -47,6 +47,10 @@ def main():
     r.add_argument("--fresh", action="store_true",
                    help="the --out directory holds another study (or anything but a study): move it into "
                         "DIR/old-<time>/ and start this one (nothing is deleted)")
+    r.add_argument("--order", choices=["longest", "shortest"], default="longest",
+                   help="which runs start first: the longest estimated (default: the least wall time on a few "
+                        "cores) or the shortest (the most runs complete and archived by any moment, for a "
+                        "machine that may be lost before the study ends)")
     r.add_argument("--archive", metavar="DIR",
                    help="the results archive each complete run is reduced into (default: the study file's "
                         "[study] archive, relative to the repository; none if it names none)")
@@ -103,7 +107,7 @@ def main():
                 print(f"run_study: --fresh: what {sd.dir} held is now in {moved}", flush=True)
             running = True
             if a.executor == "local":
-                return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2))
+                return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2), a.order)
             return run_slurm(sd, a)
         sd = StudyDir(Study(os.path.join(a.dir, "study.toml"), os.path.join(a.dir, "base_scene.toml")), a.dir,
                       os.path.abspath(a.to) if getattr(a, "to", None) else None)

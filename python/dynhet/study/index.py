@@ -69,17 +69,20 @@ def run_estimates(sd):
     return {sd.study.run_name(p): estimate(sc, nodes_of(sc))[0] for p, sc, *_ in plan(sd)}
 
 
-def run_order(sd, todo, est):
+def run_order(sd, todo, est, order="longest"):
     """The order the executors take runs in (the local pool, and the Slurm
     array's task indices, which a throttled array starts in order). With
     interpolated run lengths the low densities first (the rest interpolate
-    from them); otherwise the longest estimated run first, so that the
-    longest run, which sets the study's wall time on a few cores, does not
-    start last behind the short ones (longest-processing-time first; equal
-    estimates keep the study's order)."""
+    from them). Otherwise, by default, the longest estimated run first, so
+    that the longest run, which sets the study's wall time on a few cores,
+    does not start last behind the short ones (longest-processing-time
+    first); with order "shortest" the shortest first, so that the most runs
+    are complete (and archived) by any moment, where the machine may be
+    lost before the study ends. Equal estimates keep the study's order."""
     if sd.study.run_length["tau_alpha"] == "interpolate":
         return sorted(todo, key=lambda p: p["packing_fraction"])
-    return sorted(todo, key=lambda p: -est.get(sd.study.run_name(p), 0.0))
+    sign = {"longest": -1.0, "shortest": 1.0}[order]
+    return sorted(todo, key=lambda p: sign * est.get(sd.study.run_name(p), 0.0))
 
 
 def nodes_of(sc):
