@@ -7,6 +7,7 @@ frames.
 
 Usage: check_run.py RUN.h5 SCENE.toml
 """
+import itertools
 import math
 import sys
 
@@ -256,8 +257,12 @@ def check_chi4(f, unwrapped, L, origin_frame, pair_frame):
                     want_err[j] = jackknife([curve([i for i in range(ko) if i // b != blk])[j] for blk in range(nb_)])
             ok = np.isnan(want_err) == np.isnan(got_err)
             fin = ~np.isnan(want_err)
-            d = np.max(np.abs(want_err[fin] - got_err[fin]) / np.maximum(want_err[fin], 1e-9 * np.max(want_err[fin]) + 1e-12)) \
-                if fin.any() else 0.0
+            # Relative to the error, with a floor at the replicates' roundoff:
+            # where every replicate is the same number (want 0), the node's
+            # sum of squares holds a few ulps of chi4 (seen: 6e-14 of 0.02).
+            floor = 1e-12 * max(np.max(np.abs(chi)), 1e-12)
+            excess = np.maximum(np.abs(want_err[fin] - got_err[fin]) - floor, 0.0)
+            d = np.max(excess / np.maximum(want_err[fin], 1e-300)) if fin.any() else 0.0
             check(ok.all() and d < 1e-6, f"chi4 {name} m={m}: its block jackknife error equals brute force "
                   f"(max rel diff {d:.2g})")
             # chi4^P, tau4: the vertex of the parabola in ln t fitted to the
@@ -266,8 +271,8 @@ def check_chi4(f, unwrapped, L, origin_frame, pair_frame):
             # largest point and its neighbours. Their errors: a jackknife over
             # blocks of origins spanning the last lag the fit reads (at most
             # a quarter of the origins; the whole box needs 3 blocks).
-            def peak(y):
-                b = int(np.nanargmax(y))
+            def peak(y, b=None):
+                b = int(np.nanargmax(y)) if b is None else b
                 lo = hi = b
                 while lo > 0 and y[lo - 1] > y[b] / 2:
                     lo -= 1
@@ -295,9 +300,22 @@ def check_chi4(f, unwrapped, L, origin_frame, pair_frame):
             bsz = block_of(lag[pk[2]])
             nb_ = -(-ko // bsz)
             if nb_ >= 3:
-                reps = np.array([peak(curve([i for i in range(ko) if i // bsz != blk]))[:2] for blk in range(nb_)])
-                errs = np.sqrt((nb_ - 1) / nb_ * ((reps - reps.mean(axis=0)) ** 2).sum(axis=0))
+                # A replicate whose largest value is tied (chi4 on a few hundred
+                # disks takes few distinct values) has its peak at either lag,
+                # decided by roundoff that differs between the node and numpy:
+                # every such choice is a brute-force answer.
+                options = []
+                for blk in range(nb_):
+                    y = curve([i for i in range(ko) if i // bsz != blk])
+                    top = np.nanmax(y)
+                    tied = [j for j in range(len(y)) if abs(y[j] - top) <= 1e-12 * abs(top)]
+                    options.append([peak(y, j)[:2] for j in tied])
                 re = (g["chi4_peak_err"]["value"][-1][gi], g["tau4_err"]["value"][-1][gi])
+                candidates = []
+                for pick in itertools.islice(itertools.product(*options), 256):
+                    reps = np.array(pick)
+                    candidates.append(np.sqrt((nb_ - 1) / nb_ * ((reps - reps.mean(axis=0)) ** 2).sum(axis=0)))
+                errs = min(candidates, key=lambda e: max(abs(u - v) / (abs(v) + 1e-12) for u, v in zip(re, e)))
                 check(all(abs(u - v) <= 1e-6 * abs(v) + 1e-12 for u, v in zip(re, errs)),
                       f"chi4 {name} m={m}: peak errors +- {re[0]:.3g}, +- {re[1]:.3g} equal a brute-force "
                       f"jackknife over {nb_} blocks of {bsz} origins")
