@@ -15,7 +15,7 @@
 # env: BUILD_DIR (default build), PEER_DIR (default ../peer-edmd beside the
 #      project root), PEER_SCRIPTS (default /work/shared/peer), WORK_DIR
 #      (default PEER_DIR/runs), PAIRS (interleaved pairs per case, default
-#      3), COLL (collisions per run, default 2e7), CORE (default 1).
+#      5), COLL (collisions per run, default 2e7), CORE (default 1).
 # Prints summarize.py's table (collisions per CPU second, medians and the
 # ratio dynhet/peer; collision frequency and Z of both codes as a check).
 set -euo pipefail
@@ -24,7 +24,7 @@ build=$(cd "${BUILD_DIR:-$root/build}" && pwd)
 scripts=${PEER_SCRIPTS:-/work/shared/peer}
 export PEER_DIR=${PEER_DIR:-$(cd "$root/.." && pwd)/peer-edmd}
 export WORK_DIR=${WORK_DIR:-$PEER_DIR/runs}
-export PAIRS=${PAIRS:-3}
+export PAIRS=${PAIRS:-5}
 cases=("$@")
 [ ${#cases[@]} -gt 0 ] || cases=(10000:0.78 100000:0.78 1000000:0.78)
 [ -d "$PEER_DIR/Cylinder2D" ] || { echo "peer_compare: no snapshot of l09rin/EDMD in $PEER_DIR (see the head of this script)" >&2; exit 2; }
