@@ -46,7 +46,7 @@ A_SNAPSHOT = 0.6             # the cutoff whose tau_alpha picks the snapshot fra
 RUN_KEYS = ("state", "tau_estimate", "tau_source", "tau_alpha", "wall_s", "cpu_s", "cpu_unrecorded", "attempts",
             "requeues", "finished")
 PILOT_KEYS = ("state", "tau_alpha", "unit", "guess", "attempts", "packing_fraction", "series", "wall_s",
-              "cpu_s")
+              "cpu_s", "system_key", "reused_from")
 
 
 class ArchiveError(Exception):
