@@ -147,5 +147,21 @@ check '[[ ! -d $tmp/bad/runs ]]' "an invalid study runs nothing"
 printf '[study]\nscene = "%s"\n[axes]\npacking_fraction = [0.6, 0.95]\n' "$root/scenes/tiny.toml" >"$tmp/dense.toml"
 "${study[@]}" "$tmp/dense.toml" --out "$tmp/dense" >"$tmp/dense.out" 2>&1 && rc=0 || rc=$?
 check '[[ $rc == 2 ]] && grep -q "phi0.9500.*system.packing_fraction" "$tmp/dense.out"' "a point whose scene sim_node refuses is named before anything runs"
+# Two series (N = 300 and 400) whose pilots run the same system (a pilot runs
+# min(N, pilot_particles) = 300 particles): the second takes the first's
+# tau_alpha instead of running it again, and says so.
+sed -e '/^\[\[override\]\]/,$d' -e 's/^seed = \[1, 2\]/seed = [1]\nn_particles = [300, 400]/' \
+  -e 's/^packing_fraction = .*/packing_fraction = [0.60]/' -e "s|\.\./scenes/|$root/scenes/|" "$root/studies/tiny.toml" >"$tmp/shared.toml"
+"${study[@]}" "$tmp/shared.toml" --out "$tmp/shared" --jobs 1 >"$tmp/shared.out" 2>&1 && rc=0 || rc=$?
+check '[[ $rc == 0 ]] && grep -q "2 of 2 runs complete, 0 failed" "$tmp/shared.out"' "two series sharing a pilot system: both runs complete"
+check '[[ $(ls "$tmp"/shared/pilots/*/run.h5 | wc -l) == 1 ]]' "the shared pilot system ran once (one pilot run.h5)"
+check '/usr/bin/python3 -c "
+import tomllib, glob, sys
+st = {p.split(\"/\")[-2]: tomllib.load(open(p, \"rb\")) for p in glob.glob(\"$tmp/shared/pilots/*/status.toml\")}
+ran = [n for n, s in st.items() if s[\"attempts\"] > 0]
+took = [n for n, s in st.items() if s.get(\"reused_from\")]
+ok = len(st) == 2 and len(ran) == 1 and len(took) == 1 and st[took[0]][\"reused_from\"] == ran[0] \
+     and st[took[0]][\"tau_alpha\"] == st[ran[0]][\"tau_alpha\"] and st[took[0]][\"system_key\"] == st[ran[0]][\"system_key\"]
+sys.exit(0 if ok else 1)"' "the other series' pilot took its tau_alpha, naming the pilot it came from"
 ((fail == 0)) || { echo "--- outputs"; cat "$tmp"/*.out; }
 exit $fail

@@ -47,7 +47,7 @@ A_SNAPSHOT = default("observables", "cutoff_a")[0]  # whose tau_alpha picks the 
 RUN_KEYS = ("state", "tau_estimate", "tau_source", "tau_alpha", "wall_s", "cpu_s", "cpu_unrecorded", "attempts",
             "requeues", "finished")
 PILOT_KEYS = ("state", "tau_alpha", "unit", "guess", "attempts", "packing_fraction", "series", "wall_s",
-              "cpu_s")
+              "cpu_s", "system_key", "reused_from")
 
 
 class ArchiveError(Exception):

@@ -1,6 +1,7 @@
 """Prepared and equilibrated states shared by runs, and the pilots that measure tau_alpha."""
 import fcntl
 import hashlib
+import json
 import math
 import os
 import re
@@ -111,6 +112,42 @@ def pid_alive(pid):
         return True
 
 
+def pilot_system_key(sc):
+    """What a pilot simulates, as a hash: its scene without the run lengths
+    ([run], [schedule]) and the prepared state's path. Two pilots with one
+    key run the same system from the same state and measure the same
+    tau_alpha."""
+    phys = {k: v for k, v in sc.items() if k not in ("run", "schedule")}
+    phys["system"] = {k: v for k, v in sc.get("system", {}).items() if k != "initial_state"}
+    return hashlib.sha1(json.dumps(phys, sort_keys=True).encode()).hexdigest()[:16]
+
+
+def same_system_pilot(sd, name, key, unit):
+    """(name, status) of a complete pilot of another series that ran the
+    system with this key (from the study directory, or from the archive on
+    a machine that lost the directory), or None. A pilot from before keys
+    were recorded is judged by its scene.toml."""
+    from .toml_io import read_toml
+    found = {}
+    if sd.archive is not None:
+        found.update(sd.archive.read()["pilots"])
+    pdir = os.path.join(sd.dir, "pilots")
+    for other in sorted(os.listdir(pdir)) if os.path.isdir(pdir) else []:
+        st = read_status(os.path.join(pdir, other))
+        if st.get("state") == "complete" and "system_key" not in st:
+            try:
+                st = dict(st, system_key=pilot_system_key(read_toml(os.path.join(pdir, other, "scene.toml"))))
+            except (OSError, ValueError):
+                continue
+        found[other] = st
+    for other, st in sorted(found.items()):
+        if (other != name and st.get("state") == "complete" and st.get("system_key") == key
+                and st.get("unit", sd.study.run_length["unit"]) == unit and math.isfinite(st.get("tau_alpha", math.nan))
+                and not st.get("reused_from")):
+            return other, st
+    return None
+
+
 def pilot(sd, p, unit=None):
     """tau_alpha of p (unit: "tau_alpha" or "tau_alpha_cr", default the
     study's run_length.unit) from a short, small run of its series; cached
@@ -143,6 +180,19 @@ def pilot_locked(sd, p, name, d, unit):
     p = dict(p, seed=st.axes.get("seed", [st.base_value("seed")])[0])
     own = unit == st.run_length["unit"]
     g, _ = sd.guess(p, finished=False, table="tau_guess" if own else "tau_guess_cr")
+    key = pilot_system_key(st.scene(p, g, pilot=True, unit=unit))
+    same = same_system_pilot(sd, name, key, unit)
+    if same is not None:
+        # Another series' pilot ran this very system (a pilot runs min(N,
+        # run_length.pilot_particles) particles, so the series of every N
+        # above that share one): its tau_alpha, not the same run again.
+        other, st_other = same
+        done = {"state": "complete", "tau_alpha": st_other["tau_alpha"], "guess": st_other.get("guess", g),
+                "attempts": 0, "packing_fraction": p["packing_fraction"], "series": list(st.series_key(p)),
+                "wall_s": 0.0, "cpu_s": 0.0, "unit": unit, "system_key": key, "reused_from": other}
+        write_status(d, done)
+        archive_pilot(sd, name, done)
+        return done["tau_alpha"]
     spent_wall = spent_cpu = 0.0  # over every attempt: what the pilot cost
     for attempt in range(1, 7):
         sc = st.scene(p, g, pilot=True, unit=unit)
@@ -165,7 +215,7 @@ def pilot_locked(sd, p, name, d, unit):
             key = st.series_key(p)
             done = {"state": "complete", "tau_alpha": tau, "guess": g, "attempts": attempt,
                     "packing_fraction": p["packing_fraction"], "series": list(key), "wall_s": spent_wall, "cpu_s": spent_cpu,
-                    "unit": unit}
+                    "unit": unit, "system_key": pilot_system_key(sc)}
             write_status(d, done)
             archive_pilot(sd, name, done)
             return tau
