@@ -43,10 +43,11 @@ set_tests_properties(stress_engine_elastic_1e8 PROPERTIES LABELS stress TIMEOUT 
 
 # The study runner, local executor: studies/tiny.toml end to end, skipped
 # when run again, an interrupted study resumed to the same results bit for
-# bit, changed and invalid studies refused (tests/study_local.sh).
+# bit, changed and invalid studies refused, two series sharing one pilot
+# (tests/study_local.sh). About 400 s beside the rest of the suite on 2 cores.
 add_test(NAME study_local_tiny
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/study_local.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
-set_tests_properties(study_local_tiny PROPERTIES LABELS process TIMEOUT 400)
+set_tests_properties(study_local_tiny PROPERTIES LABELS process TIMEOUT 700)
 
 # Kept frames for the field's tools: run.frames() and the GSD export, read
 # back by MDAnalysis (tests/frames_export.sh).
