@@ -275,3 +275,58 @@ def test_a_study_tied_for_the_most_sizes_does_not_fill_a_size_the_other_has_not_
     del A.extra[("d_size", "neighbours", 0.9, 0.78, 1000000)]
     assert [(p.N, p.study) for p in A.promote_largest_n()] == [(65536, "scale")]
     assert [(p.N, p.study, n) for p, n in A.held_back] == [(262144, "scale", 1)]
+
+
+def test_a_study_of_the_standard_measures_alone_stands_in_and_the_cage_relative_rows_keep_their_n():
+    """studies/size_standard.toml measures no cage-relative quantity and
+    size_cage.toml no chi4: when "everything the study's point measured"
+    counted the cage-relative measures, no larger N ever stood in. The
+    standard rows take the larger N; the cage-relative view and tau_alpha^CR
+    keep the largest N that measured them."""
+    from dynhet.analysis.local_measures import TAU_CR, series_measuring
+    from dynhet.analysis.output import cr_sizes_note
+    A = analysis()
+    for p in A.points.values():
+        for r in p.runs:
+            r["cut_cr"] = {0.6: {"tau_alpha": 300.0, "tau_alpha_err": 1.0}}
+            r["cut"][0.6].update(tau_cr=300.0, tau_cr_err=1.0)   # as read_run keeps tau_alpha^CR beside tau_alpha
+            r["D_cr"], r["D_cr_err"] = 0.01, 0.001
+    for p in A.extra.values():
+        for r in p.runs:
+            r["cut_cr"] = {}                                  # as size_standard's runs: the key, no cutoff
+    promoted = A.promote_largest_n()
+    assert [(p.phi, p.N, p.study) for p in promoted] == [(0.78, 65536, "scale2")]
+    assert [(p.phi, p.N) for p in A.series()] == [(0.70, 4096), (0.78, 65536)]
+    C = A.cage_relative_view()
+    assert [(p.phi, p.N) for p in C.series()] == [(0.70, 4096), (0.78, 4096)]
+    assert [(p.phi, p.N) for p in series_measuring(A, TAU_CR)] == [(0.70, 4096), (0.78, 4096)]
+    assert cr_sizes_note(A).endswith("the largest N that did, φ = 0.78: N = 4096.")
+    A = analysis()
+    for r in A.points[("neighbours", 0.9, 0.78, 4096)].runs:
+        r["cut"][0.6]["chi4"] = [1.0]                         # a standard measure the larger N lacks: not taken
+    assert A.promote_largest_n() == []
+
+
+def test_a_planned_size_with_no_run_archived_is_held_back():
+    """The largest size of a study that stands in elsewhere, not yet started
+    (no run archived, so no point of it), is named as held back too."""
+    from dynhet.analysis.output import largest_n_notes
+    A = analysis()
+    A.unfinished = {("scale2", "neighbours", 0.9, 0.78, 262144): 1,   # planned, not started
+                    ("other", "neighbours", 0.9, 0.78, 262144): 1,    # a study with no point anywhere: not one that stands in
+                    ("scale2", "neighbours", 0.9, 0.70, 4096): 1}     # not above this study's own N
+    assert [(p.phi, p.N) for p in A.promote_largest_n()] == [(0.78, 65536)]
+    assert [(p.study, p.phi, p.N, n) for p, n in A.held_back] == [("scale2", 0.78, 262144, 1)]
+    assert "N = 262144 of study scale2 (1 run not complete)" in largest_n_notes(A)
+
+
+def test_the_cutoff_rows_keep_this_studys_cutoffs_where_a_larger_n_of_one_cutoff_stands_in():
+    from dynhet.analysis.cutoff import cutoff_candidates
+    A = analysis()
+    A.study_name = "quick"
+    for p in A.points.values():
+        for r in p.runs:
+            r["cut"][1.4] = dict(r["cut"][0.6])               # this study ran two cutoffs, the larger N one
+    A.promote_largest_n()
+    assert [(p.phi, p.N) for p in A.series()] == [(0.70, 4096), (0.78, 65536)]
+    assert sorted((p.phi, p.N) for p in cutoff_candidates(A)) == [(0.70, 4096), (0.78, 4096)]

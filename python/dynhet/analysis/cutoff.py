@@ -18,14 +18,26 @@ def df_fit(pts, cfn, xfn):
     return fit_series(pts, cfn, sf.power, xrun=xfn, x_range=(XI_MIN_DF, math.inf))
 
 
+def cutoff_candidates(A):
+    """The main series' points that ran several cutoffs, per study and
+    density the largest N: every point, not only A.series(), since where
+    --largest-n took a larger N of a study with one cutoff, this study's own
+    point still holds the others (a promoted point, in both dicts, counts once)."""
+    top = {}
+    for q in list(A.points.values()) + list(A.extra.values()):
+        if q.pairs == "neighbours" and abs(q.eps - EPS_MAIN) < 1e-9 and len(q.runs[0]["cut"]) > 1:
+            k = (getattr(q, "study", None) or A.study_name, q.phi)
+            if k not in top or q.N > top[k].N:
+                top[k] = q
+    return list(top.values())
+
+
 def cutoff_results(A):
     """The cutoff a. Each a is taken at its own tau_alpha(a) where the run's
     lags reach it (solid), and all at tau_alpha of a = 0.6 (dashed); the
     d_f' rows use each a's own tau_alpha."""
     # the study (this one or an --also one) whose lags reach furthest in tau_alpha(0.6), all its densities
-    cands = [p for p in A.series() + [q for q in A.extra.values() if q.pairs == "neighbours" and abs(q.eps - EPS_MAIN) < 1e-9]
-             if len(p.runs[0]["cut"]) > 1]
-    cands = list({id(p): p for p in cands}.values())  # a point promoted by --largest-n is in both
+    cands = cutoff_candidates(A)
     reach = lambda p: cut(p.runs[0])["lag"][-1] / max(cut(p.runs[0])["tau_alpha"], 1e-300)
     by_study = {}
     for p in cands:

@@ -24,14 +24,27 @@ def measured(p, fn):
     return np.isfinite(p.mean(fn)[0])
 
 
+def series_measuring(A, fn):
+    """One point per density of the main series: the largest N whose runs
+    measured fn. With --largest-n a study of the standard measures alone
+    stands in for the series at some densities (Analysis.promote_largest_n);
+    the cage-relative and bond-breaking times stay at the N that has them."""
+    best = {}
+    for p in A.points.values():
+        if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and measured(p, fn):
+            if p.phi not in best or p.N > best[p.phi].N:
+                best[p.phi] = p
+    return [best[phi] for phi in sorted(best)]
+
+
 def local_phi_results(A):
-    pts = [p for p in A.series() if measured(p, TAU_CR) or measured(p, TAU_B)]
-    if not pts:
+    per = {fn: series_measuring(A, fn) for _, fn, _, _ in MEASURES}
+    if not per[TAU_CR] and not per[TAU_B]:
         say("    no run measured tau_alpha^CR or tau_B: no rows")
         return
     fig, ax = plt.subplots(figsize=(6.5, 4.6))
     for label, fn, col, m in MEASURES:
-        sel = [p for p in pts if measured(p, fn)]
+        sel = per[fn]
         x, y, e = series_arrays(sel, fn)
         errorbar(ax, x, y, e, fmt=m, ms=4, color=col, label=label)
         if len(sel) < 4 or fn is tau:
@@ -51,10 +64,15 @@ def local_phi_results(A):
     ax.legend(fontsize=8)
     ax.set_title(f"τ_α, cage-relative τ_α^CR and bond-breaking τ_B (ε = {EPS_MAIN:g}, a = {A_MAIN:g})")
     f = A.save(fig, "tau_local_phi.png")
-    for p in pts:
-        cells = [f"{label.split(' ')[0]} {fmt(*p.mean(fn)[:2])}" for label, fn, _, _ in MEASURES if measured(p, fn)]
-        A.row(f"relaxation times at φ = {p.phi:g} (N {p.N})", "not in the paper", "not measured",
-              ", ".join(cells), "—", f, [p])
+    local = {p.phi for fn in (TAU_CR, TAU_B) for p in per[fn]}
+    for phi in sorted(local):
+        # each time from the largest N that measured it; a size other than the row's is named
+        at = [(label.split(" ")[0], fn, next((p for p in per[fn] if p.phi == phi), None)) for label, fn, _, _ in MEASURES]
+        at = [(name, fn, p) for name, fn, p in at if p is not None]
+        n_row = at[0][2].N
+        cells = [f"{name} {fmt(*p.mean(fn)[:2])}" + (f" (N {p.N})" if p.N != n_row else "") for name, fn, p in at]
+        A.row(f"relaxation times at φ = {phi:g} (N {n_row})", "not in the paper", "not measured",
+              ", ".join(cells), "—", f, list({id(p): p for _, _, p in at}.values()))
 
 
 def local_n_results(A):

@@ -10,7 +10,7 @@ import numpy as np
 from .points import MIN_CAL_DOF
 from .quantities import PER_RUN, chi4_at_tau, cut, tau, xi_at_tau
 from .verdicts import fmt
-from .config import CONVENTIONS, EPS_MAIN, shown_path
+from .config import A_MAIN, CONVENTIONS, EPS_MAIN, shown_path
 from .restate import restate
 
 
@@ -175,7 +175,7 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=()):
               "largest N over the studies, not this study's own: "
               + "; ".join(f"φ = {p.phi:g} ({p.pairs}, ε = {p.eps:g}): N = {p.N}, study {p.study}, "
                           f"{len(p.runs)} seed{'s' if len(p.runs) > 1 else ''}" for p in A.promoted)
-              + ". The other densities are this study's." + largest_n_notes(A), ""]
+              + ". The other densities are this study's." + cr_sizes_note(A) + largest_n_notes(A), ""]
     elif getattr(A, "held_back", None):
         L += ["**At the largest N** (`--largest-n`): no larger N taken." + largest_n_notes(A), ""]
     if A.skipped:
@@ -290,6 +290,23 @@ def still_drifting(multi, d, d_cr, n_top):
             if text.startswith("drifting") and text.split("; over N = ")[0].endswith(f"to {n_top}"):
                 out.append(f"{name}{' — cage-relative' if cr else ''}{text[len('drifting'):]}")
     return out
+
+
+def cr_sizes_note(A):
+    """Where a point taken by --largest-n has no cage-relative measures (a
+    study of the standard measures alone): the cage-relative rows' N there."""
+    if not getattr(A, "promoted", None):
+        return ""
+    keep = []
+    for p in A.promoted:
+        if any(A_MAIN in (r.get("cut_cr") or {}) for r in p.runs):
+            continue
+        own = [q for q in A.points.values() if (q.pairs, q.eps, q.phi) == (p.pairs, p.eps, p.phi)
+               and any(A_MAIN in (r.get("cut_cr") or {}) for r in q.runs)]
+        if own:
+            keep.append(f"φ = {p.phi:g}: N = {max(q.N for q in own)}")
+    return (" That study measured no cage-relative quantity: the cage-relative rows (and τ_α^CR in the rows "
+            "of relaxation times) keep the largest N that did, " + "; ".join(keep) + ".") if keep else ""
 
 
 def largest_n_notes(A):

@@ -33,6 +33,12 @@ class PhiSeries(NamedTuple):
 QUANTITY_ALIASES = {"D": "diffusion"}
 
 
+def is_cage_relative_key(key):
+    """Whether a run's quantity is a cage-relative one (cut_cr, D_cr,
+    tau_cr_err, ...: a "cr" part in its name)."""
+    return "cr" in str(key).split("_")
+
+
 def drawable(ax):
     """Whether a panel's lines hold one point its axes can show (finite, and
     positive on a log axis): a panel of NaN only (a quantity no run of the
@@ -204,10 +210,16 @@ class Analysis:
         self.held_back; size.protocol_waiting), joins this study's points, so that every series (and
         so every row and fit) takes it in place of this study's own; other
         studies' densities are not added. Returns the promoted points (also
-        in self.promoted)."""
+        in self.promoted). What the point measured means the standard
+        measures: the cage-relative ones (keys with a "cr" part) are the
+        cage-relative view's, which keeps the largest N that has them
+        (a study of the standard measures alone, studies/size_standard.toml,
+        stands in for the paper's rows; the cage-relative rows stay at the
+        N whose runs measured them)."""
         from .size import waiting_for, waiting_sizes
         def measured(p):
-            return set.intersection(*[set(r["cut"].get(A_MAIN, {})) | set(r) for r in p.runs]) if p.runs else set()
+            keys = set.intersection(*[set(r["cut"].get(A_MAIN, {})) | set(r) for r in p.runs]) if p.runs else set()
+            return {k for k in keys if not is_cage_relative_key(k)}
         main = lambda p: p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9
         # a size the leading protocol (size.leading_protocol) has not finished is not filled
         # from another study's runs of other lengths (size.protocol_waiting)
@@ -234,6 +246,19 @@ class Analysis:
             q = best.get(key)
             if q is None or p.N > q.N or (p.N == q.N and len(p.runs) > len(q.runs)):
                 best[key] = p
+        # a size of a study that stands in elsewhere (its points measured what this study's did)
+        # with no run archived yet is held back as well: planned, not finished
+        stands_in = {k[0] for k, p in self.extra.items()
+                     if any(pk[:3] == k[1:4] for pk in self.points) and
+                     measured(max((q for pk, q in self.points.items() if pk[:3] == k[1:4]), key=lambda q: q.N))
+                     <= measured(p)}
+        for k, left in getattr(self, "unfinished", {}).items():
+            key = k[1:4]
+            own = [q.N for pk, q in self.points.items() if pk[:3] == key]
+            if left and k not in self.extra and k[0] in stands_in and own and k[4] > max(own):
+                stand_in = Point(k[1:])
+                stand_in.study = k[0]
+                self.held_back.append((stand_in, left))
         # only the sizes above the one taken were held back in its place
         self.held_back = list({(p.study, p.pairs, p.eps, p.phi, p.N): (p, n) for p, n in self.held_back
                                if p.N > getattr(best.get((p.pairs, p.eps, p.phi)), "N", 0)}.values())
