@@ -39,14 +39,18 @@
 # density's largest N (--largest-n), writes its scratch output (study.h5,
 # figures) to DIR/analysis and restates, row by row, the table of commit
 # 556a0f6 (the N = 4096 table that judged 16 of 53 rows "differs"; taken from
-# git). Writes docs/reproduction.md (with docs/reproduction_findings.md
-# appended), docs/finite_size.md and its figures.
+# git), and sets every row against the table of commit 9a3e6a1 (quick
+# alone, N = 4096 at every density, the last table before --largest-n had
+# larger boxes to take): which verdicts the larger N changed. Writes
+# docs/reproduction.md (with docs/reproduction_findings.md appended),
+# docs/finite_size.md and its figures.
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 usage() { awk 'NR > 1 && !/^#/ { exit } NR > 1 { sub(/^# ?/, ""); print }' "$0"; }
 all=(quick size_standard size_cage cutoff d_size) # quick leads the analysis; the rest are --also
 studies=("${all[@]}")
 before_commit=556a0f6
+n4096_commit=9a3e6a1 # results/quick complete, every density at N = 4096 (no larger N finished yet)
 runs=$root/../runs results=$root/results docs=$root/docs only="" dry=0 analyse_only=0 partial=0 build=1 pass=() fresh=()
 figures=()
 while (($#)); do
@@ -141,6 +145,11 @@ if git -C "$root" cat-file -e "$before_commit:docs/reproduction.md" 2>/dev/null;
   restate=(--restate "$before_commit:docs/reproduction.md")
 else
   echo "reproduce: not a git checkout with commit $before_commit: no row-by-row restatement" >&2
+fi
+if git -C "$root" cat-file -e "$n4096_commit:docs/reproduction.md" 2>/dev/null; then
+  restate+=(--compare "N = 4096 (quick alone)=$n4096_commit:docs/reproduction.md")
+else
+  echo "reproduce: not a git checkout with commit $n4096_commit: no comparison with the N = 4096 table" >&2
 fi
 cd "$root"
 mkdir -p "$docs"

@@ -330,3 +330,4 @@ def test_the_cutoff_rows_keep_this_studys_cutoffs_where_a_larger_n_of_one_cutoff
     A.promote_largest_n()
     assert [(p.phi, p.N) for p in A.series()] == [(0.70, 4096), (0.78, 65536)]
     assert sorted((p.phi, p.N) for p in cutoff_candidates(A)) == [(0.70, 4096), (0.78, 4096)]
+

@@ -90,3 +90,35 @@ def test_how_far_each_step_moved_the_value_in_errors(tmp_path):
     rows = [dict(item="d_f'", ours="1.3 ± 0.2", verdict="agrees (1.2 σ)")]
     text = "\n".join(restate(str(old), rows))
     assert "| d_f' | 0.95 ± 0.09; differs (7.4 σ) | 1.3 ± 0.2; agrees (1.2 σ) | now agrees; error 2.2× the earlier one's | 1.6 |" in text
+
+
+def test_the_comparison_with_the_n_4096_table_lists_what_changed(tmp_path):
+    """analyse_study --compare: every row with a verdict against the same
+    result in another table: changed verdicts, moves of 2 sigma or more under
+    the same verdict, new rows; the rest counted. A joint fit's phi_c in a
+    row's name (it moves with the data) does not make the row new."""
+    from dynhet.analysis.restate import compare
+    ref = tmp_path / "old.md"
+    ref.write_text("| result | paper (section, figure) | paper | ours | verdict | figure | CPU |\n|---|---|---|---|---|---|---|\n"
+                   "| θ | 3.2 | 1.47 | 1.52 ± 0.07 | agrees (0.7 σ) | f | 1 |\n"
+                   "| γχ | 3.4 | 2.5 | 1.13 ± 0.15 | differs (9.1 σ) | f | 1 |\n"
+                   "| ρ with the joint fit's φ_c = 0.8013 | 3.3 | 1.63 | 1.68 ± 0.18 | not judged: χ² | f | 1 |\n"
+                   "| κ | 3.3 | 1.8 | 1.71 ± 0.01 | differs (8 σ) | f | 1 |\n"
+                   "| Q(t) | 3.1 | figure only | 12 | figure | f | 1 |\n"
+                   "| better form | 3.1 | VFT | VFT (χ²/dof 12) | not judged: both | f | 1 |\n")
+    rows = [{"item": "θ", "ours": "1.53 ± 0.03", "verdict": "agrees (1.9 σ)"},
+            {"item": "γχ", "ours": "1.37 ± 0.23", "verdict": "not judged: χ²/dof 9.5"},
+            {"item": "ρ with the joint fit's φ_c = 0.8018", "ours": "1.54 ± 0.2", "verdict": "not judged: χ²"},
+            {"item": "κ", "ours": "1.75 ± 0.01", "verdict": "differs (5 σ)"},
+            {"item": "Q(t)", "ours": "12", "verdict": "figure"},
+            {"item": "better form", "ours": "power law (χ²/dof 9.7)", "verdict": "not judged: both"},
+            {"item": "d_f'", "ours": "1.1 ± 0.1", "verdict": "differs (4.5 σ)"}]
+    out = compare("N = 4096", str(ref), rows)
+    body = [l for l in out if l.startswith("| ") and not l.startswith("| result")]
+    assert [l.split(" | ")[0][2:] for l in body] == ["γχ", "κ", "better form", "d_f'"]
+    assert body[0].endswith("| differs → not judged | 0.9 |")
+    assert body[1].endswith("| same verdict, moved | 2.8 |")
+    assert body[2].endswith("| same verdict, another value | — |")
+    assert "new row" in body[3]
+    assert out[-1] == "1 row changed verdict, 2 rows moved by 2σ or more (or changed, quoting no error) under the same verdict, " \
+                      "2 rows stayed within 2σ under the same verdict, 1 row new."

@@ -134,6 +134,10 @@ def main(argv=None):
     ap.add_argument("--restate-via", action="append", default=[], metavar="LABEL=TABLE",
                     help="a table made between --restate's and this one (repeatable, in order): a column of its "
                          "verdicts, and the change column says at which step each verdict moved")
+    ap.add_argument("--compare", metavar="LABEL=TABLE",
+                    help="another table of the same study design (a file, or COMMIT:PATH), e.g. the one at N = 4096 "
+                         "before --largest-n took the larger boxes: append every row whose verdict changed or whose "
+                         "value moved by 2 or more combined errors against it")
     ap.add_argument("--no-figures", action="store_true",
                     help="the text alone (study.h5 and the tables): no figure is drawn or copied, the documents name "
                          "the figures the same command without it draws (a fraction of the time)")
@@ -153,6 +157,14 @@ def main(argv=None):
         via.append((label, path))
     if via and not a.restate:
         refuse("--restate-via needs --restate (the table the steps start from)")
+    compare = None
+    if a.compare:
+        label, eq, path = a.compare.rpartition("=")
+        if not eq or not label or not path:
+            refuse(f"--compare {a.compare}: give LABEL=TABLE (e.g. \"N = 4096=4096.md\")")
+        if not restate_exists(path):
+            refuse(f"--compare {a.compare}: no such file {path}")
+        compare = (label, path)
     if a.largest_n and not a.also:
         refuse("--largest-n takes the largest N over the --also studies: give at least one")
     for d in [a.study_dir] + a.also:
@@ -235,9 +247,9 @@ def main(argv=None):
     driving_rows(A)
     write_h5(A, os.path.join(A.out, "study.h5"))
     cmd = a.command or "launch_scripts/analyse_study.sh " + " ".join(stated_args(argv if argv is not None else sys.argv[1:]))
-    write_table(A, os.path.join(A.out, "reproduction.md"), cmd, a.discussion, a.restate, via)
+    write_table(A, os.path.join(A.out, "reproduction.md"), cmd, a.discussion, a.restate, via, compare)
     if a.table:
-        write_table(A, a.table, cmd, a.discussion, a.restate, via)
+        write_table(A, a.table, cmd, a.discussion, a.restate, via, compare)
     try:
         densities = write_finite_size(A, os.path.join(A.out, "finite_size.md"), cmd)
         if a.finite_size:

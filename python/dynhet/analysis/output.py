@@ -11,7 +11,7 @@ from .points import MIN_CAL_DOF
 from .quantities import PER_RUN, chi4_at_tau, cut, tau, xi_at_tau
 from .verdicts import fmt
 from .config import A_MAIN, CONVENTIONS, EPS_MAIN, shown_path
-from .restate import restate
+from .restate import compare, restate
 
 
 def write_h5(A, path):
@@ -153,7 +153,7 @@ def cpu_caveat(A):
             + ", and a run started over counts its last start only)")
 
 
-def write_table(A, path, command, discussion=None, restate_from=None, via=()):
+def write_table(A, path, command, discussion=None, restate_from=None, via=(), compare_with=None):
     n_runs = sum(len(p.runs) for p in A.points.values())
     total = sum(A.cpu.values())
     L = ["# The paper from our own runs", "",
@@ -212,6 +212,8 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=()):
                  + " | ".join(cells) + " |")
     if restate_from:
         L += restate(restate_from, A.rows, via)
+    if compare_with:
+        L += compare(*compare_with, A.rows)
     L.append("")
     os.makedirs(os.path.dirname(os.path.abspath(path)), exist_ok=True)
     with open(path + ".tmp", "w") as fh:

@@ -154,3 +154,54 @@ def restate(old_path, rows, via=()):
     out += ["", f"{n['same'] + n['new'] + n['gone']} rows differed; {n['same']} still differ, {n['new']} have another "
             f"verdict now, {n['gone']} have no row now."]
     return out
+
+
+def _held(item):
+    """A row's name with the joint fit's phi_c it holds masked ("ρ with the
+    joint fit's φ_c = 0.8013"): the same result in a table whose joint fit
+    moved."""
+    return re.sub(rf"(joint fit's (?:φ_c = )?){NUM}", r"\1#", item)
+
+
+JUDGED = ("agrees", "differs", "not judged", "not determined", "not comparable")
+
+
+def compare(ref_label, ref_path, rows, label="now"):
+    """Markdown lines: every row of this table against the same result in
+    another table of the same study design (`ref_path`, e.g. the table at
+    N = 4096 before --largest-n took the larger boxes): the rows whose
+    verdict changed, those whose value moved by 2 or more combined errors
+    under the same verdict (or changed, where it quotes no error), and how
+    many stayed. Rows without a verdict
+    ("figure", "—") are not compared."""
+    ref = read_rows(ref_path)
+    ref_by_fit = {_held(k): v for k, v in ref.items()}
+    changed, moved, same, new = [], [], 0, []
+    for r in rows:
+        item, ours, verdict = r["item"], r["ours"], r["verdict"]
+        if kind(verdict) not in JUDGED:
+            continue
+        m = find(item, ref, fuzzy=False) or ref_by_fit.get(_held(item))
+        if m is None:
+            new.append(f"| {item} | — | {short(ours, verdict)} | new row | — |")
+            continue
+        step = shifts([m[0], ours])
+        line = f"| {item} | {short(*m)} | {short(ours, verdict)} | "
+        if kind(m[1]) != kind(verdict):
+            changed.append(line + f"{kind(m[1])} → {kind(verdict)} | {step} |")
+        elif step != "—" and float(step) >= 2:
+            moved.append(line + f"same verdict, moved | {step} |")
+        elif step == "—" and m[0].split(" (")[0] != ours.split(" (")[0]:   # no error to weigh it by
+            moved.append(line + "same verdict, another value | — |")
+        else:
+            same += 1
+    out = ["", f"## Against {ref_label} (`{ref_path}`)", "",
+           f"Every row with a verdict, against the same result in that table ({ref_label}): the rows whose verdict "
+           "changed, those whose value moved by 2 or more combined errors (the last column) under the same verdict "
+           "(or changed, where it quotes no error), and the rows new here. Why each changed is in the findings below.", "",
+           f"| result | {ref_label}: ours; verdict | {label}: ours; verdict | change | moved (σ) |",
+           "|---|---|---|---|---|"] + changed + moved + new
+    rows_ = lambda n: f"{n} row{'' if n == 1 else 's'}"
+    out += ["", f"{rows_(len(changed))} changed verdict, {rows_(len(moved))} moved by 2σ or more (or changed, quoting "
+            f"no error) under the same verdict, {rows_(same)} stayed within 2σ under the same verdict, {rows_(len(new))} new."]
+    return out
