@@ -301,6 +301,9 @@ def test_a_study_of_the_standard_measures_alone_stands_in_and_the_cage_relative_
     assert [(p.phi, p.N) for p in C.series()] == [(0.70, 4096), (0.78, 4096)]
     assert [(p.phi, p.N) for p in series_measuring(A, TAU_CR)] == [(0.70, 4096), (0.78, 4096)]
     assert cr_sizes_note(A).endswith("the largest N that did, φ = 0.78: N = 4096.")
+    for r in A.points[("neighbours", 0.9, 0.78, 4096)].runs:
+        r["has_frames"] = True                            # the snapshots: the largest N with frames
+    assert [(p.phi, p.N) for p in A.series_with(lambda p: any(r.get("has_frames") for r in p.runs))] == [(0.78, 4096)]
     A = analysis()
     for r in A.points[("neighbours", 0.9, 0.78, 4096)].runs:
         r["cut"][0.6]["chi4"] = [1.0]                         # a standard measure the larger N lacks: not taken
@@ -331,3 +334,29 @@ def test_the_cutoff_rows_keep_this_studys_cutoffs_where_a_larger_n_of_one_cutoff
     assert [(p.phi, p.N) for p in A.series()] == [(0.70, 4096), (0.78, 65536)]
     assert sorted((p.phi, p.N) for p in cutoff_candidates(A)) == [(0.70, 4096), (0.78, 4096)]
 
+
+
+def test_the_restitutions_are_set_side_by_side_at_one_box_size(tmp_path):
+    """With --largest-n eps = 0.9 alone had larger boxes at some densities,
+    so phi_c(eps) compared eps = 0.9 at N = 65536 with the others at 4096 (a
+    verdict moved by the box, not by eps). Every eps now at the largest N all ran."""
+    from dynhet.analysis.restitution import restitution_results
+
+    def pt(eps, phi, n, tau):
+        p = Point(("neighbours", eps, phi, n))
+        p.runs = [{"seed": s, "N": n, "cut": {0.6: {"tau_alpha": tau * (1 + 0.01 * s), "tau_alpha_err": 0.1}}}
+                  for s in (1, 2, 3)]
+        return p
+    A = Analysis.__new__(Analysis)
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    A.figdir, A.dir = str(tmp_path), str(tmp_path)
+    for eps in (0.9, 0.8):
+        for phi, tau in ((0.70, 3.0), (0.72, 4.0), (0.74, 6.0), (0.76, 10.0)):
+            p = pt(eps, phi, 4096, tau / eps)
+            A.points[p.pairs, p.eps, p.phi, p.N] = p
+    big = pt(0.9, 0.76, 65536, 5.0)                   # as --largest-n promotes it
+    A.points[big.pairs, big.eps, big.phi, big.N] = big
+    A.promoted = [big]
+    restitution_results(A)
+    row = next(r for r in A.rows if r["item"].startswith("ε = 0.9: φ_c"))
+    assert "sizes:" not in row["note"]                # one box size: N = 4096

@@ -155,7 +155,8 @@ def cluster_results(A, phi_c, phi_c_why=None, joint=None):
     fig, ax = plt.subplots(1, 3, figsize=(16, 5.4))
     shown = []
     for k, phi in enumerate(PHI_SNAP):
-        cands = [p for p in pts if any(r.get("has_frames") for r in p.runs)]
+        # (the largest N with frames: a point --largest-n took may have none)
+        cands = A.series_with(lambda p: any(r.get("has_frames") for r in p.runs))
         p = A.nearest(cands, phi)
         if p is None or p in shown:
             ax[k].set_axis_off()

@@ -29,12 +29,7 @@ def series_measuring(A, fn):
     measured fn. With --largest-n a study of the standard measures alone
     stands in for the series at some densities (Analysis.promote_largest_n);
     the cage-relative and bond-breaking times stay at the N that has them."""
-    best = {}
-    for p in A.points.values():
-        if p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9 and measured(p, fn):
-            if p.phi not in best or p.N > best[p.phi].N:
-                best[p.phi] = p
-    return [best[phi] for phi in sorted(best)]
+    return A.series_with(lambda p: measured(p, fn))
 
 
 def local_phi_results(A):

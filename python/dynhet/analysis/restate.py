@@ -163,7 +163,7 @@ def _held(item):
     return re.sub(rf"(joint fit's (?:φ_c = )?){NUM}", r"\1#", item)
 
 
-JUDGED = ("agrees", "differs", "not judged", "not determined", "not comparable")
+NO_VERDICT = ("figure", "—", "")
 
 
 def compare(ref_label, ref_path, rows, label="now"):
@@ -172,16 +172,17 @@ def compare(ref_label, ref_path, rows, label="now"):
     N = 4096 before --largest-n took the larger boxes): the rows whose
     verdict changed, those whose value moved by 2 or more combined errors
     under the same verdict (or changed, where it quotes no error), and how
-    many stayed. Rows without a verdict
-    ("figure", "—") are not compared."""
+    many stayed. Rows without a verdict in either table ("figure", "—")
+    are not compared."""
     ref = read_rows(ref_path)
     ref_by_fit = {_held(k): v for k, v in ref.items()}
     changed, moved, same, new = [], [], 0, []
     for r in rows:
         item, ours, verdict = r["item"], r["ours"], r["verdict"]
-        if kind(verdict) not in JUDGED:
-            continue
         m = find(item, ref, fuzzy=False) or ref_by_fit.get(_held(item))
+        # a row is compared where either table gives it a verdict ("not resolved" is one)
+        if kind(verdict) in NO_VERDICT and (m is None or kind(m[1]) in NO_VERDICT):
+            continue
         if m is None:
             new.append(f"| {item} | — | {short(ours, verdict)} | new row | — |")
             continue

@@ -279,6 +279,18 @@ class Analysis:
                     by_phi[p.phi] = p
         return [by_phi[phi] for phi in sorted(by_phi)]
 
+    def series_with(self, has, pairs="neighbours", eps=EPS_MAIN):
+        """One point per density of a series: the largest N whose point `has`
+        takes (where --largest-n took a larger N that lacks something, such
+        as the cage-relative measures or the frames, the study's own point
+        still has it)."""
+        by_phi = {}
+        for k, p in self.points.items():
+            if k[0] == pairs and abs(k[1] - eps) < 1e-9 and has(p):
+                if p.phi not in by_phi or p.N > by_phi[p.phi].N:
+                    by_phi[p.phi] = p
+        return [by_phi[phi] for phi in sorted(by_phi)]
+
     def restitutions(self, pairs="neighbours"):
         return sorted({k[1] for k in self.points if k[0] == pairs}, reverse=True)
 
