@@ -360,3 +360,30 @@ def test_the_restitutions_are_set_side_by_side_at_one_box_size(tmp_path):
     restitution_results(A)
     row = next(r for r in A.rows if r["item"].startswith("ε = 0.9: φ_c"))
     assert "sizes:" not in row["note"]                # one box size: N = 4096
+
+
+def test_the_ageing_slope_of_two_seeds_is_not_their_spread_alone(tmp_path):
+    """Two seeds whose tau_alpha(t0) slopes happen to agree (0.004, 0.006)
+    gave 0.005 +- 0.001 and "differs" from 0, while each seed's origins
+    scatter about its line by far more. With fewer than sf.MIN_JK_SEEDS seeds
+    the error is at least the seeds' own errors combined."""
+    import numpy as np
+    from dynhet import fits as sf
+    from dynhet.analysis.overlap import ageing_results
+    A = Analysis.__new__(Analysis)
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    A.figdir, A.dir = str(tmp_path), str(tmp_path)
+    p = Point(("neighbours", 0.9, 0.78, 65536))
+    t0 = np.arange(8) * 1.2 * 14.0
+    wobble = np.array([0.05, -0.04, 0.03, -0.06, 0.04, -0.02, 0.05, -0.03])
+    for seed, slope in ((1, 0.004), (2, 0.006)):
+        tt = 14.0 * (1 + slope * t0 / 14.0 + wobble * (1 if seed == 1 else -1))
+        p.runs.append({"seed": seed, "N": 65536, "cut": {0.6: {"tau_alpha": 14.0, "tau_alpha_err": 0.1,
+                                                               "t0": list(t0), "tau_t0": list(tt)}}})
+    A.points[p.pairs, p.eps, p.phi, p.N] = p
+    ageing_results(A)
+    row = next(r for r in A.rows if r["item"].startswith("τ_α(t0) at φ = 0.78"))
+    own = [sf.slope_with_error(t0 / 14.0, np.asarray(r["cut"][0.6]["tau_t0"]) / 14.0)[1] for r in p.runs]
+    expected = np.hypot(*own) / 2
+    assert row["verdict"].startswith("agrees")
+    assert f"{expected:.2g}" in row["note"] and "over their spread's" in row["note"]

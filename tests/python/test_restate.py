@@ -106,7 +106,8 @@ def test_the_comparison_with_the_n_4096_table_lists_what_changed(tmp_path):
                    "| κ | 3.3 | 1.8 | 1.71 ± 0.01 | differs (8 σ) | f | 1 |\n"
                    "| Q(t) | 3.1 | figure only | 12 | figure | f | 1 |\n"
                    "| better form | 3.1 | VFT | VFT (χ²/dof 12) | not judged: both | f | 1 |\n"
-                   "| φ_c(ε) falls | 3.4 | yes | 0.80, 0.79 | agrees (falls 2.1 σ) | f | 1 |\n")
+                   "| φ_c(ε) falls | 3.4 | yes | 0.80, 0.79 | agrees (falls 2.1 σ) | f | 1 |\n"
+                   "| τ_B against N | — | — | N 4096: 274 ± 2 | drifting: 2.54 ± 1.1 per doubling of N | f | 1 |\n")
     rows = [{"item": "θ", "ours": "1.53 ± 0.03", "verdict": "agrees (1.9 σ)"},
             {"item": "γχ", "ours": "1.37 ± 0.23", "verdict": "not judged: χ²/dof 9.5"},
             {"item": "ρ with the joint fit's φ_c = 0.8018", "ours": "1.54 ± 0.2", "verdict": "not judged: χ²"},
@@ -114,6 +115,7 @@ def test_the_comparison_with_the_n_4096_table_lists_what_changed(tmp_path):
             {"item": "Q(t)", "ours": "12", "verdict": "figure"},
             {"item": "better form", "ours": "power law (χ²/dof 9.7)", "verdict": "not judged: both"},
             {"item": "φ_c(ε) falls", "ours": "0.80, 0.795", "verdict": "not resolved (falls 1.2 σ)"},
+            {"item": "τ_B against N", "ours": "N 4096: 274 ± 2", "verdict": "drifting: 0.67 ± 0.51 per doubling of N"},
             {"item": "d_f'", "ours": "1.1 ± 0.1", "verdict": "differs (4.5 σ)"}]
     out = compare("N = 4096", str(ref), rows)
     body = [l for l in out if l.startswith("| ") and not l.startswith("| result")]
@@ -125,4 +127,4 @@ def test_the_comparison_with_the_n_4096_table_lists_what_changed(tmp_path):
     assert body[2].endswith("| same verdict, another value | — |")
     assert "new row" in body[3]
     assert out[-1] == "2 rows changed verdict, 2 rows moved by 2σ or more (or changed, quoting no error) under the same verdict, " \
-                      "2 rows stayed within 2σ under the same verdict, 1 row new."
+                      "3 rows stayed within 2σ under the same verdict, 1 row new."   # a drift's rate is not its verdict

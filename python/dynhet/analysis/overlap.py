@@ -155,6 +155,14 @@ def ageing_results(A):
                 fits.append(sf.slope_with_error(t0[m] / tm, tt[m] / tm))
         s, se, n = sf.seed_mean([f[0] for f in fits])
         note = f"jackknife over {n} seeds" if n > 1 else ""
+        own = [f[1] for f in fits if np.isfinite(f[0])]
+        if 1 < n < sf.MIN_JK_SEEDS and all(np.isfinite(own)):
+            # two or three seeds: their spread (one or two dof) is not taken alone, as for a
+            # fit (sf.MIN_JK_SEEDS): at least the seeds' own errors (origins about the line) combined
+            own_se = math.sqrt(sum(e * e for e in own)) / n
+            if own_se > se:
+                note += f"; the seeds' own errors combined, {own_se:.2g}, over their spread's {se:.2g}"
+                se = own_se
         if n == 1 and np.isfinite(fits[0][1]):
             # one seed: the error from its origins' scatter about the line
             # (sf.slope_with_error takes it only where the origins lie at least

@@ -52,7 +52,7 @@ def _key(item):
 
 def kind(verdict):
     v = verdict.split(" (")[0].split(";")[0].strip()
-    for k in ("not judged", "not comparable", "not determined"):
+    for k in ("not judged", "not comparable", "not determined", "drifting"):   # (their reasons and rates follow)
         if v.startswith(k):
             return k
     return v
