@@ -442,5 +442,18 @@ def results_readme(results):
         of = f" of {planned}" if planned is not None else ""
         lines.append(f"| `{s}` | {what} | `launch_scripts/run_study.sh studies/{name}.toml` | {n}{of} | {cpu:.2f} "
                      f"(runs and pilots) | {size / 2**20:.1f} MiB |\n")
+    checks = []   # folders of single runs beside the studies, each with a README that says what and how
+    for root, dirs, files in sorted(os.walk(results)):
+        dirs[:] = sorted(x for x in dirs if not is_archive(os.path.join(root, x)))
+        if root != results and "README.md" in files:
+            with open(os.path.join(root, "README.md")) as fh:
+                title = fh.readline().lstrip("# ").strip()
+            size = sum(os.path.getsize(os.path.join(root, f)) for f in files)
+            total += size
+            checks.append(f"- `{os.path.relpath(root, results)}`: {title} ({size / 2**20:.1f} MiB; its README.md says "
+                          "how it was made)\n")
+    if checks:
+        lines.append("\nChecks: single runs beside the studies, each with the scene, the reduced run and how it was made.\n\n")
+        lines += checks
     lines.append(f"\nIn all {total / 2**20:.1f} MiB of entries (the folder is kept under 150 MB).\n")
     return "".join(lines)
