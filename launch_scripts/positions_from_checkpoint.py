@@ -11,20 +11,13 @@ Usage: launch_scripts/positions_from_checkpoint.py RUN OUT.h5
           file gives them; the checkpoint's time, path and sha256 as
           attributes"""
 import argparse
-import hashlib
 import os
 import sys
 
 import h5py
 import numpy as np
 
-
-def sha256_of(path):
-    h = hashlib.sha256()
-    with open(path, "rb") as fh:
-        for block in iter(lambda: fh.read(1 << 20), b""):
-            h.update(block)
-    return h.hexdigest()
+from dynhet.archive import sha256_of
 
 
 def read_checkpoint(path):

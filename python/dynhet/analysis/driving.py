@@ -15,11 +15,7 @@ from .plotting import errorbar
 def driving_results(A):
     """The eps = 0.9 series under both kick-pair rules, side by side."""
     rules = [r for r in ("neighbours", "any") if A.series(pairs=r)]
-    # both rules at one box size (the largest both ran): with --largest-n the neighbour series
-    # alone would take larger boxes, where tau_alpha is shorter at the highest densities
-    sizes = [{k[3] for k in A.points if k[0] == r and abs(k[1] - EPS_MAIN) < 1e-9} for r in rules]
-    common = set.intersection(*sizes) if sizes else set()
-    n_common = max(common) if common else None
+    n_common = A.common_size([(r, EPS_MAIN) for r in rules])   # both rules at one box size
     out = {}
     fig, ax = plt.subplots(figsize=(6, 4.5))
     for rule, col in zip(rules, ("C0", "C3")):

@@ -15,11 +15,7 @@ from .plotting import errorbar
 def restitution_results(A):
     fig, ax = plt.subplots(1, 3, figsize=(16, 4.5))
     eps_list = A.restitutions()
-    # every eps at one box size, the largest all ran (with --largest-n eps = 0.9 alone would
-    # take larger boxes, where tau_alpha is shorter at the highest densities)
-    sizes = [{k[3] for k in A.points if k[0] == "neighbours" and abs(k[1] - e) < 1e-9} for e in eps_list]
-    common_n = set.intersection(*sizes) if sizes else set()
-    n_common = max(common_n) if common_n else None
+    n_common = A.common_size([("neighbours", e) for e in eps_list])   # every eps at one box size
     series = lambda e: A.series(eps=e, N=n_common)
     # phi_c(eps) and phi_0(eps) are compared over the densities every eps has
     ranges = [(min(p.phi for p in series(e)), max(p.phi for p in series(e))) for e in eps_list if series(e)]

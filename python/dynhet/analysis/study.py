@@ -291,6 +291,15 @@ class Analysis:
                     by_phi[p.phi] = p
         return [by_phi[phi] for phi in sorted(by_phi)]
 
+    def common_size(self, series):
+        """The largest N every (pairs, eps) of `series` ran (None if they share
+        none): series set side by side at one box size, where --largest-n
+        would give one of them larger boxes (shorter tau_alpha at the highest
+        densities)."""
+        sizes = [{k[3] for k in self.points if k[0] == pairs and abs(k[1] - eps) < 1e-9} for pairs, eps in series]
+        common = set.intersection(*sizes) if sizes else set()
+        return max(common) if common else None
+
     def restitutions(self, pairs="neighbours"):
         return sorted({k[1] for k in self.points if k[0] == pairs}, reverse=True)
 
