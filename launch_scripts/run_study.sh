@@ -11,6 +11,9 @@
 #   --order shortest   the shortest estimated run first instead: the most
 #                      runs complete and archived by any moment, where the
 #                      machine may be lost before the study ends
+#   --first GLOB       the runs whose names match this shell pattern before
+#                      all others (repeatable, the first pattern's first),
+#                      e.g. --first 'phi0.7900_*_n65536_*'
 #   --executor slurm   one sbatch job array (a task per run) and a dependent
 #                      job that writes the index; --partition, --time, --mem
 #                      and --sbatch=FLAG (repeatable) pass through

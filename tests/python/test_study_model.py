@@ -127,12 +127,26 @@ def test_the_executors_take_the_longest_run_first(tmp_path):
     short = run_order(sd, pts, est, "shortest")
     assert [est[sd.study.run_name(p)] for p in short] == sorted(costs)
     assert [p["seed"] for p in short if p["packing_fraction"] == 0.6] == [1, 2]
+    # --first: the matching runs ahead of all others, pattern by pattern, each
+    # group in the --order; the rest as before
+    names = lambda seq: [sd.study.run_name(p) for p in seq]
+    big = [n for n in names(pts) if "_n1024_" in n]
+    firsts = run_order(sd, pts, est, "shortest", ["*_n1024_*", "phi0.6000_*"])
+    assert names(firsts[:len(big)]) == names(sorted((p for p in pts if "_n1024_" in sd.study.run_name(p)),
+                                                    key=lambda p: est[sd.study.run_name(p)]))
+    rest = firsts[len(big):]
+    assert all(sd.study.run_name(p).startswith("phi0.6000_") for p in rest[:2])
+    assert names(rest[2:]) == [n for n in names(short) if n not in names(firsts[:len(big) + 2])]
+    with pytest.raises(StudyError, match="--first 'phi0.9_\\*' matches none"):
+        run_order(sd, pts, est, "shortest", ["phi0.9_*"])
     # interpolated run lengths need the low densities first, whatever they cost
     sd = StudyDir(study(tmp_path, text.replace('tau_alpha = "pilot"', 'tau_alpha = "interpolate"')),
                   str(tmp_path / "out2"))
     sd.claim()
     order = run_order(sd, sd.study.points(), est)
     assert [p["packing_fraction"] for p in order[:2]] == [0.6, 0.6]
+    with pytest.raises(StudyError, match="interpolates its run lengths"):
+        run_order(sd, sd.study.points(), est, "longest", ["*"])
 
 
 def test_a_size_not_yet_piloted_is_estimated_from_the_pilots_of_the_same_system(tmp_path):

@@ -24,7 +24,7 @@ from .paths import ROOT, SIM
 from .toml_io import toml_dump, write_atomic
 from .model import Study, StudyError
 from .rundir import StudyDir
-from .index import dry_run, plan, write_index
+from .index import dry_run, plan, run_order, write_index
 from .local import analyse, run_local
 from .slurm import run_slurm, task
 
@@ -51,6 +51,10 @@ def main():
                    help="which runs start first: the longest estimated (default: the least wall time on a few "
                         "cores) or the shortest (the most runs complete and archived by any moment, for a "
                         "machine that may be lost before the study ends)")
+    r.add_argument("--first", metavar="GLOB", action="append", default=[],
+                   help="start the runs whose names match this shell pattern before all others (repeatable: "
+                        "the first pattern's runs first), e.g. --first 'phi0.7900_*_n65536_*': the runs a "
+                        "result waits for, ahead of the rest")
     r.add_argument("--archive", metavar="DIR",
                    help="the results archive each complete run is reduced into (default: the study file's "
                         "[study] archive, relative to the repository; none if it names none)")
@@ -93,6 +97,7 @@ def main():
             why = sd.refusal()
             if why and not a.fresh:
                 raise StudyError(why)
+            run_order(sd, [], {}, a.order, a.first)     # refuses a --first that names no run
             if a.dry_run:
                 if why:
                     print(f"# --fresh: what {sd.dir} holds would move into {sd.dir}/old-<time>/")
@@ -107,7 +112,7 @@ def main():
                 print(f"run_study: --fresh: what {sd.dir} held is now in {moved}", flush=True)
             running = True
             if a.executor == "local":
-                return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2), a.order)
+                return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2), a.order, a.first)
             return run_slurm(sd, a)
         sd = StudyDir(Study(os.path.join(a.dir, "study.toml"), os.path.join(a.dir, "base_scene.toml")), a.dir,
                       os.path.abspath(a.to) if getattr(a, "to", None) else None)

@@ -1,10 +1,11 @@
 """The study's index (index.toml), its plan and the dry run."""
+import fnmatch
 import os
 
 from .. import schema
 from ..scene import resolved
 from .toml_io import toml_value, write_atomic
-from .model import AXES
+from .model import AXES, StudyError
 from .estimates import estimate, fmt_time
 from .progress import sim_progress
 from .rundir import read_status
@@ -69,7 +70,7 @@ def run_estimates(sd):
     return {sd.study.run_name(p): estimate(sc, nodes_of(sc))[0] for p, sc, *_ in plan(sd)}
 
 
-def run_order(sd, todo, est, order="longest"):
+def run_order(sd, todo, est, order="longest", first=()):
     """The order the executors take runs in (the local pool, and the Slurm
     array's task indices, which a throttled array starts in order). With
     interpolated run lengths the low densities first (the rest interpolate
@@ -78,11 +79,26 @@ def run_order(sd, todo, est, order="longest"):
     does not start last behind the short ones (longest-processing-time
     first); with order "shortest" the shortest first, so that the most runs
     are complete (and archived) by any moment, where the machine may be
-    lost before the study ends. Equal estimates keep the study's order."""
+    lost before the study ends. Equal estimates keep the study's order.
+    The runs whose names match a pattern of first (shell globs) go before all
+    others, those of the first pattern first (each group in that order):
+    the runs a result waits for, ahead of the rest."""
     if sd.study.run_length["tau_alpha"] == "interpolate":
+        if first:
+            raise StudyError(f"--first: study {sd.study.name} interpolates its run lengths (tau_alpha = "
+                             "\"interpolate\"), so its lower densities must run first; give it no --first")
         return sorted(todo, key=lambda p: p["packing_fraction"])
+    names = [sd.study.run_name(p) for p in sd.study.points()]
+    for pat in first:
+        if not fnmatch.filter(names, pat):
+            raise StudyError(f"--first {pat!r} matches none of study {sd.study.name}'s {len(names)} runs "
+                             f"(names like {names[0]})")
     sign = {"longest": -1.0, "shortest": 1.0}[order]
-    return sorted(todo, key=lambda p: sign * est.get(sd.study.run_name(p), 0.0))
+
+    def group(p):
+        name = sd.study.run_name(p)
+        return next((i for i, pat in enumerate(first) if fnmatch.fnmatchcase(name, pat)), len(first))
+    return sorted(todo, key=lambda p: (group(p), sign * est.get(sd.study.run_name(p), 0.0)))
 
 
 def nodes_of(sc):

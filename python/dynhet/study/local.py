@@ -16,14 +16,14 @@ from .index import run_estimates, run_order, write_index
 from .progress import PROGRESS_EVERY, describe, eta_seconds, sim_progress, study_eta
 
 
-def run_local(sd, jobs, order="longest"):
+def run_local(sd, jobs, order="longest", first=()):
     points = [p for p in sd.study.points()]
     todo = [p for p in points if read_status(sd.run_dir(p)).get("state") != "complete"]
     done0 = len(points) - len(todo)
     if done0:
         print(f"study {sd.study.name}: {done0} of {len(points)} runs complete already (skipped)", flush=True)
     est = run_estimates(sd)
-    todo = run_order(sd, todo, est, order)
+    todo = run_order(sd, todo, est, order, first)
     lock = threading.Lock()
     state = {"done": done0, "failed": 0, "running": 0, "left": len(todo), "cpu_done": 0.0, "est_done": 0.0,
              "active": {}}

@@ -26,7 +26,7 @@ def run_slurm(sd, a):
                 print(f"{sd.study.run_name(p)}: still in Slurm job {st['job']} ({q.stdout.split()[0]})")
                 continue
         todo.append(p)
-    todo = run_order(sd, todo, run_estimates(sd), a.order)
+    todo = run_order(sd, todo, run_estimates(sd), a.order, a.first)
     if not todo:
         print(f"study {sd.study.name}: nothing to submit ({len(points)} runs complete or queued)")
         write_index(sd)
