@@ -4,7 +4,8 @@
 # reproduce.sh refuse such a destination (exit 2, naming what is there and
 # --fresh), leave it byte for byte as it was, and with --fresh move it aside
 # to the place they name, intact. A run that fails at run time exits 1 with
-# its last line said; a run's own directory still resumes.
+# its last line said; a run's own directory still resumes. setup.sh refuses
+# a build that would change the id of a build whose programs are running.
 set -uo pipefail
 root=$1 build=$2
 tmp=$(mktemp -d)
@@ -123,6 +124,34 @@ run "$tmp/a3.out" bash "$root/launch_scripts/analyse_study.sh" "$tmp/st" --table
 check '[[ $rc == 1 ]] && ! grep -q refused "$tmp/a3.out"' "analyse_study: a table it generated is not refused (exit $rc: no complete run)"
 run "$tmp/a4.out" bash "$root/launch_scripts/analyse_study.sh" "$tmp/nostudy"
 check '[[ $rc == 2 ]] && grep -q "not a study directory" "$tmp/a4.out"' "analyse_study: a directory that is not a study is a bad argument (exit $rc)"
+
+# setup.sh on a build directory whose programs run: a build that would change
+# its id is refused (exit 2, the processes named, nothing built), since their
+# checkpoints carry the id and a resume refuses another build's; the same id,
+# or --force, goes on to the build (here a build directory with an empty
+# CMake cache, so the build fails at once: exit 1).
+version=$(sed -n 's/^project(dynhet VERSION \([0-9.]*\).*/\1/p' "$root/CMakeLists.txt")
+mkdir -p "$tmp/b/common" "$tmp/b/bin"
+: >"$tmp/b/CMakeCache.txt"
+cmake -DSRC="$root" -DOUT="$tmp/b/common/build_id.cpp" -DVERSION=0.0.0 -P "$root/common/build_id.cmake"
+cp "$(command -v sleep)" "$tmp/b/bin/sleep"
+"$tmp/b/bin/sleep" 120 &
+busy=$!
+BUILD_DIR=$tmp/b run "$tmp/b1.out" bash "$root/launch_scripts/setup.sh"
+check '[[ $rc == 2 && ! -e $tmp/b.build.log ]] && grep -q "refused: .*$tmp/b is build 0.0.0-" "$tmp/b1.out" &&
+  grep -q "pid $busy: $tmp/b/bin/sleep 120" "$tmp/b1.out"' \
+  "setup: a build that would change the id of a running build is refused (exit $rc), the process named, nothing built"
+BUILD_DIR=$tmp/b run "$tmp/b2.out" bash "$root/launch_scripts/setup.sh" --force
+check '[[ $rc == 1 && -e $tmp/b.build.log ]] && grep -q -- "--force: building" "$tmp/b2.out"' \
+  "setup --force: builds anyway, said (exit $rc: this directory's empty cache)"
+rm -f "$tmp/b.build.log"
+cmake -DSRC="$root" -DOUT="$tmp/b/common/build_id.cpp" -DVERSION="$version" -P "$root/common/build_id.cmake"
+BUILD_DIR=$tmp/b run "$tmp/b3.out" bash "$root/launch_scripts/setup.sh"
+check '[[ $rc == 1 && -e $tmp/b.build.log ]] && ! grep -q refused "$tmp/b3.out"' \
+  "setup: a build that keeps the id of a running build is not refused (exit $rc: this directory's empty cache)"
+kill $busy 2>/dev/null
+BUILD_DIR=$tmp/b run "$tmp/b4.out" bash "$root/launch_scripts/setup.sh" --frobnicate
+check '[[ $rc == 2 ]] && grep -q "unknown argument" "$tmp/b4.out"' "setup: an unknown argument is refused (exit $rc)"
 
 if ((fail)); then
   for f in "$tmp"/*.out; do echo "== $f"; tail -8 "$f"; done
