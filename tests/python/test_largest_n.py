@@ -300,7 +300,22 @@ def test_a_study_of_the_standard_measures_alone_stands_in_and_the_cage_relative_
     C = A.cage_relative_view()
     assert [(p.phi, p.N) for p in C.series()] == [(0.70, 4096), (0.78, 4096)]
     assert [(p.phi, p.N) for p in series_measuring(A, TAU_CR)] == [(0.70, 4096), (0.78, 4096)]
-    assert cr_sizes_note(A).endswith("the largest N that did, φ = 0.78: N = 4096.")
+    assert cr_sizes_note(A).endswith("keeps this study's largest N that has them, φ = 0.78: N = 4096.")
+    # a study of the cage-relative overlap alone (size_cage) run to a larger N: tau_alpha^CR takes it
+    # there, its runs all complete, at this study's densities only; the cage-relative view does not
+    for phi, n, study in ((0.78, 16384, "cage"), (0.80, 16384, "cage"), (0.70, 8192, "cage2")):
+        p = point(phi, n, (1, 2), study)
+        for r in p.runs:
+            r["cut_cr"] = {0.6: {"tau_alpha": 310.0, "tau_alpha_err": 1.0}}
+            r["cut"][0.6].update(tau_cr=310.0, tau_cr_err=1.0)
+        A.extra[(study,) + (p.pairs, p.eps, p.phi, p.N)] = p
+    A.unfinished = {("cage2", "neighbours", 0.9, 0.70, 8192): 1}
+    assert [(p.phi, p.N) for p in series_measuring(A, TAU_CR)] == [(0.70, 4096), (0.78, 16384)]
+    assert [(p.phi, p.N) for p in A.cage_relative_view().series()] == [(0.70, 4096), (0.78, 4096)]
+    assert [(p.phi, p.N) for p in A.series()] == [(0.70, 4096), (0.78, 65536)]   # the standard rows unchanged
+    note = cr_sizes_note(A)
+    assert "take the largest N over the studies read whose runs measured them, φ = 0.78: N = 16384 (cage, 2 seeds)." \
+        in note and note.endswith("keeps this study's largest N that has them, φ = 0.78: N = 4096.")
     for r in A.points[("neighbours", 0.9, 0.78, 4096)].runs:
         r["has_frames"] = True                            # the snapshots: the largest N with frames
     assert [(p.phi, p.N) for p in A.series_with(lambda p: any(r.get("has_frames") for r in p.runs))] == [(0.78, 4096)]

@@ -18,6 +18,7 @@ from .size import Z_CONVERGED, held_back, others_note, points_by_phi_n, size_ver
 from .size_rows import (CHI4P_ROWS, MIN_SHELLS, TAU_ROWS, c_b_times, chi4p_grid, has_cr, kappa_windows, lags_in_tau_cr,
                         missing_cell, quantities, shells_note, tau_b_bound, tau_b_points)
 from .steady import change_dof, steady_verdict, unsteady
+from .steady_runs import steady_section
 from .verdicts import fmt
 
 
@@ -393,6 +394,7 @@ def write_finite_size(A, path, command):
         L += ["", f"Runs (seeds) per N: {seeds}." + (f" Longest lag in units of each run's own measured "
                                                       f"τ_α^CR (a study in units of τ_α^CR sets every N's lags from its pilot's; a run's own τ_α^CR scatters about that, and so does this ratio): {spans}."
                                                       if spans else ""), ""]
+    L += steady_section(A)
     if multi:
         L += spread_section(multi, multi_cr, multi_tb)
         L += ["## Plots", ""]

@@ -297,19 +297,38 @@ def still_drifting(multi, d, d_cr, n_top):
 
 def cr_sizes_note(A):
     """Where a point taken by --largest-n has no cage-relative measures (a
-    study of the standard measures alone): the cage-relative rows' N there."""
+    study of the standard measures alone): the N the cage-relative rows take
+    there. tau_alpha^CR and tau_B in the rows of relaxation times (and
+    their fits against phi) take the largest N over the studies that
+    measured them (local_measures.series_measuring); the cage-relative view
+    (its tau_alpha fits, chi4, S4, clusters) the largest N of this study's
+    points that has them."""
     if not getattr(A, "promoted", None):
         return ""
-    keep = []
+    from .local_measures import TAU_CR, series_measuring
+    local = {p.phi: p for p in series_measuring(A, TAU_CR)}
+    view, times = [], []
     for p in A.promoted:
         if any(A_MAIN in (r.get("cut_cr") or {}) for r in p.runs):
             continue
         own = [q for q in A.points.values() if (q.pairs, q.eps, q.phi) == (p.pairs, p.eps, p.phi)
                and any(A_MAIN in (r.get("cut_cr") or {}) for r in q.runs)]
         if own:
-            keep.append(f"φ = {p.phi:g}: N = {max(q.N for q in own)}")
-    return (" That study measured no cage-relative quantity: the cage-relative rows (and τ_α^CR in the rows "
-            "of relaxation times) keep the largest N that did, " + "; ".join(keep) + ".") if keep else ""
+            view.append(f"φ = {p.phi:g}: N = {max(q.N for q in own)}")
+        if p.phi in local and p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9:
+            q = local[p.phi]
+            times.append(f"φ = {p.phi:g}: N = {q.N}" + (f" ({q.study}, {len(q.runs)} seed{'s' * (len(q.runs) > 1)})"
+                                                       if getattr(q, "study", None) else ""))
+    out = ""
+    if times:
+        out += (" That study measured no cage-relative quantity: τ_α^CR and τ_B in the rows of relaxation times, and "
+                "their fits against φ, take the largest N over the studies read whose runs measured them, "
+                + "; ".join(times) + ".")
+    if view:
+        out += (" The cage-relative view (the rows marked cage-relative: its fits of τ_α, χ4 and ξ, χ4, S4 and the "
+                "clusters, which only this study's runs measured the cage-relative way) keeps this study's largest N "
+                "that has them, " + "; ".join(view) + ".")
+    return out
 
 
 def largest_n_notes(A):

@@ -31,6 +31,14 @@ def run_schedule(path):
         return int(g.attrs["origins"]), float(g.attrs["origin_spacing"])
 
 
+def run_equilibration(path):
+    """The run's equilibration time (parameters/run of run.h5); NaN where it
+    is not recorded."""
+    with h5py.File(path, "r") as f:
+        g = f.get("parameters/run")
+        return float(g.attrs["equilibration_time"]) if g is not None and "equilibration_time" in g.attrs else math.nan
+
+
 def blocks_span(longest_lag, schedule):
     """The nodes' origin_blocks_span: whether jackknife blocks of origins that
     span `longest_lag` fit at least MIN_JACKKNIFE_BLOCKS times into the
@@ -113,6 +121,7 @@ def read_run(path, meta):
         r["N"] = int(meta["n_particles"])
         r["cut"] = read_cutoffs(run)
         r["schedule"] = run_schedule(path)
+        r["t_equil"] = run_equilibration(path)
         # The same of the cage-relative displacements (observables.cage_relative),
         # and their tau_alpha beside the standard one.
         r["cut_cr"] = read_cutoffs(run, cage_relative=True)

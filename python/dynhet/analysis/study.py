@@ -279,13 +279,22 @@ class Analysis:
                     by_phi[p.phi] = p
         return [by_phi[phi] for phi in sorted(by_phi)]
 
-    def series_with(self, has, pairs="neighbours", eps=EPS_MAIN):
+    def series_with(self, has, pairs="neighbours", eps=EPS_MAIN, over_studies=False):
         """One point per density of a series: the largest N whose point `has`
         takes (where --largest-n took a larger N that lacks something, such
         as the cage-relative measures or the frames, the study's own point
-        still has it)."""
+        still has it). over_studies: also the --also studies' points whose
+        runs are all complete, at a density of this study's (a quantity one
+        of them measures to larger N than the study that stands in for the
+        paper's rows, such as tau_alpha^CR in studies/size_cage.toml); at
+        equal N this study's point stays."""
+        own_phi = {k[2] for k in self.points if k[0] == pairs and abs(k[1] - eps) < 1e-9}
+        cands = list(self.points.items())
+        if over_studies:
+            unfinished = getattr(self, "unfinished", {})
+            cands += [(k[1:], p) for k, p in self.extra.items() if not unfinished.get(k) and k[3] in own_phi]
         by_phi = {}
-        for k, p in self.points.items():
+        for k, p in cands:
             if k[0] == pairs and abs(k[1] - eps) < 1e-9 and has(p):
                 if p.phi not in by_phi or p.N > by_phi[p.phi].N:
                     by_phi[p.phi] = p
