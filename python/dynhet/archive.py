@@ -429,6 +429,30 @@ def study_summary(d):
         planned, cpu, size
 
 
+def check_provenance(root, files):
+    """What a check's reduced run (run.h5.gz) records of how it was made:
+    its command and its CPU (or wall) seconds."""
+    import gzip
+    import tempfile
+    if "run.h5.gz" not in files:
+        return []
+    try:
+        with tempfile.NamedTemporaryFile(suffix=".h5") as tmp:
+            with gzip.open(os.path.join(root, "run.h5.gz"), "rb") as fh:
+                tmp.write(fh.read())
+            tmp.flush()
+            with h5py.File(tmp.name, "r") as f:
+                a = dict(f["provenance"].attrs) if "provenance" in f else {}
+    except OSError as e:
+        return [f"run.h5.gz not readable: {e}"]
+    out = [f"command `{a['command']}`"] if "command" in a else []
+    if "cpu_s" in a:
+        out.append(f"{float(a['cpu_s']) / 3600:.2f} CPU-hours")
+    elif "wall_s" in a:
+        out.append(f"{float(a['wall_s']) / 3600:.2f} hours of wall time, CPU not recorded")
+    return out
+
+
 def results_readme(results):
     """The text of results/README.md: one line per archived study."""
     lines = [README_HEAD]
@@ -450,8 +474,9 @@ def results_readme(results):
                 title = fh.readline().lstrip("# ").strip()
             size = sum(os.path.getsize(os.path.join(root, f)) for f in files)
             total += size
-            checks.append(f"- `{os.path.relpath(root, results)}`: {title} ({size / 2**20:.1f} MiB; its README.md says "
-                          "how it was made)\n")
+            checks.append(f"- `{os.path.relpath(root, results)}`: {title} ({size / 2**10:.0f} KiB"
+                          + "".join(f"; {x}" for x in check_provenance(root, files))
+                          + "; its README.md says how it was made)\n")
     if checks:
         lines.append("\nChecks: single runs beside the studies, each with the scene, the reduced run and how it was made.\n\n")
         lines += checks
