@@ -51,3 +51,21 @@ def test_the_section_counts_every_run_and_takes_tau_cr_where_the_run_has_none():
     assert "τ_α^CR(t0): 0 steady, 0 not steady, 2 not judged" in L and "Equilibration 5 to 5 τ_α^CR" in L
     rows = [l for l in L.splitlines() if l.startswith("| big")]
     assert len(rows) == 1 and "| 10 † |" in rows[0]   # 600 over the 4096 runs' tau_alpha^CR of 60
+
+
+def test_the_same_system_after_two_equilibration_times_is_set_side_by_side():
+    A = Analysis.__new__(Analysis)
+    A.points, A.extra, A.cpu = {}, {}, {}
+    p = Point(("neighbours", 0.9, 0.8, 4096))
+    p.runs = [run(s, 0.0, 0.02, tau=t, t_equil=3000.0) for s, t in ((1, 200.0), (2, 300.0))]
+    A.points[p.pairs, p.eps, p.phi, p.N] = p
+    q = Point(("neighbours", 0.9, 0.8, 4096))
+    q.study = "long"
+    q.runs = [run(s, 0.0, 0.02, tau=t, t_equil=9000.0) for s, t in ((1, 300.0), (2, 400.0))]
+    for r in q.runs:
+        r["study"] = "long"
+    A.extra[("long",) + (q.pairs, q.eps, q.phi, q.N)] = q
+    L = "\n".join(steady_section(A))
+    # means 250 and 350, each with a standard error of 50: +40%, 100 / (50 sqrt 2) = 1.4 errors
+    assert ("- φ = 0.8, N = 4096: τ_α 250 ± 50 after 3000 (this study, 2 runs); 350 ± 50 after 9000 (long, 2 runs): "
+            "+40% from the shortest to the longest, 1.4 of their combined errors.") in L
