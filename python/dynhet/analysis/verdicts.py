@@ -42,6 +42,9 @@ def fit_verdict(f, name, paper, transform=lambda v: v):
     v, e = transform(f.p[name]), f.error(name)
     if np.isfinite(e) and np.isfinite(v) and e > abs(v):
         return f"not judged: its error exceeds its value (the points do not determine it)"
+    if np.isfinite(e) and paper != 0 and e > abs(paper):
+        # within 2 errors of the paper then says nothing: the same error would "agree" with 0 or twice it
+        return "not judged: its error exceeds the paper's value (the comparison could not tell it from 0)"
     return verdict(v, e, paper)
 
 
