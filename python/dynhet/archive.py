@@ -445,7 +445,8 @@ def check_provenance(root, files):
                 a = dict(f["provenance"].attrs) if "provenance" in f else {}
     except OSError as e:
         return [f"run.h5.gz not readable: {e}"]
-    out = [f"command `{a['command']}`"] if "command" in a else []
+    out = [f"run.h5.gz sha256 {sha256_of(os.path.join(root, 'run.h5.gz'))[:16]}…"]
+    out += [f"command `{a['command']}`"] if "command" in a else []
     if "cpu_s" in a:
         out.append(f"{float(a['cpu_s']) / 3600:.2f} CPU-hours")
     elif "wall_s" in a:

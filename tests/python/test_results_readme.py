@@ -18,7 +18,9 @@ def test_a_check_beside_the_studies_is_listed_with_its_title_and_size(tmp_path):
     (tmp_path / "checks" / "notes.txt").write_text("a folder without a README is not a check\n")
     text = results_readme(str(tmp_path))
     kib = sum(f.stat().st_size for f in d.iterdir()) / 1024
-    assert (f"- `checks/cr_big`: Cage-relative relaxation at N = 262144 ({kib:.0f} KiB; command "
+    import hashlib
+    sha = hashlib.sha256((d / "run.h5.gz").read_bytes()).hexdigest()[:16]
+    assert (f"- `checks/cr_big`: Cage-relative relaxation at N = 262144 ({kib:.0f} KiB; run.h5.gz sha256 {sha}…; command "
             "`launch_scripts/run_scene.sh scene.toml`; 2.00 CPU-hours; its README.md says how it was made)") in text
     assert f"In all {kib / 1024:.1f} MiB of entries" in text and kib > 2800
     assert text.count("\n- `") == 1
