@@ -178,6 +178,35 @@ def test_the_finite_size_table_holds_back_a_size_the_leading_protocol_has_not_fi
     assert sorted(points_by_phi_n(A)[0.76]) == [1024, 4096, 16384, 65536, 1000000]
 
 
+def test_a_study_of_the_overlap_and_msd_alone_does_not_lead_the_tables_of_every_measure():
+    """phi 0.76: d_size (overlap and MSD, one seed, N 4096 to 10^6) plans more
+    sizes than size_standard (every standard measure, N 4096 to 262144).
+    The finite-size table of every measure (and the promotion, which waits
+    for the leading protocol) takes size_standard's sizes; D against N
+    (lead_by "n") takes d_size's."""
+    from dynhet.analysis.size import points_by_phi_n
+    A = Analysis.__new__(Analysis)
+    A.points, A.extra, A.cpu, A.unfinished = {}, {}, {}, {}
+    A.protocols = {"size_standard": ("tau_alpha", 20.0), "d_size": ("tau_alpha", 5.0)}
+    for n in (4096, 16384, 65536, 262144):
+        p = point(0.76, n, (1, 2), "size_standard")
+        for r in p.runs:
+            r["cut"][0.6]["chi4"] = [1.0]
+        A.extra[("size_standard",) + (p.pairs, p.eps, p.phi, p.N)] = p
+    for n in (4096, 16384, 65536):
+        p = point(0.76, n, (1,), "d_size")
+        A.extra[("d_size",) + (p.pairs, p.eps, p.phi, p.N)] = p
+    A.unfinished = {("d_size", "neighbours", 0.9, 0.76, 262144): 1, ("d_size", "neighbours", 0.9, 0.76, 1000000): 1}
+    assert sorted(points_by_phi_n(A)[0.76]) == [4096, 16384, 65536, 262144]
+    assert {p.study for p in points_by_phi_n(A)[0.76].values()} == {"size_standard"}
+    assert {p.study for p in points_by_phi_n(A, lead_by="n")[0.76].values()} == {"d_size"}
+    q = point(0.76, 4096, (1, 2, 3))
+    for r in q.runs:
+        r["cut"][0.6]["chi4"] = [1.0]
+    A.points[(q.pairs, q.eps, q.phi, q.N)] = q
+    assert [(p.N, p.study) for p in A.promote_largest_n()] == [(262144, "size_standard")]
+
+
 def test_the_per_point_table_says_which_study_and_which_point_the_rows_take():
     """A referee's point: phi 0.8 at N 4096 read 256 in the per-point table
     (quick_cr) and 327 in finite_size.md (scale), with no word of which is which."""

@@ -46,7 +46,9 @@ def leading_protocol(A, phi, ps, lead_by="cr", planned_too=False):
     planned_sizes); among as many, with lead_by "cr" the one with the
     cage-relative measures (studies/size_cage.toml: run lengths in units of
     tau_alpha^CR), with "n" the one reaching the largest N (D against N:
-    studies/d_size.toml to 10^6); then the most runs. Among the protocols
+    studies/d_size.toml to 10^6); then the most runs. With "cr" a protocol
+    that measured neither chi4 nor the cage-relative overlap (d_size) leads
+    only where no other ran. Among the protocols
     with points in ps, or (planned_too) with sizes planned at phi at all."""
     planned = planned_sizes(A, ps).get(phi, {})
     studies = {}
@@ -57,7 +59,13 @@ def leading_protocol(A, phi, ps, lead_by="cr", planned_too=False):
         own = [p for p in ps if study_of(p) in studies[pr]]
         sizes = set().union(*(planned.get(st, set()) for st in studies[pr])) | {p.N for p in own}
         cr = any(A_MAIN in (r.get("cut_cr") or {}) for p in own for r in p.runs)
-        return (len(sizes), cr if lead_by == "cr" else max(sizes), sum(len(p.runs) for p in own), str(pr))
+        # the tables of every measure: a protocol of the overlap and the MSD alone (d_size, for
+        # D against N) does not lead them, whatever its sizes, where one measured chi4 or the
+        # cage-relative overlap
+        rich = cr or any("chi4" in r["cut"].get(A_MAIN, {}) for p in own for r in p.runs)
+        if lead_by == "cr":
+            return (rich, len(sizes), cr, sum(len(p.runs) for p in own), str(pr))
+        return (len(sizes), max(sizes), sum(len(p.runs) for p in own), str(pr))
     with_points = [pr for pr in studies if any(study_of(p) in studies[pr] for p in ps)]
     return max(with_points if with_points and not planned_too else studies, key=key)
 
