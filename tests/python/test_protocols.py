@@ -39,10 +39,12 @@ def test_a_tie_at_one_n_goes_to_the_study_that_runs_the_density_at_every_n():
 
 
 def protocol_point(study, n, seeds=1, cr=False, phi=0.76):
-    """A point of `study` at (phi, N) with `seeds` runs (cage-relative measures with cr)."""
+    """A point of `study` at (phi, N) with `seeds` runs (cage-relative measures
+    with cr); every study but d_size (the overlap and the MSD alone) measured chi4."""
     p = Point(("neighbours", 0.9, phi, n))
     p.study = study
-    p.runs = [{"seed": s, "N": n, "study": study, **({"cut_cr": {0.6: {}}} if cr else {})}
+    chi4 = {} if study == "d_size" else {"cut": {0.6: {"chi4": [1.0]}}}
+    p.runs = [{"seed": s, "N": n, "study": study, **chi4, **({"cut_cr": {0.6: {}}} if cr else {})}
               for s in range(1, seeds + 1)]
     return p
 

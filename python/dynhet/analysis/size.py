@@ -62,7 +62,7 @@ def leading_protocol(A, phi, ps, lead_by="cr", planned_too=False):
         # the tables of every measure: a protocol of the overlap and the MSD alone (d_size, for
         # D against N) does not lead them, whatever its sizes, where one measured chi4 or the
         # cage-relative overlap
-        rich = cr or any("chi4" in r["cut"].get(A_MAIN, {}) for p in own for r in p.runs)
+        rich = cr or any("chi4" in (r.get("cut") or {}).get(A_MAIN, {}) for p in own for r in p.runs)
         if lead_by == "cr":
             return (rich, len(sizes), cr, sum(len(p.runs) for p in own), str(pr))
         return (len(sizes), max(sizes), sum(len(p.runs) for p in own), str(pr))
