@@ -9,7 +9,9 @@
 # another's, so the running sims could no longer resume from what they
 # write. The refusal names them. Build into another BUILD_DIR, or let them
 # finish; --force builds anyway (they resume then only with a build of
-# their own commit, which gives the same id again).
+# their own commit, which gives the same id again). Runs interrupted
+# earlier, or queued on Slurm, are not seen here: they too resume only with
+# their own build.
 set -euo pipefail
 force=0
 case ${1:-} in
@@ -28,7 +30,7 @@ running_from() {
   for exe in /proc/[0-9]*/exe; do
     pid=${exe#/proc/}; pid=${pid%/exe}
     [[ $(readlink "$exe" 2>/dev/null) == "$dir"/* ]] || continue
-    echo "  pid $pid: $(tr '\0' ' ' <"/proc/$pid/cmdline" 2>/dev/null | cut -c1-160)"
+    echo "  pid $pid: $({ tr '\0' ' ' <"/proc/$pid/cmdline"; } 2>/dev/null | cut -c1-160)"
   done
 }
 
@@ -56,7 +58,8 @@ $procs
 Building there now would make it build $new. Their checkpoints carry the
 old id, and a resume refuses another build's, so they could not resume from
 what they write. Build into another directory (BUILD_DIR=<dir> $0),
-or let them finish (or stop them and resume them first); --force builds anyway.
+or let them finish (or stop them and resume them first); \`$0 --force\`
+builds anyway (then run_scene.sh, run_study.sh or reproduce.sh with --no-build).
 MSG
   exit 2
 }

@@ -434,6 +434,7 @@ def check_provenance(root, files):
     its command and its CPU (or wall) seconds."""
     import gzip
     import tempfile
+    import zlib
     if "run.h5.gz" not in files:
         return []
     try:
@@ -443,7 +444,7 @@ def check_provenance(root, files):
             tmp.flush()
             with h5py.File(tmp.name, "r") as f:
                 a = dict(f["provenance"].attrs) if "provenance" in f else {}
-    except OSError as e:
+    except (OSError, EOFError, zlib.error) as e:   # not gzip, cut short, corrupt
         return [f"run.h5.gz not readable: {e}"]
     out = [f"run.h5.gz sha256 {sha256_of(os.path.join(root, 'run.h5.gz'))[:16]}…"]
     out += [f"command `{a['command']}`"] if "command" in a else []

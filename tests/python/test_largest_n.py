@@ -330,6 +330,7 @@ def test_a_study_of_the_standard_measures_alone_stands_in_and_the_cage_relative_
     assert [(p.phi, p.N) for p in C.series()] == [(0.70, 4096), (0.78, 4096)]
     assert [(p.phi, p.N) for p in series_measuring(A, TAU_CR)] == [(0.70, 4096), (0.78, 4096)]
     assert cr_sizes_note(A).endswith("keeps this study's largest N that has them, φ = 0.78: N = 4096.")
+    assert "τ_α^CR and τ_B" not in cr_sizes_note(A)          # both at this study's points: nothing to say
     # a study of the cage-relative overlap alone (size_cage) run to a larger N: tau_alpha^CR takes it
     # there, its runs all complete, at this study's densities only; the cage-relative view does not
     for phi, n, study in ((0.78, 16384, "cage"), (0.80, 16384, "cage"), (0.70, 8192, "cage2")):
@@ -343,8 +344,12 @@ def test_a_study_of_the_standard_measures_alone_stands_in_and_the_cage_relative_
     assert [(p.phi, p.N) for p in A.cage_relative_view().series()] == [(0.70, 4096), (0.78, 4096)]
     assert [(p.phi, p.N) for p in A.series()] == [(0.70, 4096), (0.78, 65536)]   # the standard rows unchanged
     note = cr_sizes_note(A)
-    assert "take the largest N over the studies read whose runs measured them, φ = 0.78: N = 16384 (cage, 2 seeds)." \
-        in note and note.endswith("keeps this study's largest N that has them, φ = 0.78: N = 4096.")
+    assert ("take the largest N over the studies read whose runs measured them, where that is another study's: "
+            "φ = 0.78: N = 16384 (cage, 2 seeds).") in note
+    assert note.endswith("keeps this study's largest N that has them, φ = 0.78: N = 4096.")
+    # without --largest-n (no promotion asked for) every row keeps this study's points
+    del A.promoted
+    assert [(p.phi, p.N) for p in series_measuring(A, TAU_CR)] == [(0.70, 4096), (0.78, 4096)]
     for r in A.points[("neighbours", 0.9, 0.78, 4096)].runs:
         r["has_frames"] = True                            # the snapshots: the largest N with frames
     assert [(p.phi, p.N) for p in A.series_with(lambda p: any(r.get("has_frames") for r in p.runs))] == [(0.78, 4096)]

@@ -28,11 +28,12 @@ def series_measuring(A, fn):
     """One point per density of the main series: the largest N whose runs
     measured fn. With --largest-n a study of the standard measures alone
     stands in for the series at some densities (Analysis.promote_largest_n);
-    the cage-relative and bond-breaking times take the largest N over every
-    study read whose runs measured them and are all complete (a study of
+    then (--largest-n) the cage-relative and bond-breaking times take the
+    largest N over every study read whose runs measured them and are all
+    complete (a study of
     those measures alone, studies/size_cage.toml, runs them to larger N
     than the study of the paper's rows)."""
-    return A.series_with(lambda p: measured(p, fn), over_studies=fn is not tau)
+    return A.series_with(lambda p: measured(p, fn), over_studies=fn is not tau and hasattr(A, "promoted"))
 
 
 def local_phi_results(A):

@@ -177,8 +177,8 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=(), co
               + "; ".join(f"φ = {p.phi:g} ({p.pairs}, ε = {p.eps:g}): N = {p.N}, study {p.study}, "
                           f"{len(p.runs)} seed{'s' if len(p.runs) > 1 else ''}" for p in A.promoted)
               + ". The other densities are this study's." + cr_sizes_note(A) + largest_n_notes(A), ""]
-    elif getattr(A, "held_back", None):
-        L += ["**At the largest N** (`--largest-n`): no larger N taken." + largest_n_notes(A), ""]
+    elif getattr(A, "held_back", None) or cr_sizes_note(A):
+        L += ["**At the largest N** (`--largest-n`): no larger N taken." + cr_sizes_note(A) + largest_n_notes(A), ""]
     if A.skipped:
         L += [f"Left out: {len(A.skipped)} runs not complete ({', '.join(sorted({s for _, s in A.skipped}))}).", ""]
     L += ["| result | paper (section, figure) | paper | ours | verdict | figure | CPU |", "|---|---|---|---|---|---|---|"]
@@ -296,18 +296,33 @@ def still_drifting(multi, d, d_cr, n_top):
 
 
 def cr_sizes_note(A):
-    """Where a point taken by --largest-n has no cage-relative measures (a
-    study of the standard measures alone): the N the cage-relative rows take
-    there. tau_alpha^CR and tau_B in the rows of relaxation times (and
-    their fits against phi) take the largest N over the studies that
-    measured them (local_measures.series_measuring); the cage-relative view
-    (its tau_alpha fits, chi4, S4, clusters) the largest N of this study's
-    points that has them."""
-    if not getattr(A, "promoted", None):
+    """With --largest-n: the N the cage-relative rows take. tau_alpha^CR and
+    tau_B in the rows of relaxation times (and their fits against phi) take
+    the largest N over the studies that measured them
+    (local_measures.series_measuring), said wherever that is another
+    study's point; the cage-relative view (its tau_alpha fits, chi4, S4,
+    clusters) keeps the largest N of this study's points that has them,
+    said where a promoted point has no cage-relative measures."""
+    if not hasattr(A, "promoted"):
         return ""
-    from .local_measures import TAU_CR, series_measuring
-    local = {p.phi: p for p in series_measuring(A, TAU_CR)}
-    view, times = [], []
+    from .local_measures import TAU_B, TAU_CR, series_measuring
+    cr_at = {p.phi: p for p in series_measuring(A, TAU_CR)}
+    b_at = {p.phi: p for p in series_measuring(A, TAU_B)}
+
+    def where(q):
+        return f"N = {q.N}" + (f" ({q.study}, {len(q.runs)} seed{'s' * (len(q.runs) > 1)})"
+                               if getattr(q, "study", None) else " (this study's)")
+    times = []
+    for phi in sorted(set(cr_at) | set(b_at)):
+        c, b = cr_at.get(phi), b_at.get(phi)
+        if not any(getattr(q, "study", None) for q in (c, b) if q is not None):
+            continue
+        if c is not None and (b is None or b is c):
+            times.append(f"φ = {phi:g}: {where(c)}")
+        else:
+            times.append(f"φ = {phi:g}: " + "; ".join(f"{name} {where(q)}" for name, q in (("τ_α^CR", c), ("τ_B", b))
+                                                      if q is not None))
+    view = []
     for p in A.promoted:
         if any(A_MAIN in (r.get("cut_cr") or {}) for r in p.runs):
             continue
@@ -315,19 +330,14 @@ def cr_sizes_note(A):
                and any(A_MAIN in (r.get("cut_cr") or {}) for r in q.runs)]
         if own:
             view.append(f"φ = {p.phi:g}: N = {max(q.N for q in own)}")
-        if p.phi in local and p.pairs == "neighbours" and abs(p.eps - EPS_MAIN) < 1e-9:
-            q = local[p.phi]
-            times.append(f"φ = {p.phi:g}: N = {q.N}" + (f" ({q.study}, {len(q.runs)} seed{'s' * (len(q.runs) > 1)})"
-                                                       if getattr(q, "study", None) else ""))
     out = ""
     if times:
-        out += (" That study measured no cage-relative quantity: τ_α^CR and τ_B in the rows of relaxation times, and "
-                "their fits against φ, take the largest N over the studies read whose runs measured them, "
-                + "; ".join(times) + ".")
+        out += (" τ_α^CR and τ_B in the rows of relaxation times, and their fits against φ, take the largest N over "
+                "the studies read whose runs measured them, where that is another study's: " + "; ".join(times) + ".")
     if view:
-        out += (" The cage-relative view (the rows marked cage-relative: its fits of τ_α, χ4 and ξ, χ4, S4 and the "
-                "clusters, which only this study's runs measured the cage-relative way) keeps this study's largest N "
-                "that has them, " + "; ".join(view) + ".")
+        out += (" A study taken above measured no cage-relative quantity: the cage-relative view (the rows marked "
+                "cage-relative: its fits of τ_α, χ4 and ξ, χ4, S4 and the clusters, which only this study's runs "
+                "measured the cage-relative way) keeps this study's largest N that has them, " + "; ".join(view) + ".")
     return out
 
 

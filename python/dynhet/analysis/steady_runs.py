@@ -16,13 +16,20 @@ from .steady import steady_limit
 from .verdicts import fmt
 
 
+def std_cut(r):
+    """The run's standard results at the main cutoff ({} where it has none)."""
+    return (r.get("cut") or {}).get(A_MAIN, {})
+
+
 def run_change(r, cr):
     """(change in % of tau_alpha, its error, its dof, the verdict): "steady",
     "not steady", or why it cannot be judged."""
     try:
+        if not cutx(r, cr).get("tau_alpha", math.nan) > 0:
+            return math.nan, math.nan, None, "not judged: no τ_α"
         v, e = production_change(r, cr)
         k = int(np.isfinite(np.asarray(cutx(r, cr)["tau_t0"], float)).sum()) - 2
-    except (KeyError, TypeError, ValueError):
+    except (KeyError, TypeError, ValueError, IndexError):
         return math.nan, math.nan, None, "not measured"
     if not np.isfinite(v):
         return v, e, None, "not judged: fewer than 3 origins"
@@ -68,7 +75,7 @@ def across_protocols(rows):
     Lines only; no verdict beyond the number of errors."""
     groups = {}
     for study, p, r, _, t_eq, _, _, _ in rows:
-        tau = cutx(r, False).get("tau_alpha", math.nan)
+        tau = std_cut(r).get("tau_alpha", math.nan)
         if np.isfinite(t_eq) and np.isfinite(tau):
             sys_ = (p.pairs, p.eps, p.phi, p.N)
             groups.setdefault(sys_, {}).setdefault((round(t_eq, 1), study), []).append(tau)
@@ -110,7 +117,7 @@ def steady_section(A):
         own = own if np.isfinite(own) and own > 0 else math.nan
         unit = own if np.isfinite(own) else ref.get((p.pairs, p.eps, p.phi), math.nan)
         t_eq = float(r.get("t_equil", math.nan))
-        tau = cutx(r, False).get("tau_alpha", math.nan)
+        tau = std_cut(r).get("tau_alpha", math.nan)
         sched = r.get("schedule")
         prod = (sched[0] - 1) * sched[1] / tau if sched and np.isfinite(tau) and tau > 0 else math.nan
         s = per_study.setdefault(study, {"runs": 0, "eq": [], "std": {}, "cr": {}})
@@ -158,8 +165,9 @@ def steady_section(A):
         cells = [change_cell(v, e, why) for v, e, _, why in changes]
         eq = (f"{t_eq / unit:.3g}" + ("" if np.isfinite(own) else " †")
               if np.isfinite(t_eq) and np.isfinite(unit) and unit > 0 else "—")
-        tau = cutx(r, False).get("tau_alpha", math.nan)
-        L.append(f"| {study} | {p.pairs} | {p.eps:g} | {p.phi:g} | {p.N} | {r.get('seed', '—')} | {t_eq:.4g} | {eq} | "
-                 f"{tau:.3g} | {prod:.3g} | {cells[0]} | {cells[1]} |")
+        tau = std_cut(r).get("tau_alpha", math.nan)
+        num = lambda x, f: format(x, f) if np.isfinite(x) else "—"
+        L.append(f"| {study} | {p.pairs} | {p.eps:g} | {p.phi:g} | {p.N} | {r.get('seed', '—')} | {num(t_eq, '.4g')} | "
+                 f"{eq} | {num(tau, '.3g')} | {num(prod, '.3g')} | {cells[0]} | {cells[1]} |")
     L.append("")
     return L

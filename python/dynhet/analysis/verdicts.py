@@ -42,8 +42,9 @@ def fit_verdict(f, name, paper, transform=lambda v: v):
     v, e = transform(f.p[name]), f.error(name)
     if np.isfinite(e) and np.isfinite(v) and e > abs(v):
         return f"not judged: its error exceeds its value (the points do not determine it)"
-    if np.isfinite(e) and paper != 0 and e > abs(paper):
+    if np.isfinite(e) and paper != 0 and e > abs(paper) and abs(v - paper) <= 2 * e:
         # within 2 errors of the paper then says nothing: the same error would "agree" with 0 or twice it
+        # (a value beyond 2 such errors still differs)
         return "not judged: its error exceeds the paper's value (the comparison could not tell it from 0)"
     return verdict(v, e, paper)
 
