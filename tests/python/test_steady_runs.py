@@ -68,4 +68,4 @@ def test_the_same_system_after_two_equilibration_times_is_set_side_by_side():
     L = "\n".join(steady_section(A))
     # means 250 and 350, each with a standard error of 50: +40%, 100 / (50 sqrt 2) = 1.4 errors
     assert ("- φ = 0.8, N = 4096: τ_α 250 ± 50 after 3000 (this study, 2 runs); 350 ± 50 after 9000 (long, 2 runs): "
-            "+40% from the shortest to the longest, 1.4 of their combined errors.") in L
+            "+40% from the shortest to the longest, 1.4 of their combined errors (2 dof).") in L

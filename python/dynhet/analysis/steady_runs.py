@@ -90,8 +90,10 @@ def across_protocols(rows):
             stats.append((t, study, m, se, len(taus)))
         lo, hi = stats[0], stats[-1]
         d, e = hi[2] - lo[2], math.hypot(hi[3], lo[3])
+        # Welch-Satterthwaite: two means of 2 or 3 seeds each leave an error known to a few dof only
+        dof = e ** 4 / sum(x[3] ** 4 / (x[4] - 1) for x in (lo, hi)) if np.isfinite(e) and e > 0 else math.nan
         change = (f": {100 * d / lo[2]:+.0f}% from the shortest to the longest"
-                  + (f", {abs(d) / e:.1f} of their combined errors" if np.isfinite(e) and e > 0 else
+                  + (f", {abs(d) / e:.1f} of their combined errors ({dof:.2g} dof)" if np.isfinite(e) and e > 0 else
                      " (one run at one of them: no error)"))
         cells = "; ".join(f"{m:.3g}" + (f" ± {se:.2g}" if np.isfinite(se) else "") + f" after {t:.4g} ({study}, "
                           f"{k} run{'s' * (k > 1)})" for t, study, m, se, k in stats)
