@@ -431,22 +431,18 @@ def study_summary(d):
 
 def check_provenance(root, files):
     """What a check's reduced run (run.h5.gz) records of how it was made:
-    its command and its CPU (or wall) seconds."""
-    import gzip
-    import tempfile
+    its hash, its command and its CPU (or wall) seconds."""
     import zlib
     if "run.h5.gz" not in files:
         return []
+    p = os.path.join(root, "run.h5.gz")
+    digest = sha256_of(p)
     try:
-        with tempfile.NamedTemporaryFile(suffix=".h5") as tmp:
-            with gzip.open(os.path.join(root, "run.h5.gz"), "rb") as fh:
-                tmp.write(fh.read())
-            tmp.flush()
-            with h5py.File(tmp.name, "r") as f:
-                a = dict(f["provenance"].attrs) if "provenance" in f else {}
+        with h5py.File(readable(p, digest), "r") as f:
+            a = dict(f["provenance"].attrs) if "provenance" in f else {}
     except (OSError, EOFError, zlib.error) as e:   # not gzip, cut short, corrupt
         return [f"run.h5.gz not readable: {e}"]
-    out = [f"run.h5.gz sha256 {sha256_of(os.path.join(root, 'run.h5.gz'))[:16]}…"]
+    out = [f"run.h5.gz sha256 {digest[:16]}…"]
     out += [f"command `{a['command']}`"] if "command" in a else []
     if "cpu_s" in a:
         out.append(f"{float(a['cpu_s']) / 3600:.2f} CPU-hours")

@@ -56,12 +56,12 @@ def test_a_tau_b_error_whose_blocks_cannot_span_it_is_dropped_on_reading(tmp_pat
     the node did: 8 origins 263.7 apart allow blocks of 2 origins, which span
     a lag of up to 2 spacings; tau_B = 1950 spans 8."""
     import h5py
-    from dynhet.analysis.runs import blocks_span, run_schedule
+    from dynhet.analysis.runs import blocks_span, run_plan
     path = tmp_path / "run.h5"
     with h5py.File(path, "w") as f:
         g = f.create_group("parameters/schedule")
         g.attrs["origins"], g.attrs["origin_spacing"] = 8, 263.72614
-    sch = run_schedule(str(path))
+    sch = run_plan(str(path))[0]
     assert sch == (8, 263.72614)
     assert not blocks_span(1950.0, sch)
     assert blocks_span(2 * 263.72614, sch) and not blocks_span(2.01 * 263.72614, sch)

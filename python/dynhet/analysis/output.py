@@ -171,14 +171,15 @@ def write_table(A, path, command, discussion=None, restate_from=None, via=(), co
          "the seed mean where no run quotes one. \"agrees\" means within 2 of our standard errors; a row "
          "marked \"differs\" is discussed below the table. CPU is that of the runs behind the row.", ""]
     L += calibration_lines(A)
+    cr_note = cr_sizes_note(A)
     if getattr(A, "promoted", None):
         L += ["**At the largest N** (`--largest-n`): at these densities every row and fit takes the point of the "
               "largest N over the studies, not this study's own: "
               + "; ".join(f"φ = {p.phi:g} ({p.pairs}, ε = {p.eps:g}): N = {p.N}, study {p.study}, "
                           f"{len(p.runs)} seed{'s' if len(p.runs) > 1 else ''}" for p in A.promoted)
-              + ". The other densities are this study's." + cr_sizes_note(A) + largest_n_notes(A), ""]
-    elif getattr(A, "held_back", None) or cr_sizes_note(A):
-        L += ["**At the largest N** (`--largest-n`): no larger N taken." + cr_sizes_note(A) + largest_n_notes(A), ""]
+              + ". The other densities are this study's." + cr_note + largest_n_notes(A), ""]
+    elif getattr(A, "held_back", None) or cr_note:
+        L += ["**At the largest N** (`--largest-n`): no larger N taken." + cr_note + largest_n_notes(A), ""]
     if A.skipped:
         L += [f"Left out: {len(A.skipped)} runs not complete ({', '.join(sorted({s for _, s in A.skipped}))}).", ""]
     L += ["| result | paper (section, figure) | paper | ours | verdict | figure | CPU |", "|---|---|---|---|---|---|---|"]

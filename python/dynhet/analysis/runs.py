@@ -21,22 +21,16 @@ def fnum(v):
 MIN_JACKKNIFE_BLOCKS = 4   # kMinJackknifeBlocks of analysis_nodes/kernels/include/dynhet/analysis/fits.hpp
 
 
-def run_schedule(path):
-    """(origins, origin spacing) of a run (parameters/schedule of run.h5);
-    None where it is not recorded."""
+def run_plan(path):
+    """((origins, origin spacing) or None, equilibration time or NaN) of a
+    run: parameters/schedule and parameters/run of run.h5, where recorded."""
     with h5py.File(path, "r") as f:
-        g = f.get("parameters/schedule")
-        if g is None or "origins" not in g.attrs or "origin_spacing" not in g.attrs:
-            return None
-        return int(g.attrs["origins"]), float(g.attrs["origin_spacing"])
-
-
-def run_equilibration(path):
-    """The run's equilibration time (parameters/run of run.h5); NaN where it
-    is not recorded."""
-    with h5py.File(path, "r") as f:
-        g = f.get("parameters/run")
-        return float(g.attrs["equilibration_time"]) if g is not None and "equilibration_time" in g.attrs else math.nan
+        g, r = f.get("parameters/schedule"), f.get("parameters/run")
+        schedule = (int(g.attrs["origins"]), float(g.attrs["origin_spacing"])) \
+            if g is not None and "origins" in g.attrs and "origin_spacing" in g.attrs else None
+        t_equil = float(r.attrs["equilibration_time"]) if r is not None and "equilibration_time" in r.attrs \
+            else math.nan
+    return schedule, t_equil
 
 
 def blocks_span(longest_lag, schedule):
@@ -120,8 +114,7 @@ def read_run(path, meta):
         obs = run.observables()
         r["N"] = int(meta["n_particles"])
         r["cut"] = read_cutoffs(run)
-        r["schedule"] = run_schedule(path)
-        r["t_equil"] = run_equilibration(path)
+        r["schedule"], r["t_equil"] = run_plan(path)
         # The same of the cage-relative displacements (observables.cage_relative),
         # and their tau_alpha beside the standard one.
         r["cut_cr"] = read_cutoffs(run, cage_relative=True)

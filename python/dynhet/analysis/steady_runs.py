@@ -74,8 +74,7 @@ def across_protocols(rows):
     (a growth as t_w^0.3 adds some 5% over a production of a sixth of t_w).
     Lines only; no verdict beyond the number of errors."""
     groups = {}
-    for study, p, r, _, t_eq, _, _, _ in rows:
-        tau = std_cut(r).get("tau_alpha", math.nan)
+    for study, p, r, _, t_eq, _, _, tau, _ in rows:
         if np.isfinite(t_eq) and np.isfinite(tau):
             sys_ = (p.pairs, p.eps, p.phi, p.N)
             groups.setdefault(sys_, {}).setdefault((round(t_eq, 1), study), []).append(tau)
@@ -132,7 +131,7 @@ def steady_section(A):
                                                       else f" ({p.pairs}, ε {p.eps:g})"))
         if np.isfinite(t_eq) and np.isfinite(unit) and unit > 0:
             s["eq"].append((t_eq / unit, p.phi))
-        rows.append((study, p, r, changes, t_eq, unit, own, prod))
+        rows.append((study, p, r, changes, t_eq, unit, own, tau, prod))
     L = ["## Equilibration and steadiness, run by run", "",
          "The size studies (studies/size_standard.toml, studies/size_cage.toml) equilibrate each run for 5 τ_α^CR "
          "of their estimate (run_length.equilibration_tau in units of the cage-relative τ_α^CR, whose estimate is "
@@ -163,12 +162,12 @@ def steady_section(A):
     L += across_protocols(rows)
     L += ["", "| study | kick pairs | ε | φ | N | seed | equilibration | equil. / τ_α^CR | τ_α | production / τ_α | "
               "τ_α(t0) change, % | τ_α^CR(t0) change, % |", "|---|---|---|---|---|---|---|---|---|---|---|---|"]
-    for study, p, r, changes, t_eq, unit, own, prod in rows:
+    def num(x, f):
+        return format(x, f) if np.isfinite(x) else "—"
+    for study, p, r, changes, t_eq, unit, own, tau, prod in rows:
         cells = [change_cell(v, e, why) for v, e, _, why in changes]
         eq = (f"{t_eq / unit:.3g}" + ("" if np.isfinite(own) else " †")
               if np.isfinite(t_eq) and np.isfinite(unit) and unit > 0 else "—")
-        tau = std_cut(r).get("tau_alpha", math.nan)
-        num = lambda x, f: format(x, f) if np.isfinite(x) else "—"
         L.append(f"| {study} | {p.pairs} | {p.eps:g} | {p.phi:g} | {p.N} | {r.get('seed', '—')} | {num(t_eq, '.4g')} | "
                  f"{eq} | {num(tau, '.3g')} | {num(prod, '.3g')} | {cells[0]} | {cells[1]} |")
     L.append("")
