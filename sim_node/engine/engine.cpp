@@ -4,12 +4,19 @@
 #include "dynhet/engine/engine.hpp"
 
 #include <algorithm>
+#include <cstddef>
+#include <cstring>
 #include <cmath>
 #include <stdexcept>
 #include <string>
 
 #include "dynhet/engine/collision.hpp"
 #include "dynhet/model.hpp"
+
+#if defined(__x86_64__) && defined(__gnu_linux__) && !defined(DYNHET_NO_CLONES)
+#include <immintrin.h>
+#define DYNHET_AVX2_GATHER 1
+#endif
 
 namespace dynhet::engine {
 
@@ -161,14 +168,16 @@ void Engine::prefetch_neighbours(int i) const {
 #define DYNHET_PAIR_CLONES
 #endif
 
-namespace {
 struct PairBlock {
   static constexpr int kSize = 8;
   double x, y, vx, vy, r, now, scale, growth, box, half_box;
   alignas(32) double bx[kSize], by[kSize], bvx[kSize], bvy[kSize], bt[kSize], br[kSize];
 };
 
-DYNHET_PAIR_CLONES void collision_times(const PairBlock& p, double* dt) {
+namespace {
+
+// The body of collision_times(), also inlined into pair_block_avx2().
+[[gnu::always_inline]] inline void collision_times_of(const PairBlock& p, double* dt) {
   for (int q = 0; q < PairBlock::kSize; ++q) {
     const double bdt = p.now - p.bt[q];
     const double x = p.x - (p.bx[q] + p.bvx[q] * bdt), y = p.y - (p.by[q] + p.bvy[q] * bdt);
@@ -177,7 +186,112 @@ DYNHET_PAIR_CLONES void collision_times(const PairBlock& p, double* dt) {
                                 p.vx - p.bvx[q], p.vy - p.bvy[q], p.scale * rsum, p.growth * rsum);
   }
 }
+
+DYNHET_PAIR_CLONES void collision_times(const PairBlock& p, double* dt) { collision_times_of(p, dt); }
+
+// The first lane q < nk with the smallest dt[q], if that is below best
+// (then best becomes it), else -1: what a scan in lane order keeping the
+// first strictly smaller value finds.
+int earliest_lane(const double* dt, int nk, double& best) {
+  int lane = -1;
+  for (int q = 0; q < nk; ++q)
+    if (dt[q] < best) best = dt[q], lane = q;
+  return lane;
+}
 } // namespace
+
+// What the pair tests read of the neighbours l[0], ..., l[nk - 1] (and of
+// l[nk - 1] again for the lanes beyond them) copied into the block. This
+// moves data only, so every version gives the same block (and the same
+// trajectories). Where the processor has AVX2, each half of a neighbour's
+// line is read as one vector and four neighbours' halves are transposed in
+// registers: (x, y, vx, vy) and (t, event time, counter, partner) give bx,
+// by, bvx, bvy and bt, and the counter word's top bit, the species, picks
+// the radius by its sign (blendv): per neighbour, six loads and six
+// stores (and a look-up of the radius) become two loads, about three
+// shuffles and one and a half stores. The pair tests follow inlined, and
+// the earliest lane is found by vector compares.
+#ifdef DYNHET_AVX2_GATHER
+[[gnu::target("avx2")]] int Engine::pair_block_avx2(const Particle* part, const int32_t* l, int nk,
+                                                    const double* radius, PairBlock& blk, double& best) {
+  // The indices: lanes below nk from the list, the others its last member
+  // (a masked load reads nothing beyond the list).
+  const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
+  const __m256i in_list = _mm256_cmpgt_epi32(_mm256_set1_epi32(nk), lane);
+  const __m256i idx = _mm256_blendv_epi8(_mm256_set1_epi32(l[nk - 1]), _mm256_maskload_epi32(l, in_list), in_list);
+  alignas(32) int32_t k[8];
+  _mm256_store_si256(reinterpret_cast<__m256i*>(k), idx);
+  const __m256d r0 = _mm256_set1_pd(radius[0]), r1 = _mm256_set1_pd(radius[1]);
+  for (int h = 0; h < PairBlock::kSize; h += 4) {
+    const double* b0 = &part[k[h]].x;
+    const double* b1 = &part[k[h + 1]].x;
+    const double* b2 = &part[k[h + 2]].x;
+    const double* b3 = &part[k[h + 3]].x;
+    {
+      const __m256d q0 = _mm256_load_pd(b0), q1 = _mm256_load_pd(b1), q2 = _mm256_load_pd(b2), q3 = _mm256_load_pd(b3);
+      const __m256d t0 = _mm256_unpacklo_pd(q0, q1), t1 = _mm256_unpackhi_pd(q0, q1); // x0 x1 vx0 vx1, y0 y1 vy0 vy1
+      const __m256d t2 = _mm256_unpacklo_pd(q2, q3), t3 = _mm256_unpackhi_pd(q2, q3);
+      _mm256_store_pd(blk.bx + h, _mm256_permute2f128_pd(t0, t2, 0x20));
+      _mm256_store_pd(blk.bvx + h, _mm256_permute2f128_pd(t0, t2, 0x31));
+      _mm256_store_pd(blk.by + h, _mm256_permute2f128_pd(t1, t3, 0x20));
+      _mm256_store_pd(blk.bvy + h, _mm256_permute2f128_pd(t1, t3, 0x31));
+    }
+    {
+      const __m256d q0 = _mm256_load_pd(b0 + 4), q1 = _mm256_load_pd(b1 + 4);
+      const __m256d q2 = _mm256_load_pd(b2 + 4), q3 = _mm256_load_pd(b3 + 4);
+      const __m256d t0 = _mm256_unpacklo_pd(q0, q1), t2 = _mm256_unpacklo_pd(q2, q3); // t0 t1 c0 c1, t2 t3 c2 c3
+      _mm256_store_pd(blk.bt + h, _mm256_permute2f128_pd(t0, t2, 0x20));
+      _mm256_store_pd(blk.br + h, _mm256_blendv_pd(r0, r1, _mm256_permute2f128_pd(t0, t2, 0x31)));
+    }
+  }
+  alignas(32) double dt[PairBlock::kSize];
+  collision_times_of(blk, dt);
+  // The earliest lane as earliest_lane() finds it: lanes beyond the list,
+  // and any NaN, count as never; the first lane holding the minimum.
+  const __m256d never = _mm256_set1_pd(kNever);
+  const __m256i in_lo = _mm256_cvtepi32_epi64(_mm256_castsi256_si128(in_list));
+  const __m256i in_hi = _mm256_cvtepi32_epi64(_mm256_extracti128_si256(in_list, 1));
+  __m256d lo = _mm256_load_pd(dt), hi = _mm256_load_pd(dt + 4);
+  lo = _mm256_blendv_pd(never, lo, _mm256_and_pd(_mm256_castsi256_pd(in_lo), _mm256_cmp_pd(lo, lo, _CMP_ORD_Q)));
+  hi = _mm256_blendv_pd(never, hi, _mm256_and_pd(_mm256_castsi256_pd(in_hi), _mm256_cmp_pd(hi, hi, _CMP_ORD_Q)));
+  __m256d m = _mm256_min_pd(lo, hi);
+  m = _mm256_min_pd(m, _mm256_permute2f128_pd(m, m, 0x01));
+  m = _mm256_min_pd(m, _mm256_permute_pd(m, 0x5));
+  const double low = _mm256_cvtsd_f64(m);
+  if (!(low < best)) return -1;
+  best = low;
+  const int at = _mm256_movemask_pd(_mm256_cmp_pd(lo, m, _CMP_EQ_OQ)) | _mm256_movemask_pd(_mm256_cmp_pd(hi, m, _CMP_EQ_OQ)) << 4;
+  return __builtin_ctz(static_cast<unsigned>(at));
+}
+
+// pair_block_avx2 reads t at byte 32 and the species as the top bit of the
+// word at byte 48 (the bit-field's place in this ABI, checked here, not
+// assumed: elsewhere the portable copy runs, with the same result).
+bool Engine::avx2_gather_fits() {
+  static_assert(offsetof(Particle, x) == 0 && offsetof(Particle, vy) == 24 && offsetof(Particle, t) == 32 &&
+                offsetof(Particle, partner) == 56);
+  Particle p{};
+  p.species = 1;
+  uint64_t word;
+  std::memcpy(&word, reinterpret_cast<const char*>(&p) + 48, sizeof word);
+  return word == uint64_t{1} << 63 && __builtin_cpu_supports("avx2");
+}
+const bool Engine::avx2_gather_ = Engine::avx2_gather_fits();
+#endif
+
+int Engine::pair_block(const int32_t* l, int nk, PairBlock& blk, double& best) const {
+#ifdef DYNHET_AVX2_GATHER
+  if (avx2_gather_) return pair_block_avx2(part_.data(), l, nk, radius_, blk, best);
+#endif
+  for (int q = 0; q < PairBlock::kSize; ++q) {
+    const Particle& b = part_[l[std::min(q, nk - 1)]]; // beyond the list: the last one again
+    blk.bx[q] = b.x, blk.by[q] = b.y, blk.bvx[q] = b.vx, blk.bvy[q] = b.vy, blk.bt[q] = b.t;
+    blk.br[q] = radius_[b.species];
+  }
+  alignas(32) double dt[PairBlock::kSize];
+  collision_times(blk, dt);
+  return earliest_lane(dt, nk, best);
+}
 
 void Engine::predict(int i) {
   const Particle& a = part_[i];
@@ -204,19 +318,9 @@ void Engine::predict(int i) {
   PairBlock blk;
   blk.x = a.x, blk.y = a.y, blk.vx = a.vx, blk.vy = a.vy, blk.r = radius_[a.species];
   blk.now = now_, blk.scale = scale(), blk.growth = grow_, blk.box = box_, blk.half_box = half_box_;
-  alignas(32) double dt[PairBlock::kSize];
   int best_k = 0;
-  for (int k0 = 1; k0 <= m; k0 += PairBlock::kSize) {
-    const int nk = std::min(PairBlock::kSize, m - k0 + 1);
-    for (int q = 0; q < PairBlock::kSize; ++q) {
-      const Particle& b = part_[l[k0 + std::min(q, nk - 1)]]; // beyond the list: the last one again
-      blk.bx[q] = b.x, blk.by[q] = b.y, blk.bvx[q] = b.vx, blk.bvy[q] = b.vy, blk.bt[q] = b.t;
-      blk.br[q] = radius_[b.species];
-    }
-    collision_times(blk, dt);
-    for (int q = 0; q < nk; ++q)
-      if (dt[q] < best) best = dt[q], best_k = k0 + q;
-  }
+  for (int k0 = 1; k0 <= m; k0 += PairBlock::kSize)
+    if (const int q = pair_block(l + k0, std::min(PairBlock::kSize, m - k0 + 1), blk, best); q >= 0) best_k = k0 + q;
   const int32_t partner = best_k > 0 ? l[best_k] : kRebuild;
   const uint32_t partner_seen = best_k > 0 ? seen(part_[partner].coll) : 0;
   part_[i].partner = partner;

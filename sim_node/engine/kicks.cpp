@@ -49,7 +49,7 @@ int below(uint64_t h, uint64_t n) { return static_cast<int>((static_cast<unsigne
 } // namespace
 
 uint64_t Engine::kick_hash(int64_t k, int draw, int which) const {
-  const uint64_t h = mix64(mix64(p_.seed ^ 0x6b69636b70616972ULL) + 2 * static_cast<uint64_t>(k) + which);
+  const uint64_t h = mix64(kick_key_ + 2 * static_cast<uint64_t>(k) + which);
   return draw == 0 ? h : mix64(h ^ static_cast<uint64_t>(draw)); // the first draw's: those of the rule "any"
 }
 

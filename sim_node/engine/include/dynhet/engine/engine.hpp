@@ -37,6 +37,8 @@
 
 namespace dynhet::engine {
 
+struct PairBlock; // a particle and a block of its neighbours, as the pair tests read them (engine.cpp)
+
 // How the two particles of a kick are drawn (engine.cpp, kick_pair, says
 // why neighbours are the default).
 enum class KickPairs {
@@ -307,6 +309,15 @@ private:
   void build_lists(); // every list afresh, centres at the positions now (all synchronised)
   void clear_events();
   void predict(int i);
+  // The pair tests of a block of neighbours l[0], ..., l[nk - 1] (nk <= 8):
+  // the lane of the earliest collision if it comes before best (which then
+  // becomes its time), else -1 (engine.cpp; pair_block_avx2 where the
+  // processor has AVX2, the same results).
+  int pair_block(const int32_t* l, int nk, PairBlock& blk, double& best) const;
+  static int pair_block_avx2(const Particle* part, const int32_t* l, int nk, const double* radius, PairBlock& blk,
+                             double& best);
+  static bool avx2_gather_fits(); // this processor and this ABI's Particle suit pair_block_avx2
+  static const bool avx2_gather_;
   void prefetch_neighbours(int i) const;
   void sync(int i);
   void collide(int i, int j);
@@ -437,6 +448,8 @@ private:
   bool neighbour_kicks_ = false; // driven with KickPairs::neighbours: cells are wider by kick_reach
   double kick_pair_rate_ = 0; // pair kicks per unit time, whole system
   Rng rng_;
+  // The seed's hash that every kick's draws start from (kick_hash).
+  uint64_t kick_key_ = mix64(p_.seed ^ 0x6b69636b70616972ULL);
 
   double now_ = 0, offset_ = 0;
   int64_t events_since_rebase_ = 0;
