@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <string>
 #include <vector>
 
@@ -250,6 +251,32 @@ TEST(Engine, SameSeedSameTrajectoryBitForBit) {
   }
   ASSERT_EQ(a.size(), b.size());
   for (size_t i = 0; i < a.size(); ++i) ASSERT_EQ(a[i], b[i]) << i;
+}
+
+// The AVX2 pair tests (neighbours' lines transposed in registers, the
+// earliest lane by vector compares) and the portable ones move the same
+// data and take the same lane: compression (growing radii), an elastic and
+// a driven run give the same bits either way.
+TEST(Engine, VectorAndPortablePairTestsGiveTheSameBits) {
+  for (const bool driven : {false, true}) {
+    std::vector<double> xy[2];
+    int64_t events[2];
+    for (const bool portable : {true, false}) {
+      if (portable) setenv("DYNHET_PORTABLE_PAIR_TESTS", "1", 1);
+      Engine e(params(1000, 0.78, driven ? 0.9 : 1.0, driven));
+      unsetenv("DYNHET_PORTABLE_PAIR_TESTS");
+      if (!portable && !e.vector_pair_tests()) GTEST_SKIP() << "no AVX2 here: only the portable pair tests run";
+      EXPECT_EQ(e.vector_pair_tests(), !portable);
+      e.prepare();
+      e.run_until(20.0);
+      e.unwrapped_positions(xy[portable]);
+      events[portable] = e.counters().collisions + e.counters().kicks + e.counters().stale;
+    }
+    EXPECT_GT(events[0], 100000);
+    EXPECT_EQ(events[0], events[1]);
+    ASSERT_EQ(xy[0].size(), xy[1].size());
+    for (size_t i = 0; i < xy[0].size(); ++i) ASSERT_EQ(xy[0][i], xy[1][i]) << (driven ? "driven " : "elastic ") << i;
+  }
 }
 
 TEST(Engine, UnwrappedPositionsAreContinuousAcrossTheBoundary) {

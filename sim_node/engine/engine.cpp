@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cstddef>
+#include <cstdlib>
 #include <cstring>
 #include <cmath>
 #include <stdexcept>
@@ -21,6 +22,9 @@
 namespace dynhet::engine {
 
 Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution), rng_(p.seed) {
+#ifdef DYNHET_AVX2_GATHER
+  vector_pair_tests_ = avx2_gather_fits() && !std::getenv("DYNHET_PORTABLE_PAIR_TESTS");
+#endif
   if (n_ < 2) throw std::invalid_argument("engine: need at least 2 particles");
   if (n_ > Calendar::kMaxLeaves)
     throw std::invalid_argument("engine: at most " + std::to_string(Calendar::kMaxLeaves) + " particles, not " +
@@ -276,12 +280,11 @@ bool Engine::avx2_gather_fits() {
   std::memcpy(&word, reinterpret_cast<const char*>(&p) + 48, sizeof word);
   return word == uint64_t{1} << 63 && __builtin_cpu_supports("avx2");
 }
-const bool Engine::avx2_gather_ = Engine::avx2_gather_fits();
 #endif
 
 int Engine::pair_block(const int32_t* l, int nk, PairBlock& blk, double& best) const {
 #ifdef DYNHET_AVX2_GATHER
-  if (avx2_gather_) return pair_block_avx2(part_.data(), l, nk, radius_, blk, best);
+  if (vector_pair_tests_) return pair_block_avx2(part_.data(), l, nk, radius_, blk, best);
 #endif
   for (int q = 0; q < PairBlock::kSize; ++q) {
     const Particle& b = part_[l[std::min(q, nk - 1)]]; // beyond the list: the last one again

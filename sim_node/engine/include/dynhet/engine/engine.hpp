@@ -284,6 +284,12 @@ public:
   double max_overlap() const;
   // Smallest d / sigma over all neighbouring pairs.
   double min_gap_ratio() const;
+  // Whether the pair tests run as AVX2 vector code (pair_block_avx2), or
+  // as the portable code that gives the same bits: the vector code where
+  // the processor has AVX2, unless the environment sets
+  // DYNHET_PORTABLE_PAIR_TESTS when the engine is made (the test that
+  // compares the two sets it).
+  bool vector_pair_tests() const { return vector_pair_tests_; }
 
 private:
   // What predicting a collision reads of a neighbour, and what its own
@@ -317,7 +323,6 @@ private:
   static int pair_block_avx2(const Particle* part, const int32_t* l, int nk, const double* radius, PairBlock& blk,
                              double& best);
   static bool avx2_gather_fits(); // this processor and this ABI's Particle suit pair_block_avx2
-  static const bool avx2_gather_;
   void prefetch_neighbours(int i) const;
   void sync(int i);
   void collide(int i, int j);
@@ -448,6 +453,7 @@ private:
   bool neighbour_kicks_ = false; // driven with KickPairs::neighbours: cells are wider by kick_reach
   double kick_pair_rate_ = 0; // pair kicks per unit time, whole system
   Rng rng_;
+  bool vector_pair_tests_ = false;
   // The seed's hash that every kick's draws start from (kick_hash).
   uint64_t kick_key_ = mix64(p_.seed ^ 0x6b69636b70616972ULL);
 
