@@ -149,6 +149,39 @@ def test_the_executors_take_the_longest_run_first(tmp_path):
         run_order(sd, sd.study.points(), est, "longest", ["*"])
 
 
+def test_an_interrupted_run_is_ordered_by_what_its_checkpoint_has_left(tmp_path):
+    # Two runs of the same system, one interrupted 90% through: with --order
+    # shortest (and within a --first group) it goes before the fresh one,
+    # its estimate being what is left of it.
+    from dynhet.study.index import plan, run_estimates, run_estimates_left, run_order
+    from dynhet.study.rundir import StudyDir, write_status
+    from dynhet.scene import resolved
+    text = GOOD.replace("lag_max_tau = 30.0", "lag_max_tau = 30.0\ntau_guess = [[0.6, 1.0], [0.7, 5.0]]")
+    sd = StudyDir(study(tmp_path, text), str(tmp_path / "out"))
+    sd.claim()
+    pts = sd.study.points()
+    big = [p for p in pts if p["packing_fraction"] == 0.70 and p["restitution"] == 0.9]
+    assert [p["seed"] for p in big] == [1, 2]
+    full, left = run_estimates(sd), run_estimates_left(sd)
+    assert left == full                                              # nothing started: all of each is left
+    d = sd.run_dir(big[1])                                           # seed 2, 90% through, then stopped
+    os.makedirs(d, exist_ok=True)
+    write_status(d, {"state": "interrupted"})
+    sc = [sc for p, sc, *_ in plan(sd) if p == big[1]][0]
+    run = resolved(sc)["run"]
+    end = run["equilibration_time"] + run["production_time"]
+    with open(os.path.join(d, "sim_node.log"), "w") as f:
+        f.write(f"[production ] t={0.9 * end:.6g} /{end:.6g}  phi=0.7000  coll/s=1e+06  T=0.9  Z=9  "
+                "frames 10/12  ETA 0:01:00\n")
+    left = run_estimates_left(sd)
+    name = sd.study.run_name
+    assert math.isclose(left[name(big[1])], 0.1 * full[name(big[1])], rel_tol=1e-3)
+    assert left[name(big[0])] == full[name(big[0])]
+    order = [name(p) for p in run_order(sd, big, left, "shortest", ["phi0.7000_eps0.900_*"])]
+    assert order == [name(big[1]), name(big[0])]                    # the nearly finished one first
+    assert [name(p) for p in run_order(sd, big, full, "shortest")] == [name(big[0]), name(big[1])]
+
+
 def test_a_size_not_yet_piloted_is_estimated_from_the_pilots_of_the_same_system(tmp_path):
     # A pilot runs min(N, pilot_particles) particles: the pilots of N = 4096
     # and 16384 ran the same 2048-particle system as N = 65536's will, so

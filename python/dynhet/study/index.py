@@ -70,6 +70,19 @@ def run_estimates(sd):
     return {sd.study.run_name(p): estimate(sc, nodes_of(sc))[0] for p, sc, *_ in plan(sd)}
 
 
+def run_estimates_left(sd):
+    """{run name: estimated CPU seconds still to run}: run_estimates less the
+    share an interrupted run's checkpoint already holds (share_done), so that
+    an order by length puts a run that is nearly through ahead of a fresh
+    one of the same size."""
+    left = {}
+    for p, sc, _, _, state in plan(sd):
+        run = resolved(sc)["run"]
+        done = share_done(sd.run_dir(p), state, run["equilibration_time"] + run["production_time"])
+        left[sd.study.run_name(p)] = estimate(sc, nodes_of(sc))[0] * (1 - done)
+    return left
+
+
 def run_order(sd, todo, est, order="longest", first=()):
     """The order the executors take runs in (the local pool, and the Slurm
     array's task indices, which a throttled array starts in order). With
@@ -79,7 +92,9 @@ def run_order(sd, todo, est, order="longest", first=()):
     does not start last behind the short ones (longest-processing-time
     first); with order "shortest" the shortest first, so that the most runs
     are complete (and archived) by any moment, where the machine may be
-    lost before the study ends. Equal estimates keep the study's order.
+    lost before the study ends. est is what each run has still to run
+    (run_estimates_left: an interrupted run counts what its checkpoint has
+    not done). Equal estimates keep the study's order.
     The runs whose names match a pattern of first (shell globs) go before all
     others, those of the first pattern first (each group in that order):
     the runs a result waits for, ahead of the rest."""

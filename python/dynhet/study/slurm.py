@@ -10,7 +10,7 @@ from .model import AXES, StudyError
 from .rundir import read_status, write_status
 from .children import RESUMABLE, signal_children
 from .runner import do_run
-from .index import run_estimates, run_order, write_index
+from .index import run_estimates_left, run_order, write_index
 
 
 def run_slurm(sd, a):
@@ -26,7 +26,7 @@ def run_slurm(sd, a):
                 print(f"{sd.study.run_name(p)}: still in Slurm job {st['job']} ({q.stdout.split()[0]})")
                 continue
         todo.append(p)
-    todo = run_order(sd, todo, run_estimates(sd), a.order, a.first)
+    todo = run_order(sd, todo, run_estimates_left(sd), a.order, a.first)
     if not todo:
         print(f"study {sd.study.name}: nothing to submit ({len(points)} runs complete or queued)")
         write_index(sd)
