@@ -258,6 +258,8 @@ TEST(Engine, SameSeedSameTrajectoryBitForBit) {
 // data and take the same lane: compression (growing radii), an elastic and
 // a driven run give the same bits either way.
 TEST(Engine, VectorAndPortablePairTestsGiveTheSameBits) {
+  const char* was = std::getenv("DYNHET_PORTABLE_PAIR_TESTS"); // put back at the end
+  const std::string kept = was ? was : "";
   for (const bool driven : {false, true}) {
     std::vector<double> xy[2];
     int64_t events[2];
@@ -265,7 +267,10 @@ TEST(Engine, VectorAndPortablePairTestsGiveTheSameBits) {
       if (portable) setenv("DYNHET_PORTABLE_PAIR_TESTS", "1", 1);
       Engine e(params(1000, 0.78, driven ? 0.9 : 1.0, driven));
       unsetenv("DYNHET_PORTABLE_PAIR_TESTS");
-      if (!portable && !e.vector_pair_tests()) GTEST_SKIP() << "no AVX2 here: only the portable pair tests run";
+      if (!portable && !e.vector_pair_tests()) {
+        if (was) setenv("DYNHET_PORTABLE_PAIR_TESTS", kept.c_str(), 1);
+        GTEST_SKIP() << "the vector pair tests do not run here (no AVX2, or a Particle layout they do not suit)";
+      }
       EXPECT_EQ(e.vector_pair_tests(), !portable);
       e.prepare();
       e.run_until(20.0);
@@ -274,9 +279,13 @@ TEST(Engine, VectorAndPortablePairTestsGiveTheSameBits) {
     }
     EXPECT_GT(events[0], 100000);
     EXPECT_EQ(events[0], events[1]);
-    ASSERT_EQ(xy[0].size(), xy[1].size());
-    for (size_t i = 0; i < xy[0].size(); ++i) ASSERT_EQ(xy[0][i], xy[1][i]) << (driven ? "driven " : "elastic ") << i;
+    EXPECT_EQ(xy[0].size(), xy[1].size());
+    size_t differ = 0, first = 0;
+    for (size_t i = 0; i < std::min(xy[0].size(), xy[1].size()); ++i)
+      if (xy[0][i] != xy[1][i] && differ++ == 0) first = i;
+    EXPECT_EQ(differ, 0u) << (driven ? "driven" : "elastic") << ": the first at coordinate " << first;
   }
+  if (was) setenv("DYNHET_PORTABLE_PAIR_TESTS", kept.c_str(), 1);
 }
 
 TEST(Engine, UnwrappedPositionsAreContinuousAcrossTheBoundary) {

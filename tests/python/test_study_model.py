@@ -150,9 +150,11 @@ def test_the_executors_take_the_longest_run_first(tmp_path):
 
 
 def test_an_interrupted_run_is_ordered_by_what_its_checkpoint_has_left(tmp_path):
-    # Two runs of the same system, one interrupted 90% through: with --order
+    # Two runs of the same system, one stopped 90% through: with --order
     # shortest (and within a --first group) it goes before the fresh one,
-    # its estimate being what is left of it.
+    # its estimate being what is left after the point it resumes from (its
+    # newest whole checkpoint cut; its checkpoint before the frames; or,
+    # with neither, or no scene.toml, the start: it starts over).
     from dynhet.study.index import plan, run_estimates, run_estimates_left, run_order
     from dynhet.study.rundir import StudyDir, write_status
     from dynhet.scene import resolved
@@ -160,26 +162,37 @@ def test_an_interrupted_run_is_ordered_by_what_its_checkpoint_has_left(tmp_path)
     sd = StudyDir(study(tmp_path, text), str(tmp_path / "out"))
     sd.claim()
     pts = sd.study.points()
-    big = [p for p in pts if p["packing_fraction"] == 0.70 and p["restitution"] == 0.9]
-    assert [p["seed"] for p in big] == [1, 2]
+    pair = [p for p in pts if p["packing_fraction"] == 0.70 and p["restitution"] == 0.9]
+    assert [p["seed"] for p in pair] == [1, 2]
     full, left = run_estimates(sd), run_estimates_left(sd)
     assert left == full                                              # nothing started: all of each is left
-    d = sd.run_dir(big[1])                                           # seed 2, 90% through, then stopped
+    name = sd.study.run_name
+    d = sd.run_dir(pair[1])                                          # seed 2, 90% through, then stopped
     os.makedirs(d, exist_ok=True)
     write_status(d, {"state": "interrupted"})
-    sc = [sc for p, sc, *_ in plan(sd) if p == big[1]][0]
-    run = resolved(sc)["run"]
+    run = resolved([sc for p, sc, *_ in plan(sd) if p == pair[1]][0])["run"]
     end = run["equilibration_time"] + run["production_time"]
     with open(os.path.join(d, "sim_node.log"), "w") as f:
         f.write(f"[production ] t={0.9 * end:.6g} /{end:.6g}  phi=0.7000  coll/s=1e+06  T=0.9  Z=9  "
                 "frames 10/12  ETA 0:01:00\n")
-    left = run_estimates_left(sd)
-    name = sd.study.run_name
-    assert math.isclose(left[name(big[1])], 0.1 * full[name(big[1])], rel_tol=1e-3)
-    assert left[name(big[0])] == full[name(big[0])]
-    order = [name(p) for p in run_order(sd, big, left, "shortest", ["phi0.7000_eps0.900_*"])]
-    assert order == [name(big[1]), name(big[0])]                    # the nearly finished one first
-    assert [name(p) for p in run_order(sd, big, full, "shortest")] == [name(big[0]), name(big[1])]
+    assert run_estimates_left(sd)[name(pair[1])] == full[name(pair[1])]   # no checkpoint: it starts over
+    open(os.path.join(d, "checkpoint_before_frames.h5"), "w").close()
+    assert run_estimates_left(sd)[name(pair[1])] == full[name(pair[1])]   # no scene.toml: it starts over too
+    open(os.path.join(d, "scene.toml"), "w").close()
+    assert math.isclose(run_estimates_left(sd)[name(pair[1])],      # the production from its start
+                        full[name(pair[1])] * run["production_time"] / end, rel_tol=1e-9)
+    os.makedirs(os.path.join(d, "checkpoints", "cut-12"))
+    open(os.path.join(d, "checkpoints", "cut-12", "WHOLE"), "w").close()
+    left = run_estimates_left(sd)                                    # from the cut: what the sim last said
+    assert math.isclose(left[name(pair[1])], 0.1 * full[name(pair[1])], rel_tol=1e-3)
+    assert left[name(pair[0])] == full[name(pair[0])]
+    order = [name(p) for p in run_order(sd, pair, left, "shortest", ["phi0.7000_eps0.900_*"])]
+    assert order == [name(pair[1]), name(pair[0])]                  # the nearly finished one first
+    assert [name(p) for p in run_order(sd, pair, full, "shortest")] == [name(pair[0]), name(pair[1])]
+    write_status(d, {"state": "queued", "previous_state": "interrupted", "job": 7})   # a Slurm resubmission
+    assert math.isclose(run_estimates_left(sd)[name(pair[1])], 0.1 * full[name(pair[1])], rel_tol=1e-3)
+    write_status(d, {"state": "failed"})                            # a failed run starts over
+    assert run_estimates_left(sd)[name(pair[1])] == full[name(pair[1])]
 
 
 def test_a_size_not_yet_piloted_is_estimated_from_the_pilots_of_the_same_system(tmp_path):

@@ -9,6 +9,7 @@ from .model import AXES, StudyError
 from .estimates import estimate, fmt_time
 from .progress import sim_progress
 from .rundir import read_status
+from .runner import effective_state, resume_from
 
 
 def write_index(sd):
@@ -72,13 +73,19 @@ def run_estimates(sd):
 
 def run_estimates_left(sd):
     """{run name: estimated CPU seconds still to run}: run_estimates less the
-    share an interrupted run's checkpoint already holds (share_done), so that
-    an order by length puts a run that is nearly through ahead of a fresh
-    one of the same size."""
+    share of its simulated time that a stopped run resumes past (what
+    do_run resumes it from: its newest checkpoint cut, about where its
+    sim's last progress line was; its checkpoint before the frames, the
+    end of equilibration; nothing, the start), so that an order by length
+    puts a run that is nearly through ahead of a fresh one of the same
+    size, and one that will start over where a fresh one would be."""
     left = {}
-    for p, sc, _, _, state in plan(sd):
-        run = resolved(sc)["run"]
-        done = share_done(sd.run_dir(p), state, run["equilibration_time"] + run["production_time"])
+    for p, sc, *_ in plan(sd):
+        d, run = sd.run_dir(p), resolved(sc)["run"]
+        state = effective_state(read_status(d))
+        how, total = resume_from(d, state), run["equilibration_time"] + run["production_time"]
+        done = (share_done(d, "interrupted", total) if how == "cut"
+                else run["equilibration_time"] / total if how and total > 0 else 0.0)
         left[sd.study.run_name(p)] = estimate(sc, nodes_of(sc))[0] * (1 - done)
     return left
 

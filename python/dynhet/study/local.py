@@ -42,11 +42,11 @@ def run_local(sd, jobs, order="longest", first=()):
             queued = [ratio * left[sd.study.run_name(p)] for p in queue]
             active = list(state["active"].values())
         # The running runs' own ETAs (their sims'), then the queue on the slots they free.
-        left = []
+        running = []
         for d, since in active:
             pr = sim_progress(d, since)
-            left.append((eta_seconds(pr["eta"]) if pr else None) or 0.0)
-        eta = study_eta(left, queued, max(1, jobs))
+            running.append((eta_seconds(pr["eta"]) if pr else None) or 0.0)
+        eta = study_eta(running, queued, max(1, jobs))
         with lock:
             print(f"[{fmt_time(time.time() - t_start)}] study {sd.study.name}: {state['done']} done, "
                   f"{state['running']} running, {state['left']} left, {state['failed']} failed; "

@@ -22,6 +22,19 @@ def effective_state(old):
     return old.get("previous_state", s) if s == "queued" else s
 
 
+def resume_from(d, state):
+    """What do_run resumes run directory d in (effective) state `state` from:
+    "cut" (run_scene.sh continues from its newest whole checkpoint cut), the
+    path of its checkpoint_before_frames.h5 (the production from its start),
+    or None (it starts over: another state, no checkpoint, or no scene.toml)."""
+    if state not in ("running", "queued", "interrupted") or not os.path.exists(os.path.join(d, "scene.toml")):
+        return None
+    if newest_whole_cut(d) is not None:
+        return "cut"
+    ck = os.path.join(d, "checkpoint_before_frames.h5")
+    return ck if os.path.exists(ck) else None
+
+
 def carried_cpu(old, resume):
     """(CPU seconds, attempts whose CPU was lost) that a new attempt carries
     from its run's previous status: a resumed run's earlier attempts; an
@@ -91,17 +104,14 @@ def do_run(sd, p, log=print):
         return dict(old, state="running", message=f"still running in process {old.get('pid')}")
     state = effective_state(old)
     if state in ("running", "queued", "interrupted"):
-        ck = os.path.join(d, "checkpoint_before_frames.h5")
-        cut = newest_whole_cut(d)
-        if cut is not None and os.path.exists(os.path.join(d, "scene.toml")):
+        resume = resume_from(d, state)
+        if resume == "cut":
             # run_scene.sh on the same directory resumes from the cut itself.
-            resume = "cut"
             last = sim_progress(d)  # what the sim last reported (a cut is taken in either phase)
             said = f" (its sim last said: {last['phase']} t = {last['t']:.6g} of {last['end']:.6g})" if last else ""
-            log(f"{st.run_name(p)}: was interrupted; resuming from checkpoint cut {cut}{said}")
-        elif os.path.exists(ck) and os.path.exists(os.path.join(d, "scene.toml")):
-            resume = ck
-            log(f"{st.run_name(p)}: was interrupted; resuming from {ck}")
+            log(f"{st.run_name(p)}: was interrupted; resuming from checkpoint cut {newest_whole_cut(d)}{said}")
+        elif resume is not None:
+            log(f"{st.run_name(p)}: was interrupted; resuming from {resume}")
         elif state != "queued" or old.get("started"):
             log(f"{st.run_name(p)}: was interrupted before its first checkpoint; starting again")
     elif state in ("failed", "too_short", "unknown"):
