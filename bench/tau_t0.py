@@ -25,8 +25,7 @@ import tempfile
 import h5py
 import numpy as np
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "python"))
-from dynhet.fits import slope_with_error  # noqa: E402
+from dynhet.fits import slope_with_error  # bench/dynhet: the package
 
 
 def series(f, group, cutoff):
