@@ -48,8 +48,9 @@ def report(name, t0, tt, tau):
         print("fewer than 4 origins with a tau_alpha: no line")
         return
     b, e, n = slope_with_error(t0[m] / tau, tt[m] / tau)  # in units of tau_alpha on both axes
-    print(f"line: {1e4 * b:+.3g} +- {1e4 * e:.2g} per 10^4 time units (in tau_alpha per tau_alpha of t0, "
-          f"{b:+.3g} +- {e:.2g}; {n - 2} dof)")
+    err = (lambda x: f"+- {x:.2g}") if math.isfinite(e) else (lambda x: "(no error)")
+    print(f"line: {1e4 * b:+.3g} {err(1e4 * e)} per 10^4 time units (in tau_alpha per tau_alpha of t0, "
+          f"{b:+.3g} {err(e)}; {n - 2} dof)")
     if np.min(np.diff(t0[m])) < tau:
         print(f"origins lie {np.min(np.diff(t0[m])):.4g} apart, closer than tau_alpha: their tau_alpha(t0) are "
               "correlated, so the line has no error and the thirds' errors below understate theirs")
