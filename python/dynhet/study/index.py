@@ -68,26 +68,33 @@ def planned_tau_eq(sd, p, st, tau):
 
 def run_estimates(sd):
     """{run name: estimated CPU seconds} from the estimates known now."""
-    return {sd.study.run_name(p): estimate(sc, nodes_of(sc))[0] for p, sc, *_ in plan(sd)}
+    return estimates_whole_and_left(sd)[0]
 
 
 def run_estimates_left(sd):
-    """{run name: estimated CPU seconds still to run}: run_estimates less the
-    share of its simulated time that a stopped run resumes past (what
-    do_run resumes it from: its newest checkpoint cut, about where its
-    sim's last progress line was; its checkpoint before the frames, the
-    end of equilibration; nothing, the start), so that an order by length
-    puts a run that is nearly through ahead of a fresh one of the same
-    size, and one that will start over where a fresh one would be."""
-    left = {}
+    """{run name: estimated CPU seconds still to run} (estimates_whole_and_left)."""
+    return estimates_whole_and_left(sd)[1]
+
+
+def estimates_whole_and_left(sd):
+    """({run name: estimated CPU seconds}, {run name: what is still to run}),
+    from one pass over the plan. What is left is the estimate less the share
+    of its simulated time that a stopped run resumes past (what do_run
+    resumes it from: its newest checkpoint cut, about where its sim's last
+    progress line was; its checkpoint before the frames, the end of
+    equilibration; nothing, the start), so that an order by length puts a
+    run that is nearly through ahead of a fresh one of the same size, and
+    one that will start over where a fresh one would be."""
+    whole, left = {}, {}
     for p, sc, *_ in plan(sd):
-        d, run = sd.run_dir(p), resolved(sc)["run"]
+        d, run, name = sd.run_dir(p), resolved(sc)["run"], sd.study.run_name(p)
         state = effective_state(read_status(d))
         how, total = resume_from(d, state), run["equilibration_time"] + run["production_time"]
         done = (share_done(d, "interrupted", total) if how == "cut"
                 else run["equilibration_time"] / total if how and total > 0 else 0.0)
-        left[sd.study.run_name(p)] = estimate(sc, nodes_of(sc))[0] * (1 - done)
-    return left
+        whole[name] = estimate(sc, nodes_of(sc))[0]
+        left[name] = whole[name] * (1 - done)
+    return whole, left
 
 
 def run_order(sd, todo, est, order="longest", first=()):

@@ -12,7 +12,7 @@ from .estimates import fmt_time
 from .rundir import read_status, write_status
 from .children import RESUMABLE, STOPPING, already_stopping, stop_children
 from .runner import do_run
-from .index import run_estimates, run_estimates_left, run_order, write_index
+from .index import estimates_whole_and_left, run_order, write_index
 from .progress import PROGRESS_EVERY, describe, eta_seconds, sim_progress, study_eta
 
 
@@ -22,8 +22,9 @@ def run_local(sd, jobs, order="longest", first=()):
     done0 = len(points) - len(todo)
     if done0:
         print(f"study {sd.study.name}: {done0} of {len(points)} runs complete already (skipped)", flush=True)
-    est = run_estimates(sd)       # whole runs: what the measured CPU of finished ones compares with
-    left = run_estimates_left(sd)  # what each has still to run: the order, and the queue's ETA
+    # est: whole runs, what the measured CPU of finished ones compares with;
+    # left: what each has still to run, for the order and the queue's ETA
+    est, left = estimates_whole_and_left(sd)
     todo = run_order(sd, todo, left, order, first)
     lock = threading.Lock()
     state = {"done": done0, "failed": 0, "running": 0, "left": len(todo), "cpu_done": 0.0, "est_done": 0.0,
