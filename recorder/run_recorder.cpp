@@ -219,13 +219,16 @@ bool RunRecorder::on_node_status(const node_status_t &m) {
 
 // Step f: the node had handled f + 1 frames (whole or lost), time the
 // simulation time of frame f; its done or failed replaces the record of
-// that step. wall_time: seconds since the first node status the recorder
-// heard (node clocks are the host's; the run info's own stamp is old in a
-// replay).
+// that step. wall_time: seconds since the first node status that made a
+// record, any node's (node clocks are the host's; the run info's own stamp
+// is old in a replay). Not since the first status heard: the statuses of
+// nodes waiting for frames race the run info, so which of them a recorder
+// takes depends on when it heard the run info, and a log played into a
+// recorder would not give the live recorder's clock.
 void RunRecorder::write_node(const node_status_t &m) {
-  if (!node_clock_zero_) node_clock_zero_ = m.utime;
   const auto at = at_frame(int64_t{m.frames_whole} + m.frames_lost - 1, ended(m.state));
   if (!at) return;
+  if (!node_clock_zero_) node_clock_zero_ = m.utime;
   const std::string base = "nodes/" + node_key(m.node) + "/";
   writer_->append_scalar(base + "frames_whole", *at, m.frames_whole);
   writer_->append_scalar(base + "frames_lost", *at, m.frames_lost);

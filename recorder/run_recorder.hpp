@@ -22,7 +22,7 @@
 //   /particles/all/{box, species, position, image} (frames only if kept)
 //   schedule/{frame_time, origin_frame, lag_time, pair_frame [origin][lag], cutoff_a}
 //   sim/<field>            the sim's status, with sim_time (its own simulation time)
-//   nodes/<node>/<field>   the node's frame counts, with wall_time (s since the first node status)
+//   nodes/<node>/<field>   the node's frame counts, with wall_time (s since the first node status recorded)
 //   <observable>[/a<cutoff>]/<field>  each result type's group, as its
 //     declaration in lcmtypes/<type>.lcm says (docs/run_h5.md): one group per
 //     cutoff if per cutoff; series, fixed axes and attributes
@@ -143,7 +143,7 @@ private:
   std::map<std::string, Node> nodes_;
   // The groups (and fixed datasets) written once: "msd", "overlap_cr/a0.6/", ...
   std::set<std::string> started_;
-  std::optional<int64_t> node_clock_zero_;      // utime of the first node status
+  std::optional<int64_t> node_clock_zero_;      // utime of the first node status recorded
   int write_errors_ = 0;
   int64_t rejected_ = 0, unauthenticated_ = 0;
   std::string last_unauthenticated_;

@@ -3,7 +3,7 @@
 wall-clock ones? Prints each difference; exit 0 if none.
 
 What a run's wall clock decides, and so is compared only where it is not the clock's:
-- nodes/<node>/wall_time (seconds since the first node status);
+- nodes/<node>/wall_time (seconds since the first node status recorded);
 - the sim's status (observables/sim): it is published once a second, so which frames have a record is the
   clock's; its last record (the sim's last word: Z, collision counts, frames) is compared, but
   collisions_per_second and eta_seconds, which are rates of the clock;

@@ -194,16 +194,17 @@ TEST(RunRecorder, CompleteRunIsWrittenAndMarkedComplete) {
   EXPECT_EQ(h5read::read<int32_t>(f, "/observables/sim/frames_published/value"),
             (std::vector<int32_t>{1, 2, 3}));
   // Node: step = frames handled - 1, time that frame's; done (2.7 s) replaces frame 2's;
-  // the wall clock in its own element, seconds since the first node status (1.1 s).
+  // the wall clock in its own element, seconds since the first node status recorded (1.2 s,
+  // frame 0's; the waiting one at 1.1 s made no record).
   EXPECT_EQ(h5read::read<int64_t>(f, "/observables/nodes/overlap/frames_whole/step"), steps);
   EXPECT_EQ(h5read::read<double>(f, "/observables/nodes/overlap/frames_whole/time"), frame_times);
   EXPECT_EQ(h5read::read<int32_t>(f, "/observables/nodes/overlap/frames_whole/value"),
             (std::vector<int32_t>{1, 2, 3}));
   const auto wall = h5read::read<double>(f, "/observables/nodes/overlap/wall_time/value");
   ASSERT_EQ(wall.size(), 3u);
-  EXPECT_NEAR(wall[0], 0.1, 1e-5);
-  EXPECT_NEAR(wall[1], 0.2, 1e-5);
-  EXPECT_NEAR(wall[2], 1.6, 1e-5);
+  EXPECT_NEAR(wall[0], 0.0, 1e-5);
+  EXPECT_NEAR(wall[1], 0.1, 1e-5);
+  EXPECT_NEAR(wall[2], 1.5, 1e-5);
 
   // Results: the final result (frame 2, like the last running one) replaces that record.
   const std::string q = "/observables/overlap/a1.8/q";
