@@ -341,6 +341,25 @@ def test_a_resumed_run_keeps_the_cpu_of_earlier_attempts_and_counts_a_killed_one
     assert carried_cpu({"state": "failed", "cpu_s": 99.0}, None) == (0.0, 0)
 
 
+def test_max_attempts_counts_run_lengths_not_resumptions():
+    """A run stopped and resumed goes on with its schedule: however many
+    times it was started, it has been given one run length, so a too short
+    result may still be run again with a longer one (max_attempts bounds the
+    lengths). Starting over gives a new length."""
+    from dynhet.study.runner import running_status
+    first = running_status({}, None, "pilot x 1.2")
+    assert first["attempts"] == 1 and first["schedules"] == 1
+    resumed = first
+    for _ in range(4):  # four stops, each resumed from its cut
+        resumed = running_status(dict(resumed, state="interrupted"), "cut", "pilot x 1.2")
+    assert resumed["attempts"] == 5 and resumed["schedules"] == 1
+    longer = running_status(dict(resumed, state="too_short"), None, "1.3 x the tau_alpha of the previous, too short attempt")
+    assert longer["attempts"] == 6 and longer["schedules"] == 2
+    # a status written before schedules were counted: one length if it ran at all
+    assert running_status({"state": "too_short", "attempts": 3}, None, "1.3 x")["schedules"] == 2
+    assert running_status({"state": "interrupted", "attempts": 3}, "cut", "pilot")["schedules"] == 1
+
+
 def test_a_run_queued_again_on_slurm_goes_by_what_it_was_before():
     """A Slurm submission writes "queued" over the status and keeps the state
     before in previous_state: a run killed while running counts its lost

@@ -46,12 +46,23 @@ def carried_cpu(old, resume):
     return float(old.get("cpu_s", 0.0)), int(old.get("cpu_unrecorded", 0)) + int(effective_state(old) == "running")
 
 
+def schedules_tried(old, resume):
+    """How many run lengths a run has been given, counting the attempt that
+    starts now: a resumed attempt goes on with its run's schedule, one that
+    starts over (the first, or after a failed or too short run) is given a
+    new one. max_attempts bounds these, not the resumptions: a run stopped
+    and resumed many times has still been run once. A status from before
+    this count (no "schedules") is taken as one schedule."""
+    before = int(old.get("schedules", 1 if old.get("attempts") else 0))
+    return max(before, 1) if resume is not None else before + 1
+
+
 def running_status(old, resume, source):
     """The status an attempt writes at its start (over old, the previous one)."""
     carried, unrecorded = carried_cpu(old, resume)
     status = {"state": "running", "host": socket.gethostname(), "pid": os.getpid(),
               "started": time.strftime("%Y-%m-%dT%H:%M:%S"), "attempts": int(old.get("attempts", 0)) + 1,
-              "tau_source": source or "scene", "cpu_s": carried}
+              "schedules": schedules_tried(old, resume), "tau_source": source or "scene", "cpu_s": carried}
     if unrecorded:
         status["cpu_unrecorded"] = unrecorded
     return status
@@ -217,7 +228,7 @@ def do_run(sd, p, log=print):
     write_status(d, status)
     if status["state"] == "complete":
         archive_run(sd, p, status, log)
-    if status["state"] == "too_short" and status["attempts"] < rl["max_attempts"] and not STOPPING.is_set():
+    if status["state"] == "too_short" and status["schedules"] < rl["max_attempts"] and not STOPPING.is_set():
         log(f"{st.run_name(p)}: {status['message']}; again with 1.3 tau_alpha")
         return do_run(sd, p, log)
     return status
