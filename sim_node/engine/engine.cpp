@@ -73,7 +73,6 @@ Engine::Engine(const Params& p) : p_(p), n_(p.n_particles), eps_(p.restitution),
   image_x_.assign(n_, 0);
   image_y_.assign(n_, 0);
   last_collision_.assign(n_, -kNever);
-  centre_.assign(n_, Centre{0, 0});
   nbr_.reset(static_cast<size_t>(n_));
 }
 
@@ -306,7 +305,8 @@ void Engine::predict(int i) {
   // root of |d + v t|^2 = R^2, d = r - c, in the cancellation-free form.
   double best = kNever;
   {
-    const double dx = a.x - centre_[i].x, dy = a.y - centre_[i].y;
+    const Centre c0 = centre(i);
+    const double dx = a.x - c0.x, dy = a.y - c0.y;
     const double R = 0.5 * skin_;
     const double b = dx * a.vx + dy * a.vy, v2 = a.vx * a.vx + a.vy * a.vy, c = dx * dx + dy * dy - R * R;
     if (c >= 0) {
@@ -502,7 +502,7 @@ double Engine::mean_neighbours() const {
 size_t Engine::memory_bytes() const {
   auto b = [](const auto& v) { return v.capacity() * sizeof(v[0]); };
   return b(part_) + b(species_by_id_) + b(species_) + b(id_) + b(image_x_) + b(image_y_) + b(last_collision_) +
-         cells_.bytes() + b(cell_x_) + b(cell_y_) + nbr_.bytes() + kick_beyond_.bytes() + b(centre_) + cal_.bytes();
+         cells_.bytes() + b(cell_x_) + b(cell_y_) + nbr_.bytes() + kick_beyond_.bytes() + cal_.bytes();
 }
 
 double Engine::max_overlap() const { return 1.0 - min_gap_ratio(); }

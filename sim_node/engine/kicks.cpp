@@ -147,8 +147,7 @@ Engine::KickPair Engine::next_kick_pair() const {
 }
 
 void Engine::prefetch_list(int i) const {
-  nbr_.prefetch(i);
-  __builtin_prefetch(&centre_[i]);
+  nbr_.prefetch(i); // the list and its centre
 }
 
 void Engine::prefetch_particle(int i) const {

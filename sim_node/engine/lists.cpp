@@ -13,13 +13,15 @@ namespace dynhet::engine {
 // Whether j is one of i's kick candidates. With the list scale at 1 (the
 // run), near() implies kick_near(): the same sums with kick_reach > 0 added.
 bool Engine::kick_near(int i, int j) const {
-  const double dx = min_image(centre_[i].x - centre_[j].x), dy = min_image(centre_[i].y - centre_[j].y);
+  const Centre a = centre(i), b = centre(j);
+  const double dx = min_image(a.x - b.x), dy = min_image(a.y - b.y);
   const double reach = radius_[species_[i]] + radius_[species_[j]] + p_.kick_reach + skin_ + list_margin_;
   return dx * dx + dy * dy <= reach * reach;
 }
 
 bool Engine::near(int i, int j) const {
-  const double dx = min_image(centre_[i].x - centre_[j].x), dy = min_image(centre_[i].y - centre_[j].y);
+  const Centre a = centre(i), b = centre(j);
+  const double dx = min_image(a.x - b.x), dy = min_image(a.y - b.y);
   const double reach = list_scale_ * (radius_[species_[i]] + radius_[species_[j]]) + skin_ + list_margin_;
   return dx * dx + dy * dy <= reach * reach;
 }
@@ -54,7 +56,7 @@ void Engine::build_lists() {
   kick_beyond_.reset(kl ? static_cast<size_t>(n_) : 0);
   for (long i = 0; i < n_; ++i) {
     wrap(static_cast<int>(i));
-    centre_[i] = Centre{part_[i].x, part_[i].y};
+    set_centre(static_cast<int>(i), part_[i].x, part_[i].y);
     nbr_.clear(i);
   }
   build_cells(); // over the centres
@@ -98,7 +100,7 @@ void Engine::rebuild(int i) {
     for (int k = 1; k <= l[0]; ++k) kick_beyond_.remove(l[k], i);
     kick_beyond_.clear(i);
   }
-  centre_[i] = Centre{part_[i].x, part_[i].y};
+  set_centre(i, part_[i].x, part_[i].y);
   if (cx != cell_x_[i] || cy != cell_y_[i]) {
     cell_remove(i);
     cell_insert(i, cx, cy);
@@ -111,7 +113,7 @@ void Engine::rebuild(int i) {
     if (nc + c[0] > kMax) throw std::logic_error("engine: more than 512 list candidates");
     for (int k = 1; k <= c[0]; ++k) {
       const int j = c[k];
-      __builtin_prefetch(&centre_[j]);
+      nbr_.prefetch(j); // its centre
       cand[nc++] = j;
     }
   }

@@ -270,7 +270,10 @@ Snapshot Engine::snapshot() const {
   }
   if (p_.tc > 0) s.last_collision = last_collision_;
   s.centres.resize(2 * static_cast<size_t>(n_));
-  for (long i = 0; i < n_; ++i) s.centres[2 * i] = centre_[i].x, s.centres[2 * i + 1] = centre_[i].y;
+  for (long i = 0; i < n_; ++i) {
+    const Centre c = centre(static_cast<int>(i));
+    s.centres[2 * i] = c.x, s.centres[2 * i + 1] = c.y;
+  }
   nbr_.save_packed(s.neighbours, true);
   if (kick_lists()) kick_beyond_.save_packed(s.kick_lists, true);
   cells_.save_packed(s.cells, false);
@@ -320,7 +323,6 @@ void Engine::restore_snapshot(const Snapshot& s) {
     if (part_[k].partner < kRebuild || part_[k].partner >= n_) refuse("a partner is out of range");
     if (!(part_[k].event_time >= now_)) refuse("an event lies in the past");
     species_[k] = species_by_id_[i];
-    centre_[k] = Centre{s.centres[2 * k], s.centres[2 * k + 1]};
   }
   id_ = s.id;
   image_x_ = std::move(image_x);
@@ -329,6 +331,7 @@ void Engine::restore_snapshot(const Snapshot& s) {
   else last_collision_.assign(n, -kNever);
   const auto limit = static_cast<int32_t>(n_);
   if (!nbr_.load_packed(n, s.neighbours, limit, true)) refuse("its neighbour lists are malformed");
+  for (size_t k = 0; k < n; ++k) set_centre(static_cast<int>(k), s.centres[2 * k], s.centres[2 * k + 1]);
   if (!kick_beyond_.load_packed(kick_lists() ? n : 0, s.kick_lists, limit, true))
     refuse("its kick lists are malformed");
   if (kick_lists() && !kick_lists_apart())

@@ -424,15 +424,18 @@ private:
   std::vector<int32_t> image_x_, image_y_;
   std::vector<double> last_collision_; // internal time of each particle's last collision; kept only with the TC model on
 
-  // Neighbour lists: row i holds the slots of i's neighbours.
-  Rows nbr_;
-  // Kick lists (kick_lists()): row i holds i's kick candidates beyond its
-  // neighbour list. About 5 at phi = 0.78, so a row stays one line.
-  Rows kick_beyond_;
+  // Neighbour lists: row i holds the slots of i's neighbours, and in its
+  // head i's list centre (where i was when the list was made): a
+  // prediction's skin exit and its pair tests read one line of the list.
   struct Centre {
     double x, y;
   };
-  std::vector<Centre> centre_;
+  Rows nbr_{sizeof(Centre) / sizeof(int32_t)};
+  Centre centre(int i) const { return nbr_.head<Centre>(static_cast<size_t>(i)); }
+  void set_centre(int i, double x, double y) { nbr_.set_head(static_cast<size_t>(i), Centre{x, y}); }
+  // Kick lists (kick_lists()): row i holds i's kick candidates beyond its
+  // neighbour list. About 5 at phi = 0.78, so a row stays one line.
+  Rows kick_beyond_;
   double skin_;         // absolute
   double list_scale_ = 1; // radii scale the lists hold for (below 1 only while compressing)
   double list_margin_;  // roundoff allowance in the list criterion

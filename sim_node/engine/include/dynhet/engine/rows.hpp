@@ -5,10 +5,15 @@
 // stride of every row, contents and their order kept. Removal swaps the last
 // member into the gap: the order within a row depends only on the sequence
 // of pushes and removals, not on the capacity. The engine's cells and
-// neighbour lists are both such rows.
+// neighbour lists are both such rows. A row may start with a head of
+// `head_words` int32 words of the owner's own data, before its count: the
+// neighbour lists keep their list centre there, so that a prediction reads
+// its list and its centre in one line (and a row of stride 16 then holds
+// up to 11 members before the stride doubles).
 #pragma once
 
 #include <algorithm>
+#include <cstring>
 #include <cstddef>
 #include <cstdint>
 #include <vector>
@@ -19,17 +24,26 @@ namespace dynhet::engine {
 
 class Rows {
 public:
-  // n empty rows at the current stride.
+  explicit Rows(int head_words = 0) : head_(head_words) {}
+  // n empty rows at the current stride (their heads zero).
   void reset(size_t n) {
     rows_ = n;
     data_.assign(n * stride_, 0);
   }
-  int32_t* row(size_t r) { return &data_[r * stride_]; }
-  const int32_t* row(size_t r) const { return &data_[r * stride_]; }
+  int32_t* row(size_t r) { return &data_[r * stride_ + head_]; }
+  const int32_t* row(size_t r) const { return &data_[r * stride_ + head_]; }
+  // The head of row r as a T (trivially copyable, at most head_words words).
+  template <class T> T head(size_t r) const {
+    T v;
+    std::memcpy(&v, &data_[r * stride_], sizeof v);
+    return v;
+  }
+  template <class T> void set_head(size_t r, const T& v) { std::memcpy(&data_[r * stride_], &v, sizeof v); }
+  int head_words() const { return head_; }
   void prefetch(size_t r) const { __builtin_prefetch(&data_[r * stride_]); }
-  void clear(size_t r) { data_[r * stride_] = 0; }
+  void clear(size_t r) { row(r)[0] = 0; }
   void push(size_t r, int32_t v) {
-    if (data_[r * stride_] == stride_ - 1) grow();
+    if (row(r)[0] == stride_ - head_ - 1) grow();
     int32_t* c = row(r);
     c[++c[0]] = v;
   }
@@ -140,9 +154,10 @@ private:
     stride_ *= 2;
     std::vector<int32_t, BigArrayAlloc<int32_t>> bigger(rows_ * stride_, 0);
     for (size_t r = 0; r < rows_; ++r)
-      std::copy(&data_[r * old], &data_[r * old] + data_[r * old] + 1, &bigger[r * stride_]);
+      std::copy(&data_[r * old], &data_[r * old] + head_ + data_[r * old + head_] + 1, &bigger[r * stride_]);
     data_.swap(bigger);
   }
+  int head_ = 0;
   size_t rows_ = 0;
   int stride_ = 16;
   std::vector<int32_t, BigArrayAlloc<int32_t>> data_;
