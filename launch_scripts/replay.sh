@@ -194,10 +194,8 @@ wait $rec || { echo "replay: recorder failed; log $out/recorder.log" >&2; tail -
 rec=""
 grep -h -E "tau_alpha|frames whole" "$out"/*_node.log >&2 || true
 if [[ -f $out/run.h5 ]]; then
-  for obs in chi4 msd displacement clusters s4; do # plots of the observables the run has
-    /usr/bin/python3 -c "import h5py,sys; sys.exit(0 if 'observables/$obs' in h5py.File('$out/run.h5','r') else 1)" 2>/dev/null &&
-      { /usr/bin/python3 "$root/launch_scripts/plot_$obs.py" "$out/run.h5" "$out/$obs.png" || status=1; }
-  done
-  /usr/bin/python3 "$root/launch_scripts/plot_overlap.py" "$out/run.h5" "$out/overlap.png" || status=1
+  # every observable's figure that the run has, and overlap.png, in one
+  # process (as run_scene.sh draws them)
+  /usr/bin/python3 "$root/launch_scripts/plot_run.py" "$out/run.h5" "$out" || status=1
 fi
 exit $status
