@@ -83,9 +83,19 @@ class Observable:
     def __getitem__(self, name):
         """The dataset's final record (a series) or itself (fixed): an array,
         or a Python float or int where it is one number."""
-        if name not in self._g:
+        d = self._g.get(name)
+        if d is None:
             raise KeyError(f"{self.name}: no dataset {name!r}; it has {', '.join(self.names())}")
-        d = self._g[name]
+        return self._final(d)
+
+    def get(self, name, default=None):
+        """self[name], or default where the group has no such dataset (one
+        lookup in the file, where `name in` and then [name] take two)."""
+        d = self._g.get(name)
+        return default if d is None else self._final(d)
+
+    @staticmethod
+    def _final(d):
         if isinstance(d, h5py.Group):  # an H5MD time series: the last record
             v = d["value"]
             return _scalar(v[-1] if v.shape[0] else np.full(v.shape[1:], np.nan))

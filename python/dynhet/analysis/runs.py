@@ -11,7 +11,7 @@ from ..run import open_run
 def last(g, name):
     """The final record of a dataset of an Observable (dynhet.run), None if
     the group lacks it."""
-    return g[name] if name in g else None
+    return g.get(name)
 
 
 def fnum(v):
