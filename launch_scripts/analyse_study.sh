@@ -8,6 +8,7 @@
 #
 # Usage: launch_scripts/analyse_study.sh STUDY_DIR [--also STUDY_DIR2 ...] [--table docs/reproduction.md]
 #          [--finite-size docs/finite_size.md] [--discussion FILE] [--restate OLD.md [--restate-via LABEL=T.md ...]]
+#          [--no-figures]
 #   --also DIR         add the complete runs of another study (e.g. other N)
 #   --table FILE       write the reproduction table there as well
 #   --finite-size FILE write the finite-size report there as well (figures in finite_size/ beside it)
@@ -15,6 +16,7 @@
 #   --restate OLD.md   append, for each row an earlier table judged "differs", its verdict now
 #   --restate-via LABEL=T.md  a table made in between (repeatable, in order): its verdicts in a
 #                      column, and at which step each verdict moved
+#   --no-figures       the text and study.h5 alone: no figure drawn (the documents name the ones it would draw)
 #   --fresh            a --table or --finite-size FILE that exists and is not a document this
 #                      analysis wrote (refused without it) is moved aside to FILE.old-<time>
 # What it writes into STUDY_DIR, and a --table or --finite-size FILE it wrote before (its

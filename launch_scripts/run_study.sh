@@ -25,6 +25,11 @@
 #   --fresh            the --out directory holds another study (or anything
 #                      without a study.toml, which is refused): move what it
 #                      holds into DIR/old-<time>/ and start this study there
+#   --no-figures       the study analysis at the end (analyse_study.sh) writes
+#                      study.h5, reproduction.md and finite_size.md but draws
+#                      no figure (a fraction of its time; analyse_study.sh
+#                      STUDY_DIR draws them later); on Slurm, the index job's
+#                      analysis too
 #   --no-build         skip setup.sh (packages and build)
 # The study directory holds study.toml (a copy; a study file that now says
 # something else is refused, one whose comments or spacing changed is

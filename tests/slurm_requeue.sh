@@ -37,7 +37,7 @@ seed = [7]
 tau_alpha = "scene"
 TOML
 export DYNHET_TEST_SIM_DELAY=1.5
-bash "$root/launch_scripts/run_study.sh" "$tmp/requeue.toml" --no-build --executor slurm --out "$tmp/s" --time=1 \
+bash "$root/launch_scripts/run_study.sh" "$tmp/requeue.toml" --no-build --no-figures --executor slurm --out "$tmp/s" --time=1 \
   --signal-lead 45 >"$tmp/s.out" 2>&1 || { cat "$tmp/s.out"; tail -20 "$d"/*.log; exit 1; }
 ( # the administrator: a requeued task waiting out its hold may start now,
   # once the node has let go of its previous allocation. A task that
@@ -67,7 +67,7 @@ bash "$root/launch_scripts/run_study.sh" "$tmp/requeue.toml" --no-build --execut
 pids+=($!)
 check 'grep -q "1 runs submitted as Slurm job array" "$tmp/s.out"' "one task submitted, with a time limit of 1 minute"
 # Meanwhile the same study on the local executor (it sleeps, as the task does).
-bash "$root/launch_scripts/run_study.sh" "$tmp/requeue.toml" --no-build --out "$tmp/l" --jobs 1 >"$tmp/l.out" 2>&1 ||
+bash "$root/launch_scripts/run_study.sh" "$tmp/requeue.toml" --no-build --no-figures --out "$tmp/l" --jobs 1 >"$tmp/l.out" 2>&1 ||
   { cat "$tmp/l.out"; exit 1; }
 done_=0
 for _ in $(seq 2400); do # 8 minutes at most

@@ -26,25 +26,27 @@ wait_queue() { # until the queue is empty, at most 6 minutes
   done
   echo "FAIL $1 did not finish in 6 min"; squeue; exit 1
 }
-bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --executor slurm --out "$tmp/s" \
+bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --no-figures --executor slurm --out "$tmp/s" \
   --time=10 >"$tmp/s.out" 2>&1 || { cat "$tmp/s.out"; tail -20 "$d"/*.log; exit 1; }
 cat "$tmp/s.out"
 check 'grep -q "4 runs submitted as Slurm job array" "$tmp/s.out"' "one job array of 4 tasks and an index job submitted"
 # Meanwhile the same study on the local executor.
-bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --out "$tmp/l" --jobs 1 >"$tmp/l.out" 2>&1 ||
+bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --no-figures --out "$tmp/l" --jobs 1 >"$tmp/l.out" 2>&1 ||
   { cat "$tmp/l.out"; exit 1; }
 wait_queue "the Slurm jobs"
 check '[[ $(grep -c "state = \"complete\"" "$tmp/s/index.toml") == 4 ]]' "the index job wrote an index with 4 complete runs"
 check 'ls "$tmp"/s/slurm/task-*_0.out >/dev/null' "each task's log is in the study directory"
+check 'grep -q -- "--analyse --no-figures" "$tmp"/s/slurm/index-*.sbatch && [[ -f $tmp/s/study.h5 ]] && ! ls "$tmp"/s/figures/*.png >/dev/null 2>&1' \
+  "run_study.sh --no-figures reaches the index job: its analysis wrote study.h5, no figure"
 /usr/bin/python3 "$root/tests/compare_studies.py" "$tmp/l" "$tmp/s" || fail=1
 # Again: nothing left to submit.
-bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --executor slurm --out "$tmp/s" >"$tmp/s2.out" 2>&1
+bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --no-figures --executor slurm --out "$tmp/s" >"$tmp/s2.out" 2>&1
 check 'grep -q "nothing to submit" "$tmp/s2.out"' "submitted again: nothing to submit"
 # A run that failed, submitted again, starts over: the queue keeps what it was
 # (previous_state), it is not resumed from its failed attempt's checkpoints.
 run=$(ls "$tmp/s/runs" | head -1)
 sed -i 's/^state = "complete"/state = "failed"/' "$tmp/s/runs/$run/status.toml"
-bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --executor slurm --out "$tmp/s" \
+bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --no-figures --executor slurm --out "$tmp/s" \
   --time=10 >"$tmp/s3.out" 2>&1 || { cat "$tmp/s3.out"; exit 1; }
 check 'grep -q "1 runs submitted as Slurm job array" "$tmp/s3.out"' "the failed run submitted again, alone"
 wait_queue "the resubmitted job"
@@ -58,7 +60,7 @@ check '[[ $(grep -c "state = \"complete\"" "$tmp/s/index.toml") == 4 ]]' "the in
 runs=($(ls "$tmp/s/runs"))
 sed -i 's/^state = "complete"/state = "failed"/' "$tmp/s/runs/${runs[0]}/status.toml"
 rm -rf "$tmp/s/runs/${runs[1]}" && touch "$tmp/s/runs/${runs[1]}"
-rc=0; bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --executor slurm --out "$tmp/s" \
+rc=0; bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --no-figures --executor slurm --out "$tmp/s" \
   --time=10 >"$tmp/s4.out" 2>&1 || rc=$?
 check '[[ $rc != 0 ]]' "a submission that cannot write its runs' statuses fails (exit $rc)"
 check '[[ -z $(squeue -h -o %i 2>/dev/null) ]]' "and leaves no job in the queue (its held array cancelled)"

@@ -12,6 +12,10 @@ export BUILD_DIR=$build
 tmp=$(mktemp -d)
 trap 'pkill -TERM -f "study.py run .*$tmp" 2>/dev/null || true; rm -rf "$tmp"' EXIT
 study=(bash "$root/launch_scripts/run_study.sh" --no-build)
+# Study a's analysis draws its figures (tests/check_study_analysis.py checks
+# them); every later study's analysis is of numbers compared, not figures:
+# --no-figures, the text and study.h5 alone.
+nofig=(--no-figures)
 fail=0
 check() { if eval "$1"; then echo "ok   $2"; else echo "FAIL $2"; fail=1; fi; }
 
@@ -69,12 +73,12 @@ check '[[ $rc == 2 ]] && grep -q "is not a study directory nor a results archive
 
 stamp=$(stat -c %Y "$tmp"/a/runs/*/status.toml | sort | tail -1)
 sleep 1
-"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/a" --jobs 2 >"$tmp/a2.out" 2>&1
+"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/a" --jobs 2 "${nofig[@]}" >"$tmp/a2.out" 2>&1
 check 'grep -q "4 of 4 runs complete already (skipped)" "$tmp/a2.out"' "run again: every run skipped"
 check '[[ $(stat -c %Y "$tmp"/a/runs/*/status.toml | sort | tail -1) == "$stamp" ]]' "run again: no run touched"
 
 # Stop the study (SIGTERM, as a shutdown does) once the first run is in production.
-"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/b" --jobs 1 >"$tmp/b.out" 2>&1 &
+"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/b" --jobs 1 "${nofig[@]}" >"$tmp/b.out" 2>&1 &
 runner=$!
 for _ in $(seq 600); do
   ls "$tmp"/b/runs/*/checkpoint_before_frames.h5 >/dev/null 2>&1 && grep -qs "frames" "$tmp"/b/runs/*/sim_node.log &&
@@ -92,20 +96,22 @@ check '! grep -q "Traceback" "$tmp/b.out"' "a second SIGTERM during the stop: no
 check 'grep -qs "state = \"interrupted\"" "$tmp"/b/runs/*/status.toml' "the stopped run is marked interrupted"
 stopped=$(grep -ls "state = \"interrupted\"" "$tmp"/b/runs/*/status.toml | head -1)
 cpu_before=$(sed -n 's/^cpu_s = //p' "$stopped")
-"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/b" --jobs 2 >"$tmp/b2.out" 2>&1 || { cat "$tmp/b2.out"; exit 1; }
+"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/b" --jobs 2 "${nofig[@]}" >"$tmp/b2.out" 2>&1 || { cat "$tmp/b2.out"; exit 1; }
 cpu_after=$(sed -n 's/^cpu_s = //p' "$stopped") cpu_attempt=$(sed -n 's/^cpu_s_attempt = //p' "$stopped")
 check 'awk -v b="$cpu_before" -v a="$cpu_after" -v t="$cpu_attempt" "BEGIN { exit !(b > 0 && t > 0 && (a - b - t) ^ 2 < 1e-12) }"' \
   "the resumed run's CPU is its two attempts' ($cpu_before + $cpu_attempt = $cpu_after s)"
 check 'grep -qE "was interrupted; resuming from (checkpoint cut [0-9]+( \\(its sim last said: (equilibrate|production) t = )?|.*checkpoint_before_frames.h5)" "$tmp/b2.out"' \
   "run again: the interrupted run resumes from its last checkpoint cut (or, before any, from its state before the frames)"
 check 'grep -q "4 of 4 runs complete, 0 failed" "$tmp/b2.out"' "run again: 4 of 4 complete"
+check 'grep -q "analyse_study: .* rows" "$tmp/b2.out" && [[ -f $tmp/b/study.h5 && -f $tmp/b/reproduction.md ]] &&
+  ! ls "$tmp"/b/figures/*.png >/dev/null 2>&1' "run_study.sh --no-figures: the analysis wrote study.h5 and its table, no figure"
 /usr/bin/python3 "$root/tests/compare_studies.py" "$tmp/a" "$tmp/b" || fail=1
 # A run marked failed is run again from the start (run_scene.sh --fresh, its
 # old cuts and file gone), not resumed from a cut that would fail again,
 # and comes out as before, bit for bit.
 failed_run=$(ls -d "$tmp"/b/runs/*/ | head -1)
 sed -i 's/^state = .*/state = "failed"/' "$failed_run/status.toml"
-"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/b" --jobs 2 >"$tmp/b3.out" 2>&1 || { cat "$tmp/b3.out"; exit 1; }
+"${study[@]}" "$root/studies/tiny.toml" --out "$tmp/b" --jobs 2 "${nofig[@]}" >"$tmp/b3.out" 2>&1 || { cat "$tmp/b3.out"; exit 1; }
 check 'grep -q "failed before .*running it again" "$tmp/b3.out" && grep -q "3 of 4 runs complete already" "$tmp/b3.out" &&
   tail -n +"$(grep -n "^# " "$failed_run/run_scene.log" | tail -1 | cut -d: -f1)" "$failed_run/run_scene.log" | head -1 | grep -q -- "--fresh" &&
   grep -q "4 of 4 runs complete, 0 failed" "$tmp/b3.out"' \
@@ -116,7 +122,7 @@ check 'grep -q "failed before .*running it again" "$tmp/b3.out" && grep -q "3 of
 # state of its dynamics and ends bit for bit like the runs of study a.
 sed -e "s|\"../scenes/tiny.toml\"|\"$root/scenes/tiny.toml\"\nprepared_states = \"equilibrated\"|" \
   "$root/studies/tiny.toml" >"$tmp/eq.toml"
-"${study[@]}" "$tmp/eq.toml" --out "$tmp/e" --jobs 2 >"$tmp/e.out" 2>&1 || { cat "$tmp/e.out"; exit 1; }
+"${study[@]}" "$tmp/eq.toml" --out "$tmp/e" --jobs 2 "${nofig[@]}" >"$tmp/e.out" 2>&1 || { cat "$tmp/e.out"; exit 1; }
 check '[[ $(grep -l "initial_state = .*states/eq_n.*_t10.h5" "$tmp"/e/runs/*/scene.toml | wc -l) == 4 ]] &&
   grep -q "equilibrated state .* from t = 0 to 10 " "$tmp"/e/states/eq_*.log' \
   "prepared_states = \"equilibrated\": each run starts from its state equilibrated to t = 10"
@@ -152,7 +158,7 @@ check '[[ $rc == 2 ]] && grep -q "phi0.9500.*system.packing_fraction" "$tmp/dens
 # tau_alpha instead of running it again, and says so.
 sed -e '/^\[\[override\]\]/,$d' -e 's/^seed = \[1, 2\]/seed = [1]\nn_particles = [300, 400]/' \
   -e 's/^packing_fraction = .*/packing_fraction = [0.60]/' -e "s|\.\./scenes/|$root/scenes/|" "$root/studies/tiny.toml" >"$tmp/shared.toml"
-"${study[@]}" "$tmp/shared.toml" --out "$tmp/shared" --jobs 1 >"$tmp/shared.out" 2>&1 && rc=0 || rc=$?
+"${study[@]}" "$tmp/shared.toml" --out "$tmp/shared" --jobs 1 "${nofig[@]}" >"$tmp/shared.out" 2>&1 && rc=0 || rc=$?
 check '[[ $rc == 0 ]] && grep -q "2 of 2 runs complete, 0 failed" "$tmp/shared.out"' "two series sharing a pilot system: both runs complete"
 check '[[ $(ls "$tmp"/shared/pilots/*/run.h5 | wc -l) == 1 ]]' "the shared pilot system ran once (one pilot run.h5)"
 check '/usr/bin/python3 -c "

@@ -4,10 +4,12 @@ engine. A run stays what it is (launch_scripts/run_scene.sh: one scene, its
 processes on a private bus, one run.h5); a study only writes scenes, starts
 runs, reads their files and keeps their status on disk.
 
-  study.py run STUDY.toml [--executor local|slurm] [--jobs K] [--out DIR] [--dry-run]
+  study.py run STUDY.toml [--executor local|slurm] [--jobs K] [--out DIR] [--dry-run] [--no-figures]
                           [--partition P] [--time T] [--mem M] [--sbatch ARG]...
   study.py task DIR NAME      one run of a study directory (what a Slurm task runs)
-  study.py index DIR          write DIR/index.toml from the runs' status files
+  study.py index DIR [--analyse [--no-figures]]
+                              write DIR/index.toml from the runs' status files (and then, every
+                              run complete, the study analysis: what the Slurm index job runs)
   study.py results [DIR]      write DIR/README.md (default results/): a line per archived study
   study.py archive DIR [--to ARCHIVE]
                               reduce every complete run of study directory DIR into its results
@@ -58,6 +60,9 @@ def main():
     r.add_argument("--archive", metavar="DIR",
                    help="the results archive each complete run is reduced into (default: the study file's "
                         "[study] archive, relative to the repository; none if it names none)")
+    r.add_argument("--no-figures", action="store_true",
+                   help="the study analysis at the end writes its text and study.h5 but draws no figure "
+                        "(analyse_study.sh --no-figures); on Slurm, the index job's analysis too")
     r.add_argument("--partition")
     r.add_argument("--time")
     r.add_argument("--mem")
@@ -75,12 +80,15 @@ def main():
     i = sub.add_parser("index")
     i.add_argument("dir")
     i.add_argument("--analyse", action="store_true", help="then, if every run is complete, the study analysis")
+    i.add_argument("--no-figures", action="store_true", help="with --analyse: the analysis draws no figure")
     ar = sub.add_parser("archive")
     ar.add_argument("dir")
     ar.add_argument("--to", metavar="ARCHIVE", help="the archive directory (default: the study's own)")
     rs = sub.add_parser("results")
     rs.add_argument("dir", nargs="?", default=os.path.join(ROOT, "results"))
     a = ap.parse_args()
+    if a.cmd == "index" and a.no_figures and not a.analyse:
+        ap.error("index --no-figures: the figures are the analysis's, give --analyse as well")
     if a.cmd == "results":
         from ..archive import results_readme
         write_atomic(os.path.join(a.dir, "README.md"), results_readme(a.dir))
@@ -112,7 +120,8 @@ def main():
                 print(f"run_study: --fresh: what {sd.dir} held is now in {moved}", flush=True)
             running = True
             if a.executor == "local":
-                return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2), a.order, a.first)
+                return run_local(sd, a.jobs or max(1, (os.cpu_count() or 2) // 2), a.order, a.first,
+                                 figures=not a.no_figures)
             return run_slurm(sd, a)
         sd = StudyDir(Study(os.path.join(a.dir, "study.toml"), os.path.join(a.dir, "base_scene.toml")), a.dir,
                       os.path.abspath(a.to) if getattr(a, "to", None) else None)
@@ -128,7 +137,7 @@ def main():
         print(f"study {sd.study.name}: " + ", ".join(f"{v} {k}" for k, v in sorted(states.items())))
         if set(states) != {"complete"}:
             return 1
-        return analyse(sd) if a.analyse else 0
+        return analyse(sd, figures=not a.no_figures) if a.analyse else 0
     except StudyError as e:
         print(f"run_study: {e}", file=sys.stderr)
         return 1 if running else 2

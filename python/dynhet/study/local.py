@@ -16,7 +16,7 @@ from .index import estimates_whole_and_left, run_order, write_index
 from .progress import PROGRESS_EVERY, describe, eta_seconds, sim_progress, study_eta
 
 
-def run_local(sd, jobs, order="longest", first=()):
+def run_local(sd, jobs, order="longest", first=(), figures=True):
     points = [p for p in sd.study.points()]
     todo = [p for p in points if read_status(sd.run_dir(p)).get("state") != "complete"]
     done0 = len(points) - len(todo)
@@ -130,16 +130,18 @@ def run_local(sd, jobs, order="longest", first=()):
         print(f"  failed: {name}: {msg}", flush=True)
     if state["failed"]:
         return 1
-    return analyse(sd)
+    return analyse(sd, figures)
 
 
-def analyse(sd):
+def analyse(sd, figures=True):
     """The study analysis (analyse_study.py) once every run is complete:
-    study.h5, figures/ and reproduction.md in the study directory."""
+    study.h5, figures/ and reproduction.md in the study directory (without
+    figures, run_study.sh --no-figures: the text and study.h5 alone)."""
     script = os.path.join(ROOT, "launch_scripts", "analyse_study.py")
-    print(f"study {sd.study.name}: analysing ({os.path.relpath(script, ROOT)} {sd.dir})", flush=True)
-    rc = subprocess.run([sys.executable, script, sd.dir]).returncode
+    args = [sd.dir] + ([] if figures else ["--no-figures"])
+    print(f"study {sd.study.name}: analysing ({os.path.relpath(script, ROOT)} {' '.join(args)})", flush=True)
+    rc = subprocess.run([sys.executable, script, *args]).returncode
     if rc:
         print(f"study {sd.study.name}: the analysis failed (exit {rc}); the runs are complete, "
-              f"run launch_scripts/analyse_study.sh {sd.dir} again after a fix", flush=True)
+              f"run launch_scripts/analyse_study.sh {' '.join(args)} again after a fix", flush=True)
     return 1 if rc else 0

@@ -81,7 +81,7 @@ def run_slurm(sd, a):
         "#!/bin/bash", f"#SBATCH --job-name=dynhet-{sd.study.name}-index",
         f"#SBATCH --output={sdir}/index-%j.out", *common,
         "# After every task: the study's index (and what must follow the runs).",
-        f"exec /usr/bin/python3 {me} index {sd.dir} --analyse", ""]))
+        f"exec /usr/bin/python3 {me} index {sd.dir} --analyse" + (" --no-figures" if a.no_figures else ""), ""]))
     # Held until every run's status says queued: a task that started at once
     # would have its "running" overwritten by this loop's "queued".
     r = subprocess.run(["sbatch", "--parsable", "--hold", array], capture_output=True, text=True)
