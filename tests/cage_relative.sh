@@ -62,7 +62,26 @@ bash "$root/launch_scripts/run_scene.sh" "$tmp/cuts.toml" --out "$tmp/term" --ru
   --test-node-delay 0.1 >>"$tmp/term.log" 2>&1 &
 pid=$!
 set +m
-sleep 2.5
+# The SIGTERM once the run is in production with a whole checkpoint cut
+# (checkpoints/cut-*/WHOLE, and the nodes' parts at frame boundaries in
+# checkpoints/frames/), so that the second command has a cut to resume
+# from however long the processes take to start; at most 90 s.
+in_cut=0
+for _ in $(seq 1800); do
+  if ls "$tmp"/term/checkpoints/cut-*/WHOLE >/dev/null 2>&1 && ls "$tmp"/term/checkpoints/frames/*.part >/dev/null 2>&1; then
+    in_cut=1
+    break
+  fi
+  kill -0 "$pid" 2>/dev/null || break
+  sleep 0.05
+done
+if ((!in_cut)); then
+  echo "FAIL no whole checkpoint cut in production within 90 s of the start (or the run ended first): no SIGTERM sent"
+  kill -TERM -- -$pid 2>/dev/null || true
+  wait $pid || true
+  tail -20 "$tmp/term.log"
+  exit 1
+fi
 kill -TERM -- -$pid 2>/dev/null || true
 set +e; wait $pid; rc=$?; set -e
 check '[[ $rc == 75 ]]' "SIGTERM mid-production: run_scene.sh exits 75, resumable (got $rc)"

@@ -80,9 +80,30 @@ check 'complete "$tmp/ref/run.h5"' "reference run complete"
 victims=(sim_node overlap_node s4_node clusters_node recorder all)
 out=$tmp/killed
 for round in 1 2 3 4; do
+  touch "$tmp/round$round.start"
   start_run "$out"
-  t=$(( 1000 + RANDOM % 2500 )) # ms: within the production (a resumed segment lasts seconds)
+  t=$(( RANDOM % 1500 )) # ms after this segment's first whole cut: within the production (it lasts seconds)
   v=${victims[RANDOM % ${#victims[@]}]}
+  # The kill waits until this segment is in production (the processes'
+  # parts at its frame boundaries in checkpoints/frames/), its victim
+  # running and a whole cut of its own written (a cut to resume from,
+  # whatever the load does to the start); at most 90 s, or until the run
+  # has ended.
+  ready=0
+  for _ in $(seq 1800); do
+    if [[ -n $(find "$out/checkpoints" -path "*/cut-*/WHOLE" -newer "$tmp/round$round.start" 2>/dev/null | head -1) &&
+      -n $(find "$out/checkpoints/frames" -name "*.part" -newer "$tmp/round$round.start" 2>/dev/null | head -1) &&
+      -n $(pid_of "${v/all/sim_node}" "$out") ]]; then
+      ready=1
+      break
+    fi
+    kill -0 "$run_pid" 2>/dev/null || { ready=ended; break; }
+    sleep 0.05
+  done
+  if [[ $ready == 0 ]]; then
+    echo "FAIL round $round: no whole cut of this segment with $v running within 90 s of its start"
+    fail=1
+  fi
   sleep "$(printf '%d.%03d' $((t / 1000)) $((t % 1000)))"
   if [[ $v == all ]]; then
     kill -KILL -- -$run_pid 2>/dev/null || true
@@ -93,7 +114,7 @@ for round in 1 2 3 4; do
   set +e; wait $run_pid; rc=$?; set -e
   # (no whole cut: the run ended before the kill, or its cuts were off; the checks below then say so)
   cut=$(ls -d "$out"/checkpoints/cut-*/WHOLE 2>/dev/null | tail -1 | sed 's/.*cut-0*\([0-9]*\)\/WHOLE/\1/' || true)
-  echo "     round $round: SIGKILL of $v at $t ms: run_scene exit $rc, newest whole cut ${cut:-none}"
+  echo "     round $round: SIGKILL of $v $t ms after the segment's first whole cut$([[ $ready != ended ]] || echo ' (the run had ended before it)'): run_scene exit $rc, newest whole cut ${cut:-none}"
 done
 finish_run "$out" || true
 check 'complete "$out/run.h5"' "killed four times: the run completes"
