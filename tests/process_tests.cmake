@@ -45,7 +45,7 @@ set_tests_properties(stress_engine_elastic_1e8 PROPERTIES LABELS stress TIMEOUT 
 # The study runner, local executor: studies/tiny.toml end to end, skipped
 # when run again, an interrupted study resumed to the same results bit for
 # bit, changed and invalid studies refused, two series sharing one pilot
-# (tests/study_local.sh). About 400 s beside the rest of the suite on 2 cores.
+# (tests/study_local.sh). About 100 s beside the rest of the suite on 2 cores.
 add_test(NAME study_local_tiny
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/study_local.sh ${PROJECT_SOURCE_DIR} ${CMAKE_BINARY_DIR})
 set_tests_properties(study_local_tiny PROPERTIES LABELS process TIMEOUT 700)
