@@ -79,6 +79,7 @@ check 'complete "$tmp/ref/run.h5"' "reference run complete"
 # 2. SIGKILL of random processes at random times, four times.
 victims=(sim_node overlap_node s4_node clusters_node recorder all)
 out=$tmp/killed
+killed=0 # rounds whose run was killed (not ended before the kill)
 for round in 1 2 3 4; do
   touch "$tmp/round$round.start"
   start_run "$out"
@@ -112,13 +113,17 @@ for round in 1 2 3 4; do
     if [[ -n $p ]]; then kill -KILL "$p"; fi
   fi
   set +e; wait $run_pid; rc=$?; set -e
+  ((rc == 0)) || killed=$((killed + 1))
   # (no whole cut: the run ended before the kill, or its cuts were off; the checks below then say so)
   cut=$(ls -d "$out"/checkpoints/cut-*/WHOLE 2>/dev/null | tail -1 | sed 's/.*cut-0*\([0-9]*\)\/WHOLE/\1/' || true)
   echo "     round $round: SIGKILL of $v $t ms after the segment's first whole cut$([[ $ready != ended ]] || echo ' (the run had ended before it)'): run_scene exit $rc, newest whole cut ${cut:-none}"
 done
 finish_run "$out" || true
-check 'complete "$out/run.h5"' "killed four times: the run completes"
-check 'same "$out"' "killed four times and resumed: run.h5 equals the uninterrupted run's"
+# Most rounds must have killed a running run (one may find it ended on a
+# starved machine), or the checks below would say little.
+check '((killed >= 3))' "at least 3 of the 4 rounds killed the run before it ended ($killed did)"
+check 'complete "$out/run.h5"' "killed $killed times: the run completes"
+check 'same "$out"' "killed $killed times and resumed: run.h5 equals the uninterrupted run's"
 check '[[ $(grep -h "resumed from cut" "$out"/*_node.log "$out"/recorder.log | wc -l) -ge 4 ]]' "the nodes and the recorder resumed from cuts"
 
 # 3. SIGKILL while a part is written.

@@ -345,7 +345,7 @@ def test_max_attempts_counts_run_lengths_not_resumptions():
     """A run stopped and resumed goes on with its schedule: however many
     times it was started, it has been given one run length, so a too short
     result may still be run again with a longer one (max_attempts bounds the
-    lengths). Starting over gives a new length."""
+    lengths). Only a start after a too short result gives a new length."""
     from dynhet.study.runner import running_status
     first = running_status({}, None, "pilot x 1.2")
     assert first["attempts"] == 1 and first["schedules"] == 1
@@ -355,9 +355,14 @@ def test_max_attempts_counts_run_lengths_not_resumptions():
     assert resumed["attempts"] == 5 and resumed["schedules"] == 1
     longer = running_status(dict(resumed, state="too_short"), None, "1.3 x the tau_alpha of the previous, too short attempt")
     assert longer["attempts"] == 6 and longer["schedules"] == 2
+    # started over with the same length: interrupted before its first checkpoint, or after a failure
+    assert running_status(dict(longer, state="interrupted"), None, "pilot")["schedules"] == 2
+    assert running_status(dict(longer, state="queued", previous_state="running"), None, "pilot")["schedules"] == 2
+    assert running_status(dict(longer, state="failed"), None, "pilot")["schedules"] == 2
     # a status written before schedules were counted: one length if it ran at all
     assert running_status({"state": "too_short", "attempts": 3}, None, "1.3 x")["schedules"] == 2
     assert running_status({"state": "interrupted", "attempts": 3}, "cut", "pilot")["schedules"] == 1
+    assert running_status({"state": "interrupted", "attempts": 3}, None, "pilot")["schedules"] == 1
 
 
 def test_a_run_queued_again_on_slurm_goes_by_what_it_was_before():

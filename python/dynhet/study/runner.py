@@ -10,6 +10,10 @@ from .rundir import read_status, run_h5_result, write_status
 from .children import RESUMABLE, STOPPING, newest_whole_cut, run_scene
 from .progress import sim_progress
 from .states import equilibrated_state, pid_alive, pilot, prepared_state
+
+# The source of a run's tau_alpha estimate when it runs again after a too
+# short attempt.
+LONGER = "1.3 x the tau_alpha of the previous, too short attempt"
 from .archiving import archive_run, restored_run
 
 
@@ -46,15 +50,16 @@ def carried_cpu(old, resume):
     return float(old.get("cpu_s", 0.0)), int(old.get("cpu_unrecorded", 0)) + int(effective_state(old) == "running")
 
 
-def schedules_tried(old, resume):
+def schedules_tried(old):
     """How many run lengths a run has been given, counting the attempt that
-    starts now: a resumed attempt goes on with its run's schedule, one that
-    starts over (the first, or after a failed or too short run) is given a
-    new one. max_attempts bounds these, not the resumptions: a run stopped
-    and resumed many times has still been run once. A status from before
-    this count (no "schedules") is taken as one schedule."""
+    starts now: the first attempt gives it one, and each start after a too
+    short result a longer one; any other attempt (a resumption, a start over
+    after an interruption before the first checkpoint, or after a failure)
+    goes on with the length it had. max_attempts bounds these, not the
+    starts: a run stopped and resumed many times has been given one length.
+    A status from before this count (no "schedules") is taken as one."""
     before = int(old.get("schedules", 1 if old.get("attempts") else 0))
-    return max(before, 1) if resume is not None else before + 1
+    return before + 1 if before == 0 or effective_state(old) == "too_short" else before
 
 
 def running_status(old, resume, source):
@@ -62,7 +67,7 @@ def running_status(old, resume, source):
     carried, unrecorded = carried_cpu(old, resume)
     status = {"state": "running", "host": socket.gethostname(), "pid": os.getpid(),
               "started": time.strftime("%Y-%m-%dT%H:%M:%S"), "attempts": int(old.get("attempts", 0)) + 1,
-              "schedules": schedules_tried(old, resume), "tau_source": source or "scene", "cpu_s": carried}
+              "schedules": schedules_tried(old), "tau_source": source or "scene", "cpu_s": carried}
     if unrecorded:
         status["cpu_unrecorded"] = unrecorded
     return status
@@ -131,7 +136,9 @@ def do_run(sd, p, log=print):
         if rl["tau_alpha"] == "scene":
             tau_est, source = None, "scene"
         elif state == "too_short" and old.get("tau_alpha"):
-            tau_est, source = 1.3 * old["tau_alpha"], "1.3 x the tau_alpha of the previous, too short attempt"
+            tau_est, source = 1.3 * old["tau_alpha"], LONGER
+        elif state in ("running", "queued", "interrupted") and str(old.get("tau_source")).startswith(LONGER):
+            pass  # interrupted before its first checkpoint: the longer length it was given, again
         elif rl["tau_alpha"] == "interpolate" and len(sd.finished_taus(p)) >= 2:
             tau_est, source = sd.guess(p)
         else:
