@@ -501,6 +501,37 @@ TEST(Rows, PackedRowsRoundTripAndRefuseMalformedBytes) {
   }
 }
 
+// A row's head (the neighbour lists keep their centre there) is the
+// owner's: pushes, removals and the stride doubling when a row overflows
+// keep it and the members, in order; clearing a row keeps its head.
+TEST(Rows, HeadsSurviveGrowthPushesAndRemovals) {
+  using dynhet::engine::Rows;
+  struct Head {
+    double x, y;
+  };
+  Rows a(4);
+  a.reset(3);
+  for (size_t r = 0; r < 3; ++r) a.set_head(r, Head{0.5 + r, -1.25 * r});
+  for (int v = 0; v < 11; ++v) a.push(1, v); // fills row 1 at stride 16 (4 head words, a count, 11 members)
+  a.push(0, 7);
+  const size_t before = a.bytes();
+  a.push(1, 11); // the 12th member: the stride doubles
+  EXPECT_EQ(a.bytes(), 2 * before);
+  a.remove(1, 3);
+  a.clear(2);
+  for (size_t r = 0; r < 3; ++r) {
+    const Head h = a.head<Head>(r);
+    EXPECT_EQ(h.x, 0.5 + r);
+    EXPECT_EQ(h.y, -1.25 * r);
+  }
+  const std::vector<int32_t> row1{0, 1, 2, 11, 4, 5, 6, 7, 8, 9, 10}; // 3 removed: the last member took its place
+  ASSERT_EQ(a.row(1)[0], static_cast<int32_t>(row1.size()));
+  for (size_t k = 0; k < row1.size(); ++k) EXPECT_EQ(a.row(1)[k + 1], row1[k]) << k;
+  EXPECT_EQ(a.row(0)[0], 1);
+  EXPECT_EQ(a.row(0)[1], 7);
+  EXPECT_EQ(a.row(2)[0], 0);
+}
+
 // A prepared state (compressed, velocities drawn, before begin()) serves
 // every restitution and driving: a run started from it equals, bit for
 // bit, the run that compresses itself with the same seed. Compression is
