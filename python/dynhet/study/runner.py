@@ -156,7 +156,7 @@ def do_run(sd, p, log=print):
         # tau_alpha either way); a better estimate would.
         if tau_est is not None:
             best = tau_est / (rl["pilot_margin"] if source.startswith("pilot") else
-                              1.3 if source.startswith("1.3 x") else 1.0)
+                              1.3 if source == LONGER else 1.0)
             sch = sc["schedule"]
             if sch["lag_min"] <= best <= sch["lag_max"]:
                 sch["extra_lags"] = [round(best, 6)]
