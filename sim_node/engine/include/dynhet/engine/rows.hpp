@@ -13,9 +13,11 @@
 #pragma once
 
 #include <algorithm>
+#include <cassert>
 #include <cstring>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 #include "dynhet/engine/memory.hpp"
@@ -32,13 +34,20 @@ public:
   }
   int32_t* row(size_t r) { return &data_[r * stride_ + head_]; }
   const int32_t* row(size_t r) const { return &data_[r * stride_ + head_]; }
-  // The head of row r as a T (trivially copyable, at most head_words words).
+  // The head of row r as a T (trivially copyable, at most head_words words;
+  // the width is the owner's choice at run time, so debug builds check it).
   template <class T> T head(size_t r) const {
+    static_assert(std::is_trivially_copyable_v<T>);
+    assert(sizeof(T) <= sizeof(int32_t) * static_cast<size_t>(head_));
     T v;
     std::memcpy(&v, &data_[r * stride_], sizeof v);
     return v;
   }
-  template <class T> void set_head(size_t r, const T& v) { std::memcpy(&data_[r * stride_], &v, sizeof v); }
+  template <class T> void set_head(size_t r, const T& v) {
+    static_assert(std::is_trivially_copyable_v<T>);
+    assert(sizeof(T) <= sizeof(int32_t) * static_cast<size_t>(head_));
+    std::memcpy(&data_[r * stride_], &v, sizeof v);
+  }
   int head_words() const { return head_; }
   void prefetch(size_t r) const { __builtin_prefetch(&data_[r * stride_]); }
   void clear(size_t r) { row(r)[0] = 0; }
