@@ -436,3 +436,29 @@ def test_the_ageing_slope_of_two_seeds_is_not_their_spread_alone(tmp_path):
     expected = np.hypot(*own) / 2
     assert row["verdict"].startswith("agrees")
     assert f"{expected:.2g}" in row["note"] and "over their spread's" in row["note"]
+
+
+def test_the_ageing_slope_of_two_seeds_one_without_its_own_error_is_not_judged(tmp_path):
+    """Two seeds, one of them with origins closer than its tau_alpha (so no
+    error of its own): their spread (one dof) would be the only error, and
+    it is not taken alone: the row is not judged, with the reason."""
+    import numpy as np
+    from dynhet import fits as sf
+    from dynhet.analysis.overlap import ageing_results
+    A = Analysis.__new__(Analysis)
+    A.points, A.extra, A.cpu, A.fits, A.rows = {}, {}, {}, {}, []
+    A.figdir, A.dir = str(tmp_path), str(tmp_path)
+    p = Point(("neighbours", 0.9, 0.8, 65536))
+    wobble = np.array([0.05, -0.04, 0.03, -0.06, 0.04, -0.02, 0.05, -0.03])
+    for seed, slope, spacing in ((1, -0.012, 1.2), (2, -0.022, 0.8)):
+        t0 = np.arange(8) * spacing * 140.0
+        tt = 140.0 * (1 + slope * t0 / 140.0 + wobble)
+        p.runs.append({"seed": seed, "N": 65536, "cut": {0.6: {"tau_alpha": 140.0, "tau_alpha_err": 1.0,
+                                                               "t0": list(t0), "tau_t0": list(tt)}}})
+    A.points[p.pairs, p.eps, p.phi, p.N] = p
+    own = [sf.slope_with_error(np.asarray(r["cut"][0.6]["t0"]) / 140.0, np.asarray(r["cut"][0.6]["tau_t0"]) / 140.0)
+           for r in p.runs]
+    assert np.isfinite(own[0][1]) and not np.isfinite(own[1][1])   # the premise: seed 2 quotes no error
+    ageing_results(A)
+    row = next(r for r in A.rows if r["item"].startswith("τ_α(t0) at φ = 0.8"))
+    assert row["verdict"].startswith("not judged: 2 seeds, 1 of them with no error of its own")

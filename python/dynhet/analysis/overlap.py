@@ -156,6 +156,7 @@ def ageing_results(A):
         s, se, n = sf.seed_mean([f[0] for f in fits])
         note = f"jackknife over {n} seeds" if n > 1 else ""
         own = [f[1] for f in fits if np.isfinite(f[0])]
+        why = ""
         if 1 < n < sf.MIN_JK_SEEDS and all(np.isfinite(own)):
             # two or three seeds: their spread (one or two dof) is not taken alone, as for a
             # fit (sf.MIN_JK_SEEDS): at least the seeds' own errors (origins about the line) combined
@@ -163,19 +164,25 @@ def ageing_results(A):
             if own_se > se:
                 note += f"; the seeds' own errors combined, {own_se:.2g}, over their spread's {se:.2g}"
                 se = own_se
+        elif 1 < n < sf.MIN_JK_SEEDS:
+            # a seed without an error of its own (its origins closer than its tau_alpha):
+            # the spread alone would be all there is, and it is not taken alone
+            missing = sum(1 for e in own if not np.isfinite(e))
+            why = (f"not judged: {n} seeds, {missing} of them with no error of its own (origins closer "
+                   f"than its τ_α), and the spread of {n} seeds ({n - 1} dof) is not taken alone")
         if n == 1 and np.isfinite(fits[0][1]):
             # one seed: the error from its origins' scatter about the line
             # (sf.slope_with_error takes it only where the origins lie at least
             # tau_alpha apart, so their tau_alpha(t0) are independent)
             s, se = fits[0][0], fits[0][1]
             note = f"one seed: error from its {fits[0][2]} origins' scatter about the line"
-        out.append((p, s, se, note))
+        out.append((p, s, se, note, why))
     ax.set_xlabel("t0")
     ax.set_ylabel("τ_α(t0)")
     ax.legend(fontsize=6, ncol=2)
     ax.set_title("τ_α(t0) against the waiting time: no ageing (paper, sec. 3.1)")
     f = A.save(fig, "tau_alpha_t0.png")
-    for p, s, se, note in out:
+    for p, s, se, note, why in out:
         A.row(f"τ_α(t0) at φ = {p.phi:g}: slope d(τ_α/τ̄_α)/d(t0/τ̄_α)", "3.1, inset of fig. Q-t-t0", "0 (no ageing)",
-              fmt(s, se, 2), verdict(s, se, 0.0), f, [p], note)
+              fmt(s, se, 2), why or verdict(s, se, 0.0), f, [p], note)
 
