@@ -2,6 +2,8 @@
 at each density of the study the point of the largest N over the --also
 studies takes the place of the study's own in every series; densities the
 study does not have are not added."""
+import pytest
+
 from dynhet.analysis.points import Point
 from dynhet.analysis.study import Analysis
 
@@ -438,10 +440,13 @@ def test_the_ageing_slope_of_two_seeds_is_not_their_spread_alone(tmp_path):
     assert f"{expected:.2g}" in row["note"] and "over their spread's" in row["note"]
 
 
-def test_the_ageing_slope_of_two_seeds_one_without_its_own_error_is_not_judged(tmp_path):
-    """Two seeds, one of them with origins closer than its tau_alpha (so no
-    error of its own): their spread (one dof) would be the only error, and
-    it is not taken alone: the row is not judged, with the reason."""
+@pytest.mark.parametrize("spacings, words", [((1.2, 0.8), "2 seeds, 1 of them"),
+                                              ((0.8, 1.2, 0.7), "3 seeds, 2 of them")])
+def test_the_ageing_slope_of_seeds_without_their_own_error_is_not_judged(tmp_path, spacings, words):
+    """Two or three seeds, some with origins closer than their tau_alpha (so
+    no error of their own): their spread (one or two dof) would be the only
+    error, and it is not taken alone: the row is not judged, with the
+    reason naming how many seeds lack an error."""
     import numpy as np
     from dynhet import fits as sf
     from dynhet.analysis.overlap import ageing_results
@@ -450,7 +455,7 @@ def test_the_ageing_slope_of_two_seeds_one_without_its_own_error_is_not_judged(t
     A.figdir, A.dir = str(tmp_path), str(tmp_path)
     p = Point(("neighbours", 0.9, 0.8, 65536))
     wobble = np.array([0.05, -0.04, 0.03, -0.06, 0.04, -0.02, 0.05, -0.03])
-    for seed, slope, spacing in ((1, -0.012, 1.2), (2, -0.022, 0.8)):
+    for seed, (slope, spacing) in enumerate(zip((-0.012, -0.022, -0.015), spacings), start=1):
         t0 = np.arange(8) * spacing * 140.0
         tt = 140.0 * (1 + slope * t0 / 140.0 + wobble)
         p.runs.append({"seed": seed, "N": 65536, "cut": {0.6: {"tau_alpha": 140.0, "tau_alpha_err": 1.0,
@@ -458,7 +463,9 @@ def test_the_ageing_slope_of_two_seeds_one_without_its_own_error_is_not_judged(t
     A.points[p.pairs, p.eps, p.phi, p.N] = p
     own = [sf.slope_with_error(np.asarray(r["cut"][0.6]["t0"]) / 140.0, np.asarray(r["cut"][0.6]["tau_t0"]) / 140.0)
            for r in p.runs]
-    assert np.isfinite(own[0][1]) and not np.isfinite(own[1][1])   # the premise: seed 2 quotes no error
+    # the premise: exactly the seeds with origins closer than tau_alpha quote no error
+    assert [bool(np.isfinite(o[1])) for o in own] == [sp >= 1.0 for sp in spacings]
     ageing_results(A)
     row = next(r for r in A.rows if r["item"].startswith("τ_α(t0) at φ = 0.8"))
-    assert row["verdict"].startswith("not judged: 2 seeds, 1 of them with no error of its own")
+    assert row["verdict"].startswith(f"not judged: {words} with no error of its own")
+    assert f"({len(spacings) - 1} dof)" in row["verdict"]

@@ -76,7 +76,7 @@ def cell(m, seeds=0):
         return "—"
     e = measured_error(m)
     part = f" ({n} of {seeds} seeds)" if n < seeds else ""
-    # no run quotes an error and two seeds give one from their spread: one dof, itself uncertain by 70 %
+    # not every run quotes an error and two seeds give one from their spread: one dof, itself uncertain by 70 %
     two = " ²" if n == 2 and np.isfinite(e) and np.isfinite(sem) and e == sem else ""
     return (fmt(v, e) if np.isfinite(e) else f"{v:.4g} (no error)") + ("" if n > 1 else " ¹") + two + part
 
@@ -313,8 +313,8 @@ def write_finite_size(A, path, command):
          f"combined, times the study's factor below where its seeds scatter more; the seeds' spread where no run "
          f"quotes one; \"no error\" where one seed quotes none, and such a "
          f"size takes no part in the verdict); ¹ one seed: its error is the run's own (jackknife over origin blocks, times the study's factor below where it has one for that quantity), which no spread of seeds checks at that N; \"(k of m seeds)\": only k of the size's m runs have a "
-         f"value (the others not resolved or not reached), and it takes no part in the verdict either; ² no run quotes "
-         f"an error and it is the spread of two seeds (one degree of freedom: itself uncertain by some 70 %); "
+         f"value (the others not resolved or not reached), and it takes no part in the verdict either; ² not every run "
+         f"quotes an error, and it is the spread of two seeds (one degree of freedom: itself uncertain by some 70 %); "
          f"‡ not steady: "
          f"the size's τ_α(t0) (of the same measure, standard or cage-relative) moves over its production beyond "
          f"3σ's probability (Student t with the dof of its origins' scatter about the line: 4.9 errors for one run "

@@ -165,11 +165,13 @@ def ageing_results(A):
                 note += f"; the seeds' own errors combined, {own_se:.2g}, over their spread's {se:.2g}"
                 se = own_se
         elif 1 < n < sf.MIN_JK_SEEDS:
-            # a seed without an error of its own (its origins closer than its tau_alpha):
-            # the spread alone would be all there is, and it is not taken alone
+            # a seed without an error of its own (fewer than 4 origins, or origins closer
+            # than its tau_alpha: sf.slope_with_error): the spread alone would be all
+            # there is, and it is not taken alone
             missing = sum(1 for e in own if not np.isfinite(e))
-            why = (f"not judged: {n} seeds, {missing} of them with no error of its own (origins closer "
-                   f"than its τ_α), and the spread of {n} seeds ({n - 1} dof) is not taken alone")
+            why = (f"not judged: {n} seeds, {missing} of them with no error of its own (fewer than 4 "
+                   f"origins, or origins closer than its τ_α), and the spread of {n} seeds ({n - 1} dof) "
+                   f"is not taken alone")
         if n == 1 and np.isfinite(fits[0][1]):
             # one seed: the error from its origins' scatter about the line
             # (sf.slope_with_error takes it only where the origins lie at least
