@@ -29,13 +29,14 @@ check 'grep -Eq "^  phi0\.[0-9]+_eps0\.900_n300_seed[12]: (equilibrate|productio
   "progress lines name each running run's phase, time, frames and ETA"
 # Every run's schedule came from a pilot's tau_alpha (or, if the run came out
 # too short for it, from 1.3 times the run's own), and is long enough for
-# the tau_alpha it measured: equilibration 10 estimates >= 9 tau_alpha.
+# the tau_alpha it measured: equilibration 10 estimates >= 9 tau_alpha, and
+# origins one estimate apart at least its tau_alpha apart.
 check '/usr/bin/python3 -c "
 import tomllib, sys
 runs = tomllib.load(open(\"$tmp/a/index.toml\", \"rb\"))[\"runs\"].values()
 ok = all(r[\"tau_source\"] in (\"pilot x 1.2\", \"1.3 x the tau_alpha of the previous, too short attempt\")
-         and 10 * r[\"tau_estimate\"] >= 9 * r[\"tau_alpha\"] for r in runs)
-sys.exit(0 if ok and len(runs) == 4 else 1)"' "every run's schedule came from a pilot (or its own too short attempt), says so, and is >= 9 tau_alpha long"
+         and 10 * r[\"tau_estimate\"] >= 9 * r[\"tau_alpha\"] and r[\"tau_estimate\"] >= r[\"tau_alpha\"] for r in runs)
+sys.exit(0 if ok and len(runs) == 4 else 1)"' "every run's schedule came from a pilot (or its own too short attempt), says so, is >= 9 tau_alpha long, its origins >= tau_alpha apart"
 check '[[ $(ls "$tmp"/a/runs/*/run.h5 | wc -l) == 4 ]]' "each run has its run.h5"
 # Each run has a lag at its best tau_alpha estimate (schedule.extra_lags),
 # and its clusters are taken at its measured tau_alpha (interpolated between

@@ -375,3 +375,16 @@ def test_a_run_queued_again_on_slurm_goes_by_what_it_was_before():
     assert effective_state({"state": "queued"}) == "queued"          # never started
     assert effective_state({"state": "interrupted", "previous_state": "failed"}) == "interrupted"
     assert carried_cpu({"state": "queued", "previous_state": "running", "cpu_s": 7.0}, "cut") == (7.0, 1)
+
+
+def test_a_run_whose_origins_lie_closer_than_its_tau_alpha_is_too_short():
+    """Origins planned one estimated tau_alpha apart: a run that measures a
+    longer tau_alpha has correlated tau_alpha(t0), no steadiness check, and
+    is too short for its plan; one at or below its estimate is not; a plan
+    of origins closer than tau_alpha on purpose is not judged by this."""
+    from dynhet.study.runner import origins_too_close
+    sc = {"schedule": {"origin_spacing": 124.0}}
+    assert origins_too_close(sc, 157.0, 1.0)
+    assert not origins_too_close(sc, 120.0, 1.0) and not origins_too_close(sc, 124.0, 1.0)
+    assert not origins_too_close(sc, 157.0, 0.5)
+    assert not origins_too_close(sc, float("nan"), 1.0) and not origins_too_close({}, 157.0, 1.0)

@@ -100,6 +100,16 @@ def equilibrated(sd, sc, d, tau):
     return sc["run"]["equilibration_time"] >= 0.9 * rl["equilibration_tau"] * tau
 
 
+def origins_too_close(sc, tau, spacing_tau):
+    """Whether a run's origins, planned at least one tau_alpha apart
+    (run_length.origin_spacing_tau >= 1), lie closer than the tau_alpha the
+    run measured (tau, of run_length.unit): then its tau_alpha(t0) are
+    correlated and its steadiness over the production cannot be checked
+    (docs/analysis.md), so the run is too short for its plan."""
+    spacing = float(sc.get("schedule", {}).get("origin_spacing", math.nan))
+    return spacing_tau >= 1.0 and math.isfinite(tau) and math.isfinite(spacing) and spacing < tau
+
+
 def do_run(sd, p, log=print):
     """Runs (or resumes) one run to the end; returns its final status."""
     st = sd.study
@@ -230,6 +240,11 @@ def do_run(sd, p, log=print):
         status["state"] = "too_short"
         status["message"] = (f"tau_alpha {tau:.4g} against the estimate {tau_est:.4g}: the equilibration was "
                              f"under {0.9 * rl['equilibration_tau']:g} {rl['equilibration_unit']}")
+    elif tau_est is not None and origins_too_close(sc, tau, rl["origin_spacing_tau"]):
+        status["state"] = "too_short"
+        status["message"] = (f"tau_alpha {tau:.4g} against the estimate {tau_est:.4g}: its origins, "
+                             f"{float(sc['schedule']['origin_spacing']):.4g} apart, lie closer than its tau_alpha, "
+                             f"so its steadiness over the production cannot be checked")
     else:
         status["state"] = "complete"
     write_status(d, status)
