@@ -10,11 +10,11 @@ from .rundir import read_status, run_h5_result, write_status
 from .children import RESUMABLE, STOPPING, newest_whole_cut, run_scene
 from .progress import sim_progress
 from .states import equilibrated_state, pid_alive, pilot, prepared_state
+from .archiving import archive_run, restored_run
 
 # The source of a run's tau_alpha estimate when it runs again after a too
 # short attempt.
 LONGER = "1.3 x the tau_alpha of the previous, too short attempt"
-from .archiving import archive_run, restored_run
 
 
 def effective_state(old):
