@@ -388,3 +388,35 @@ def test_a_run_whose_origins_lie_closer_than_its_tau_alpha_is_too_short():
     assert not origins_too_close(sc, 120.0, 1.0) and not origins_too_close(sc, 124.0, 1.0)
     assert not origins_too_close(sc, 157.0, 0.5)
     assert not origins_too_close(sc, float("nan"), 1.0) and not origins_too_close({}, 157.0, 1.0)
+
+
+def test_on_a_new_machine_the_dry_run_sees_the_archive_as_the_run_will(tmp_path, capsys):
+    # The run directories are gone (a new machine) and the results archive
+    # holds one run and a pilot: the dry run counts the run complete at its
+    # archived CPU time, with nothing left to run, and estimates the others
+    # from the archived pilot, as running the study would (it restores both
+    # from the archive) -- not as pending runs at the study's tau_guess.
+    from dynhet.archive import Archive
+    from dynhet.study.index import dry_run, plan
+    from dynhet.study.rundir import StudyDir
+    s = study(tmp_path, GOOD.replace("lag_max_tau = 30.0", "lag_max_tau = 30.0\ntau_guess = [[0.6, 1.0], [0.7, 1.0]]"))
+    arch = Archive(str(tmp_path / "results"))
+    arch.claim(s)
+    done = [q for q in s.points() if q["packing_fraction"] == 0.6 and q["seed"] == 1][0]
+    idx = arch.read()
+    idx["runs"][s.run_name(done)] = {"file": "runs/x.h5.gz", "bytes": 1, "sha256": "0", "tau_alpha": 3.0,
+                                     "tau_estimate": 3.6, "tau_source": "pilot x 1.2", "cpu_s": 1234.0}
+    arch._write_index(idx)
+    arch.add_pilot("p07", {"state": "complete", "tau_alpha": 5.0, "packing_fraction": 0.7,
+                           "series": [0.9, "neighbours", 300]})
+    sd = StudyDir(s, str(tmp_path / "out"), archive=arch.dir)
+    rows = {s.run_name(r[0]): r for r in plan(sd)}
+    assert rows[s.run_name(done)][4] == "complete" and math.isclose(rows[s.run_name(done)][2], 3.6)
+    other = [q for q in s.points() if q["packing_fraction"] == 0.7 and q["restitution"] == 0.9][0]
+    assert [ph for ph, _ in sd.finished_taus(other)] == [0.6, 0.7]
+    assert math.isclose(sd.guess(other)[0], 5.0)
+    assert not os.path.exists(sd.run_dir(done))  # nothing written
+    dry_run(sd)
+    out = capsys.readouterr().out
+    line = [ln for ln in out.splitlines() if ln.startswith(s.run_name(done))][0]
+    assert line.split()[1] == "complete" and "0:20:34" in line

@@ -8,7 +8,7 @@ import sys
 from ..archive import Archive, ArchiveError
 from .model import AXES, StudyError
 from .paths import ROOT
-from .rundir import read_status, write_status
+from .rundir import archived_status, read_status, write_status
 
 
 def resolve(path):
@@ -58,9 +58,7 @@ def restored_run(sd, p):
         sd.archive.path(name, entry)
     except ArchiveError as e:
         raise StudyError(str(e)) from None
-    st = {k: v for k, v in entry.items() if k not in ("file", "bytes", "sha256")}
-    st.update({a: p[a] for a in AXES})
-    st.update({"state": "complete", "archived": os.path.join(sd.archive.dir, entry["file"])})
+    st = dict(archived_status(entry, p), archived=os.path.join(sd.archive.dir, entry["file"]))
     os.makedirs(sd.run_dir(p), exist_ok=True)
     write_status(sd.run_dir(p), st)
     return st

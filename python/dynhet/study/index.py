@@ -37,7 +37,7 @@ def plan(sd):
     """[(point, scene, tau, source, state)] with times from the estimates known now (nothing started)."""
     out = []
     for p in sd.study.points():
-        st = read_status(sd.run_dir(p))
+        st = sd.status(p)
         if sd.study.run_length["tau_alpha"] == "scene":
             tau, src = None, "scene"
         elif st.get("tau_estimate") and st.get("state") != "too_short":
@@ -163,7 +163,7 @@ def share_done(run_dir, state, sim_time):
 
 def dry_run(sd):
     rows = plan(sd)
-    costs = [(p, sc, tau, src, state, *estimate(sc, nodes_of(sc)), read_status(sd.run_dir(p)).get("cpu_s"))
+    costs = [(p, sc, tau, src, state, *estimate(sc, nodes_of(sc)), sd.status(p).get("cpu_s"))
              for p, sc, tau, src, state in rows]
     done = [(sc["system"]["n_particles"], cpu, float(got)) for _, sc, _, _, state, cpu, _, got in costs
             if state == "complete" and got]

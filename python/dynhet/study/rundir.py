@@ -7,7 +7,7 @@ import time
 import tomllib
 
 from .toml_io import read_toml, toml_dump, write_atomic
-from .model import StudyError
+from .model import AXES, StudyError
 
 
 def read_status(d):
@@ -39,6 +39,15 @@ def run_h5_result(path, cutoff, group="overlap"):
         return 0, float("nan")
     c, t = out.stdout.split()
     return int(c), float(t)
+
+
+def archived_status(entry, p):
+    """A run's status from its archive entry (the run's axes p): complete,
+    where the entry's file is."""
+    st = {k: v for k, v in entry.items() if k not in ("file", "bytes", "sha256")}
+    st.update({a: p[a] for a in AXES})
+    st["state"] = "complete"
+    return st
 
 
 def same_toml(a, b):
@@ -149,6 +158,40 @@ class StudyDir:
     def run_dir(self, p):
         return os.path.join(self.runs_dir, self.study.run_name(p))
 
+    def archive_index(self):
+        """The archive's index ({"runs": ..., "pilots": ...}; empty without an
+        archive), read once per change of its file."""
+        if self.archive is None or not self.archive.exists():
+            return {"runs": {}, "pilots": {}}
+        stamp = os.stat(self.archive.index_path).st_mtime_ns
+        if getattr(self, "_index_stamp", None) != stamp:
+            self._index, self._index_stamp = self.archive.read(), stamp
+        return self._index
+
+    def status(self, p):
+        """Run p's status as running the study would find it: its directory's;
+        where that does not say complete and the archive holds the run (its
+        directory gone, as on a new machine), the archive's entry, complete.
+        Nothing is written (archiving.restored_run writes it when the run
+        comes up)."""
+        st = read_status(self.run_dir(p))
+        if st.get("state") == "complete":
+            return st
+        entry = self.archive_index()["runs"].get(self.study.run_name(p))
+        return archived_status(entry, p) if entry is not None else st
+
+    def pilot_statuses(self):
+        """{name: status} of the pilots: the study directory's, and the
+        archive's where the directory lacks them complete."""
+        out = {}
+        pdir = os.path.join(self.dir, "pilots")
+        if os.path.isdir(pdir):
+            out = {name: read_status(os.path.join(pdir, name)) for name in os.listdir(pdir)}
+        for name, st in self.archive_index()["pilots"].items():
+            if out.get(name, {}).get("state") != "complete" and st.get("state") == "complete":
+                out[name] = dict(st)
+        return out
+
     def finished_taus(self, p):
         """(phi, tau_alpha) of complete runs and pilots of p's series; the
         pilots of another N count where they ran the same system (a pilot
@@ -164,19 +207,16 @@ class StudyDir:
         for q in self.study.points():
             if self.study.series_key(q) != key:
                 continue
-            st = read_status(self.run_dir(q))
+            st = self.status(q)
             if st.get("state") == "complete" and math.isfinite(st.get("tau_alpha", float("nan"))):
                 pts.append((q["packing_fraction"], st["tau_alpha"]))
-        pdir = os.path.join(self.dir, "pilots")
-        if os.path.isdir(pdir):
-            for name in os.listdir(pdir):
-                st = read_status(os.path.join(pdir, name))
-                if st.get("unit", self.study.run_length["unit"]) != self.study.run_length["unit"]:
-                    continue  # the equilibration's pilot, of the other tau_alpha
-                ser = tuple(st.get("series", []))
-                if st.get("state") == "complete" and len(ser) == 3 and ser[:2] == (key[0], key[1]) and (
-                        ser[2] == key[2] or (pp and min(ser[2], pp) == pilot_n)):
-                    pts.append((st["packing_fraction"], st["tau_alpha"]))
+        for st in self.pilot_statuses().values():
+            if st.get("unit", self.study.run_length["unit"]) != self.study.run_length["unit"]:
+                continue  # the equilibration's pilot, of the other tau_alpha
+            ser = tuple(st.get("series", []))
+            if st.get("state") == "complete" and len(ser) == 3 and ser[:2] == (key[0], key[1]) and (
+                    ser[2] == key[2] or (pp and min(ser[2], pp) == pilot_n)):
+                pts.append((st["packing_fraction"], st["tau_alpha"]))
         by_phi = {}
         for ph, t in pts:
             by_phi.setdefault(ph, []).append(t)
