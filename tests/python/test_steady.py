@@ -141,3 +141,16 @@ def test_not_steady_takes_the_student_t_of_the_origins_scatter():
     p.runs = runs(0.5, (0.01, 0.01, 0.01))
     assert change_dof(p, False) == 2
     assert change_dof(Point(("neighbours", 0.9, 0.78, 4096)), False) is None
+
+
+def test_the_spread_of_two_seeds_is_no_check_of_steadiness():
+    # where some run quotes no error, a size's error is its seeds' spread:
+    # with two seeds one dof, and 3 sigma's probability would allow 236
+    # errors, so -10.4 +- 2 (5 errors from 0) would pass as steady: not judged, said why
+    from dynhet.analysis.steady import steady_limit, steady_off, steady_verdict
+    assert abs(steady_limit(1) - 235.8) < 0.1
+    m = (-10.4, 2.0, math.nan, 2)
+    assert steady_off(m, True, 1) is None and steady_off(m, True, 2) is False
+    text = steady_verdict([4096, 65536], [(-5.0, 4.0, math.nan, 2), m], [True, True], [6, 1])
+    assert text == ("steady: 0 within 3σ's probability at N = 4096; "
+                    "not judged (1 dof: 3σ's probability would allow 236 errors) at N = 65536")
