@@ -54,7 +54,8 @@ check 'grep -q "0 runs archived now, 4 already" "$tmp/a3.out"' "archiving again 
 rm -rf "$tmp/study/tiny/runs" "$tmp/study/tiny/pilots" "$tmp/study/tiny/states" "$tmp/study/tiny/study.h5"
 "${study[@]}" "$root/studies/tiny.toml" --out "$tmp/study/tiny" --archive "$tmp/results/tiny" --jobs 2 >"$tmp/r.out" 2>&1 ||
   { cat "$tmp/r.out"; fail=1; }
-check '[[ $(grep -c "complete in the archive" "$tmp/r.out") == 4 ]] && ! ls "$tmp"/study/tiny/runs/*/run.h5 >/dev/null 2>&1 &&
+check 'grep -q "4 runs complete in the archive" "$tmp/r.out" && grep -q "4 of 4 runs complete already (skipped)" "$tmp/r.out" &&
+  grep -q "4 done, 0 running, 0 left" "$tmp/r.out" && ! ls "$tmp"/study/tiny/runs/*/run.h5 >/dev/null 2>&1 &&
   [[ ! -d $tmp/study/tiny/pilots ]] && grep -q "4 of 4 runs complete, 0 failed" "$tmp/r.out"' \
   "run directories gone: the study resumes from its archive, no run or pilot run again"
 /usr/bin/python3 "$root/tests/check_archive.py" same-analysis "$tmp/study/tiny/study.h5" "$tmp/from_archive/study.h5" || fail=1

@@ -64,6 +64,20 @@ def restored_run(sd, p):
     return st
 
 
+def restore_archived(sd, points, log=print):
+    """Every run of points that the archive holds and its directory does not
+    hold complete, restored (restored_run) before an executor plans its
+    queue, so that the queue, its order and its ETA hold only what is to
+    run; returns how many."""
+    n = 0
+    for p in points:
+        if read_status(sd.run_dir(p)).get("state") != "complete" and restored_run(sd, p) is not None:
+            n += 1
+    if n:
+        log(f"study {sd.study.name}: {n} runs complete in the archive {sd.archive.dir}; not run again")
+    return n
+
+
 def restored_pilot(sd, name, d):
     """A pilot's complete status from the archive (written into d), or None."""
     if sd.archive is None:

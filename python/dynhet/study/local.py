@@ -12,12 +12,14 @@ from .estimates import fmt_time
 from .rundir import read_status, write_status
 from .children import RESUMABLE, STOPPING, already_stopping, stop_children
 from .runner import do_run
+from .archiving import restore_archived
 from .index import estimates_whole_and_left, run_order, write_index
 from .progress import PROGRESS_EVERY, describe, eta_seconds, sim_progress, study_eta
 
 
 def run_local(sd, jobs, order="longest", first=(), figures=True):
     points = [p for p in sd.study.points()]
+    restore_archived(sd, points)
     todo = [p for p in points if read_status(sd.run_dir(p)).get("state") != "complete"]
     done0 = len(points) - len(todo)
     if done0:

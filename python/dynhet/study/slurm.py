@@ -10,11 +10,13 @@ from .model import AXES, StudyError
 from .rundir import read_status, write_status
 from .children import RESUMABLE, signal_children
 from .runner import do_run
+from .archiving import restore_archived
 from .index import run_estimates_left, run_order, write_index
 
 
 def run_slurm(sd, a):
     points = sd.study.points()
+    restore_archived(sd, points)
     todo = []
     for p in points:
         st = read_status(sd.run_dir(p))
