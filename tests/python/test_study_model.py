@@ -188,11 +188,14 @@ def test_an_interrupted_run_is_ordered_by_what_its_checkpoint_has_left(tmp_path)
     assert left[name(pair[0])] == full[name(pair[0])]
     order = [name(p) for p in run_order(sd, pair, left, "shortest", ["phi0.7000_eps0.900_*"])]
     assert order == [name(pair[1]), name(pair[0])]                  # the nearly finished one first
-    assert [name(p) for p in run_order(sd, pair, full, "shortest")] == [name(pair[0]), name(pair[1])]
+    # a run that resumes goes before one that starts afresh, whatever the estimates and the order:
+    assert [name(p) for p in run_order(sd, pair, full, "shortest")] == [name(pair[1]), name(pair[0])]
+    assert [name(p) for p in run_order(sd, pair, left, "longest")] == [name(pair[1]), name(pair[0])]
     write_status(d, {"state": "queued", "previous_state": "interrupted", "job": 7})   # a Slurm resubmission
     assert math.isclose(run_estimates_left(sd)[name(pair[1])], 0.1 * full[name(pair[1])], rel_tol=1e-3)
     write_status(d, {"state": "failed"})                            # a failed run starts over
     assert run_estimates_left(sd)[name(pair[1])] == full[name(pair[1])]
+    assert [name(p) for p in run_order(sd, pair, full, "shortest")] == [name(pair[0]), name(pair[1])]  # by the estimates
 
 
 def test_a_size_not_yet_piloted_is_estimated_from_the_pilots_of_the_same_system(tmp_path):

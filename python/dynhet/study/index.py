@@ -111,7 +111,11 @@ def run_order(sd, todo, est, order="longest", first=()):
     not done). Equal estimates keep the study's order.
     The runs whose names match a pattern of first (shell globs) go before all
     others, those of the first pattern first (each group in that order):
-    the runs a result waits for, ahead of the rest."""
+    the runs a result waits for, ahead of the rest. Within each group the
+    runs that resume past their start (a checkpoint cut, or their state
+    before the frames) go before those that start afresh: the CPU they
+    have had becomes an archived result soonest, on a machine that may be
+    lost, and their checkpoints leave the disk."""
     if sd.study.run_length["tau_alpha"] == "interpolate":
         if first:
             raise StudyError(f"--first: study {sd.study.name} interpolates its run lengths (tau_alpha = "
@@ -127,7 +131,11 @@ def run_order(sd, todo, est, order="longest", first=()):
     def group(p):
         name = sd.study.run_name(p)
         return next((i for i, pat in enumerate(first) if fnmatch.fnmatchcase(name, pat)), len(first))
-    return sorted(todo, key=lambda p: (group(p), sign * est.get(sd.study.run_name(p), 0.0)))
+
+    def afresh(p):
+        d = sd.run_dir(p)
+        return resume_from(d, effective_state(read_status(d))) is None
+    return sorted(todo, key=lambda p: (group(p), afresh(p), sign * est.get(sd.study.run_name(p), 0.0)))
 
 
 def nodes_of(sc):
