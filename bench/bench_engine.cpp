@@ -115,9 +115,14 @@ int main(int argc, char** argv) {
                            .c_str()
                      : "undriven",
               coll_per_particle, sync);
-  std::printf("%9s %6s %9s %10s %10s %10s %10s %10s %10s %9s %9s %5s %8s %11s %8s %8s\n", "N", "phi", "prep_s",
+  // sync_s: CPU seconds of the timed span spent in its synchronisations;
+  // c+k/s_loop: collisions plus kicks per CPU second of the rest, the event
+  // loop alone (a run synchronises once per run.checkpoint_interval, about
+  // 87 collisions per particle at phi = 0.78, where --coll sets how many
+  // collisions per particle the timed span's last synchronisation weighs on).
+  std::printf("%9s %6s %9s %10s %10s %10s %10s %10s %10s %9s %9s %5s %8s %11s %8s %8s %8s %11s\n", "N", "phi", "prep_s",
               "coll/s", "kicks/s", "c+k/s", "rebuild/s", "stale/s", "events/s", "ns/coll", "B/part", "nbrs", "wall_s",
-              "dE/E", "T_mean", "T_sd");
+              "dE/E", "T_mean", "T_sd", "sync_s", "c+k/s_loop");
   for (long n : ns)
     for (double phi : phis) {
       dynhet::engine::Params p = dynhet::engine::paper_params(n, phi, eps, driven);
@@ -174,7 +179,7 @@ int main(int argc, char** argv) {
       // Synchronise (and re-sort particles in memory) every `sync` time
       // units, as sim_node does at run.checkpoint_interval.
       dynhet::BlockAverage temp; // granular temperature T = KE per particle, sampled
-      double t2 = 0;
+      double t2 = 0, sync_cpu = 0;
       for (double t = e.time(), end = e.time() + t_run; t < end;) {
         for (double stop = std::min(end, t + sync); t < stop;) {
           t = std::min(stop, t + 1.0);
@@ -183,7 +188,9 @@ int main(int argc, char** argv) {
           temp.add(T);
           t2 += T * T;
         }
+        const double s0 = cpu_seconds();
         e.synchronize();
+        sync_cpu += cpu_seconds() - s0;
       }
       const double t_sd = std::sqrt(std::max(0.0, t2 / temp.count() - temp.mean() * temp.mean()));
       const double wall = seconds(t0), cpu = cpu_seconds() - cpu0;
@@ -191,10 +198,11 @@ int main(int argc, char** argv) {
       const auto c1 = e.counters();
       const double coll = double(c1.collisions - c0.collisions), kicks = double(c1.kicks - c0.kicks);
       const double cross = double(c1.rebuilds - c0.rebuilds), stale = double(c1.stale - c0.stale);
-      std::printf("%9ld %6.3f %9.2f %10.3g %10.3g %10.3g %10.3g %10.3g %10.3g %9.1f %9.0f %5.2f %8.1f %11.2e %8.4f %8.4f\n",
+      std::printf("%9ld %6.3f %9.2f %10.3g %10.3g %10.3g %10.3g %10.3g %10.3g %9.1f %9.0f %5.2f %8.1f %11.2e %8.4f %8.4f %8.3f %11.3g\n",
                   n, phi, prep, coll / cpu, kicks / cpu, (coll + kicks) / cpu, cross / cpu, stale / cpu, (coll + kicks + cross + stale) / cpu,
                   1e9 * cpu / coll, bytes, e.mean_neighbours(), wall,
-                  eps == 1.0 && !driven ? e.kinetic_energy_per_particle() / e0 - 1 : NAN, temp.mean(), t_sd);
+                  eps == 1.0 && !driven ? e.kinetic_energy_per_particle() / e0 - 1 : NAN, temp.mean(), t_sd, sync_cpu,
+                  (coll + kicks) / std::max(cpu - sync_cpu, 1e-9));
       if (fingerprint) {
         std::vector<double> xy;
         e.unwrapped_positions(xy);

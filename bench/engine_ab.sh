@@ -10,7 +10,9 @@
 # relaxed) states, kept in CACHE by whichever runs first (the first round
 # prepares them, untimed). Prints one line
 # per run, then the table of medians with the ratios new / old and, for the
-# driven rows of the new build, neighbours / any.
+# driven rows of the new build, neighbours / any; then the same table of the
+# event loop's rates alone (the timed span less its synchronisations,
+# bench_engine's c+k/s_loop), where both builds print them.
 # Usage: bench/engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS=5] [CACHE=/tmp/dynhet-bench]
 #        ROWS='elastic 10000 0.78 50;neighbours 1000000 0.78 4' bench/engine_ab.sh ...  (other rows:
 #        "mode N phi collisions-per-particle", separated by ';')
@@ -34,7 +36,14 @@ table() { # the medians of a file of runs "build mode N phi rate"
               printf "~neighbours / any, new build, N = %d, phi = %s: %.2f\n", f[2], f[3], med[k] / med[a] } }' "$1" |
     LC_ALL=C sort | sed "s/^~//"
 }
-if [[ ${1:-} == --table ]]; then table "${2:?usage: engine_ab.sh --table RUNS_FILE}"; exit 0; fi
+loop_table() { # the same table of the event loop's rates alone (the synchronisations left out), where both builds print them
+  awk '$6 != "-" && NF >= 6 {print $1, $2, $3, $4, $6}' "$1" >"$1.loop"
+  [[ $(awk '{print $1}' "$1.loop" | sort -u | wc -l) == 2 ]] || return 0
+  echo
+  echo "The event loop alone (c+k/s_loop: the timed span less its synchronisations):"
+  table "$1.loop"
+}
+if [[ ${1:-} == --table ]]; then table "${2:?usage: engine_ab.sh --table RUNS_FILE}"; loop_table "$2"; exit 0; fi
 old=${1:?usage: engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS] [CACHE]} new=${2:?usage: engine_ab.sh OLD_BUILD NEW_BUILD [ROUNDS] [CACHE]}
 rounds=${3:-5} cache=${4:-/tmp/dynhet-bench}
 for b in "$old" "$new"; do
@@ -57,8 +66,9 @@ run() { # which build mode N phi coll
   neighbours) a+=(--eps 0.9 --driven --pairs neighbours) ;;
   any) a+=(--eps 0.9 --driven --pairs any) ;;
   esac
-  # columns: N phi prep_s coll/s kicks/s c+k/s ...
-  "$2/bin/bench_engine" "${a[@]}" 2>&1 | tail -1 | awk -v w="$1" -v m="$3" '{print w, m, $1, $2, ($5 == 0 ? $4 : $6)}'
+  # columns: N phi prep_s coll/s kicks/s c+k/s ... and, where the build prints it, c+k/s_loop (18th)
+  "$2/bin/bench_engine" "${a[@]}" 2>&1 | tail -1 |
+    awk -v w="$1" -v m="$3" '{print w, m, $1, $2, ($5 == 0 ? $4 : $6), (NF >= 18 ? $18 : "-")}'
 }
 for ((r = 1; r <= rounds; ++r)); do
   for row in "${rows[@]}"; do
@@ -72,4 +82,5 @@ for ((r = 1; r <= rounds; ++r)); do
   done
 done
 table "$out"
+loop_table "$out"
 echo "(runs in $out)"
