@@ -154,3 +154,5 @@ def test_the_spread_of_two_seeds_is_no_check_of_steadiness():
     text = steady_verdict([4096, 65536], [(-5.0, 4.0, math.nan, 2), m], [True, True], [6, 1])
     assert text == ("steady: 0 within 3σ's probability at N = 4096; "
                     "not judged (1 dof: 3σ's probability would allow 236 errors) at N = 65536")
+    assert steady_verdict([65536], [m], [True], [1]) == (
+        "no verdict: not judged (1 dof: 3σ's probability would allow 236 errors) at N = 65536")

@@ -407,8 +407,13 @@ def test_on_a_new_machine_the_dry_run_sees_the_archive_as_the_run_will(tmp_path,
     arch.claim(s)
     done = [q for q in s.points() if q["packing_fraction"] == 0.6 and q["seed"] == 1][0]
     idx = arch.read()
-    idx["runs"][s.run_name(done)] = {"file": "runs/x.h5.gz", "bytes": 1, "sha256": "0", "tau_alpha": 3.0,
+    os.makedirs(os.path.join(arch.dir, "runs"), exist_ok=True)
+    with open(os.path.join(arch.dir, "runs", "x.h5.gz"), "wb") as f:
+        f.write(b"x" * 5)
+    idx["runs"][s.run_name(done)] = {"file": "runs/x.h5.gz", "bytes": 5, "sha256": "0", "tau_alpha": 3.0,
                                      "tau_estimate": 3.6, "tau_source": "pilot x 1.2", "cpu_s": 1234.0}
+    lost = [q for q in s.points() if q["packing_fraction"] == 0.6 and q["seed"] == 2][0]
+    idx["runs"][s.run_name(lost)] = {"file": "runs/gone.h5.gz", "bytes": 5, "sha256": "0", "tau_alpha": 3.0}
     arch._write_index(idx)
     arch.add_pilot("p07", {"state": "complete", "tau_alpha": 5.0, "packing_fraction": 0.7,
                            "series": [0.9, "neighbours", 300]})
@@ -418,7 +423,12 @@ def test_on_a_new_machine_the_dry_run_sees_the_archive_as_the_run_will(tmp_path,
     other = [q for q in s.points() if q["packing_fraction"] == 0.7 and q["restitution"] == 0.9][0]
     assert [ph for ph, _ in sd.finished_taus(other)] == [0.6, 0.7]
     assert math.isclose(sd.guess(other)[0], 5.0)
+    assert rows[s.run_name(lost)][4] == "pending"   # an entry whose file is gone is not taken for complete
     assert not os.path.exists(sd.run_dir(done))  # nothing written
+    # an archive of another study: the dry run refuses it, as the run does
+    other = study(tmp_path, GOOD.replace("origins = 8", "origins = 6"))
+    with pytest.raises(StudyError, match="archives another study"):
+        plan(StudyDir(other, str(tmp_path / "out2"), archive=arch.dir))
     dry_run(sd)
     out = capsys.readouterr().out
     line = [ln for ln in out.splitlines() if ln.startswith(s.run_name(done))][0]

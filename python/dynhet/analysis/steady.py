@@ -95,7 +95,7 @@ def steady_verdict(ns, ms, whole, dofs=None):
         (off if away else ok).append((n, m[0], measured_error(m)))
     tail = "".join(f"; not judged ({why}) at N = {', '.join(str(n) for n in sizes)}" for why, sizes in unjudged.items())
     if not off and not ok:
-        return "no verdict: no size with every seed's value and an error"
+        return ("no verdict: " + tail[2:]) if tail else "no verdict: no size with every seed's value and an error"
     if not off:
         return ("steady: 0 within 3σ's probability at "
                 + ("every N" if not unjudged else "N = " + ", ".join(str(n) for n, _, _ in ok)) + tail)

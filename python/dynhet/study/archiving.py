@@ -71,8 +71,13 @@ def restore_archived(sd, points, log=print):
     run; returns how many."""
     n = 0
     for p in points:
-        if read_status(sd.run_dir(p)).get("state") != "complete" and restored_run(sd, p) is not None:
-            n += 1
+        if read_status(sd.run_dir(p)).get("state") == "complete":
+            continue
+        try:
+            n += restored_run(sd, p) is not None
+        except (StudyError, OSError) as e:
+            # left to its run (do_run), which meets the same entry and fails by name, alone
+            log(f"{sd.study.run_name(p)}: NOT restored from the archive: {e}")
     if n:
         log(f"study {sd.study.name}: {n} runs complete in the archive {sd.archive.dir}; not run again")
     return n

@@ -111,16 +111,20 @@ def run_order(sd, todo, est, order="longest", first=()):
     not done). Equal estimates keep the study's order.
     The runs whose names match a pattern of first (shell globs) go before all
     others, those of the first pattern first (each group in that order):
-    the runs a result waits for, ahead of the rest. Within each group the
+    the runs a result waits for, ahead of the rest. Within each group (and
+    before the densities' order with interpolated lengths) the
     runs that resume past their start (a checkpoint cut, or their state
     before the frames) go before those that start afresh: the CPU they
     have had becomes an archived result soonest, on a machine that may be
     lost, and their checkpoints leave the disk."""
+    def afresh(p):
+        d = sd.run_dir(p)
+        return resume_from(d, effective_state(read_status(d))) is None
     if sd.study.run_length["tau_alpha"] == "interpolate":
         if first:
             raise StudyError(f"--first: study {sd.study.name} interpolates its run lengths (tau_alpha = "
                              "\"interpolate\"), so its lower densities must run first; give it no --first")
-        return sorted(todo, key=lambda p: p["packing_fraction"])
+        return sorted(todo, key=lambda p: (afresh(p), p["packing_fraction"]))  # a resumed run's length is set
     names = [sd.study.run_name(p) for p in sd.study.points()]
     for pat in first:
         if not fnmatch.filter(names, pat):
@@ -131,10 +135,6 @@ def run_order(sd, todo, est, order="longest", first=()):
     def group(p):
         name = sd.study.run_name(p)
         return next((i for i, pat in enumerate(first) if fnmatch.fnmatchcase(name, pat)), len(first))
-
-    def afresh(p):
-        d = sd.run_dir(p)
-        return resume_from(d, effective_state(read_status(d))) is None
     return sorted(todo, key=lambda p: (group(p), afresh(p), sign * est.get(sd.study.run_name(p), 0.0)))
 
 

@@ -161,24 +161,43 @@ class StudyDir:
     def archive_index(self):
         """The archive's index ({"runs": ..., "pilots": ...}; empty without an
         archive), read once per change of its file."""
+        from ..archive import ArchiveError
         if self.archive is None or not self.archive.exists():
             return {"runs": {}, "pilots": {}}
-        stamp = os.stat(self.archive.index_path).st_mtime_ns
+        st = os.stat(self.archive.index_path)
+        stamp = (st.st_ino, st.st_size, st.st_mtime_ns)
         if getattr(self, "_index_stamp", None) != stamp:
-            self._index, self._index_stamp = self.archive.read(), stamp
+            copy = os.path.join(self.archive.dir, "study.toml")
+            if os.path.exists(copy) and not same_toml(open(copy, "rb").read(), self.study.text):
+                raise StudyError(f"{self.archive.dir} archives another study than {self.study.path} ({copy} "
+                                 "differs): give another archive, or restore the study file")
+            try:
+                self._index, self._index_stamp = self.archive.read(), stamp
+            except ArchiveError as e:
+                raise StudyError(str(e)) from None
         return self._index
 
     def status(self, p):
         """Run p's status as running the study would find it: its directory's;
         where that does not say complete and the archive holds the run (its
-        directory gone, as on a new machine), the archive's entry, complete.
-        Nothing is written (archiving.restored_run writes it when the run
+        directory gone, as on a new machine), the archive's entry, complete,
+        where its file is there at its size. Nothing is written (archiving.restored_run writes it when the run
         comes up)."""
         st = read_status(self.run_dir(p))
         if st.get("state") == "complete":
             return st
         entry = self.archive_index()["runs"].get(self.study.run_name(p))
-        return archived_status(entry, p) if entry is not None else st
+        if entry is None or not self.archived_file_fits(entry):
+            return st
+        return archived_status(entry, p)
+
+    def archived_file_fits(self, entry):
+        """Whether an archive entry's file is there at the size its index
+        says (its hash is checked when the run is restored)."""
+        try:
+            return os.path.getsize(os.path.join(self.archive.dir, entry["file"])) == int(entry["bytes"])
+        except (OSError, KeyError, TypeError, ValueError):
+            return False
 
     def pilot_statuses(self):
         """{name: status} of the pilots: the study directory's, and the

@@ -16,7 +16,7 @@ from .index import run_estimates_left, run_order, write_index
 
 def run_slurm(sd, a):
     points = sd.study.points()
-    restore_archived(sd, points)
+    restored = restore_archived(sd, points)
     todo = []
     for p in points:
         st = read_status(sd.run_dir(p))
@@ -29,21 +29,41 @@ def run_slurm(sd, a):
                 continue
         todo.append(p)
     todo = run_order(sd, todo, run_estimates_left(sd), a.order, a.first)
-    if not todo:
-        print(f"study {sd.study.name}: nothing to submit ({len(points)} runs complete or queued)")
-        write_index(sd)
-        return 0
     sdir = os.path.join(sd.dir, "slurm")
-    os.makedirs(sdir, exist_ok=True)
     stamp = time.strftime("%Y%m%d-%H%M%S")
-    listing = os.path.join(sdir, f"batch-{stamp}.txt")
-    write_atomic(listing, "".join(sd.study.run_name(p) + "\n" for p in todo))
     me = STUDY_PY
     common = []
     for flag, val in (("--partition", a.partition), ("--time", a.time), ("--mem", a.mem)):
         if val:
             common.append(f"#SBATCH {flag}={val}")
     common += [f"#SBATCH {x}" for x in a.sbatch]
+    after = os.path.join(sdir, f"index-{stamp}.sbatch")
+
+    def index_job(dependency):
+        """The job that writes the index and analyses the study (after the array, or alone)."""
+        os.makedirs(sdir, exist_ok=True)
+        write_atomic(after, "\n".join([
+            "#!/bin/bash", f"#SBATCH --job-name=dynhet-{sd.study.name}-index",
+            f"#SBATCH --output={sdir}/index-%j.out", *common,
+            "# After every task: the study's index (and what must follow the runs).",
+            f"exec /usr/bin/python3 {me} index {sd.dir} --analyse" + (" --no-figures" if a.no_figures else ""), ""]))
+        r2 = subprocess.run(["sbatch", "--parsable", *dependency, after], capture_output=True, text=True)
+        if r2.returncode != 0:
+            raise StudyError(f"sbatch refused the index job: {r2.stderr.strip()}")
+        return r2.stdout.strip().split(";")[0]
+
+    if not todo:
+        write_index(sd)
+        if restored and all(read_status(sd.run_dir(p)).get("state") == "complete" for p in points):
+            # every run restored from the archive (a new machine): nothing to run, the analysis still to do
+            dep = index_job([])
+            print(f"study {sd.study.name}: every run complete in the archive; index job {dep} analyses the study")
+            return 0
+        print(f"study {sd.study.name}: nothing to submit ({len(points)} runs complete or queued)")
+        return 0
+    os.makedirs(sdir, exist_ok=True)
+    listing = os.path.join(sdir, f"batch-{stamp}.txt")
+    write_atomic(listing, "".join(sd.study.run_name(p) + "\n" for p in todo))
     array = os.path.join(sdir, f"array-{stamp}.sbatch")
     write_atomic(array, "\n".join([
         "#!/bin/bash",
@@ -78,12 +98,6 @@ def run_slurm(sd, a):
         "  fi",
         "fi",
         "exit $rc", ""]))
-    after = os.path.join(sdir, f"index-{stamp}.sbatch")
-    write_atomic(after, "\n".join([
-        "#!/bin/bash", f"#SBATCH --job-name=dynhet-{sd.study.name}-index",
-        f"#SBATCH --output={sdir}/index-%j.out", *common,
-        "# After every task: the study's index (and what must follow the runs).",
-        f"exec /usr/bin/python3 {me} index {sd.dir} --analyse" + (" --no-figures" if a.no_figures else ""), ""]))
     # Held until every run's status says queued: a task that started at once
     # would have its "running" overwritten by this loop's "queued".
     r = subprocess.run(["sbatch", "--parsable", "--hold", array], capture_output=True, text=True)
@@ -119,11 +133,7 @@ def run_slurm(sd, a):
                              f"could not be cancelled either ({c.stderr.strip()}): scancel {job}")
                              + ", the runs' states put back: submit again") from None
         raise
-    r2 = subprocess.run(["sbatch", "--parsable", f"--dependency=afterany:{job}", after], capture_output=True,
-                        text=True)
-    if r2.returncode != 0:
-        raise StudyError(f"sbatch refused the index job: {r2.stderr.strip()}")
-    dep = r2.stdout.strip().split(";")[0]
+    dep = index_job([f"--dependency=afterany:{job}"])
     write_index(sd)
     print(f"study {sd.study.name}: {len(todo)} runs submitted as Slurm job array {job} "
           f"(tasks {sdir}/task-{job}_<i>.out), index job {dep} after it; run the same command again to "
