@@ -42,6 +42,15 @@ check 'grep -q -- "--analyse --no-figures" "$tmp"/s/slurm/index-*.sbatch && [[ -
 # Again: nothing left to submit.
 bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --no-figures --executor slurm --out "$tmp/s" >"$tmp/s2.out" 2>&1
 check 'grep -q "nothing to submit" "$tmp/s2.out"' "submitted again: nothing to submit"
+# A new machine: a study directory gone, its runs all in the archive. Nothing
+# is run; the index job alone is submitted, and analyses the study.
+/usr/bin/python3 "$root/launch_scripts/study.py" archive "$tmp/l" --to "$tmp/arch" >"$tmp/ar.out" 2>&1 || { cat "$tmp/ar.out"; exit 1; }
+bash "$root/launch_scripts/run_study.sh" "$root/studies/tiny.toml" --no-build --no-figures --executor slurm --out "$tmp/s4" \
+  --archive "$tmp/arch" --time=10 >"$tmp/s4.out" 2>&1 || { cat "$tmp/s4.out"; exit 1; }
+wait_queue "the index job alone"
+check 'grep -q "4 runs complete in the archive" "$tmp/s4.out" && grep -q "every run complete in the archive; index job" "$tmp/s4.out" &&
+  ! ls "$tmp"/s4/slurm/array-*.sbatch >/dev/null 2>&1 && [[ -f $tmp/s4/study.h5 ]]' \
+  "every run in the archive: no array, the index job alone analysed the study"
 # A run that failed, submitted again, starts over: the queue keeps what it was
 # (previous_state), it is not resumed from its failed attempt's checkpoints.
 run=$(ls "$tmp/s/runs" | head -1)
