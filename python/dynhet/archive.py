@@ -311,14 +311,11 @@ class Archive:
     def claim(self, study):
         """Create the archive for `study` (a study.model.Study) or check that
         it holds that very study."""
-        from .study.rundir import same_toml
         from .study.toml_io import toml_dump
         with self._locked():
             copy = os.path.join(self.dir, "study.toml")
             if os.path.exists(copy):
-                if not same_toml(open(copy, "rb").read(), study.text):
-                    raise ArchiveError(f"{self.dir} archives another study than {study.path} ({copy} differs): "
-                                       "give another archive, or restore the study file")
+                self.check_study(study)
             else:
                 with open(copy + ".tmp", "wb") as fh:
                     fh.write(study.text)
@@ -333,6 +330,15 @@ class Archive:
                 idx["archive"] = {"format": FORMAT, "study": study.name,
                                   "description": getattr(study, "description", "") or ""}
                 self._write_index(idx)
+
+    def check_study(self, study):
+        """Refuses (ArchiveError) an archive that holds another study than
+        `study`; one that holds none yet, or this one, passes. Writes nothing."""
+        from .study.rundir import same_toml
+        copy = os.path.join(self.dir, "study.toml")
+        if os.path.exists(copy) and not same_toml(open(copy, "rb").read(), study.text):
+            raise ArchiveError(f"{self.dir} archives another study than {study.path} ({copy} differs): "
+                               "give another archive, or restore the study file")
 
     def add_run(self, name, run_dir, status, axes, study_name, command):
         """Reduce run_dir/run.h5 into runs/<name>.h5 and list it; returns its

@@ -53,22 +53,25 @@ def change_dof(p, cr):
 MIN_DOF = 2   # below it the limit is no check: one dof puts it at 236 errors (two dof: 19, one run of 4 origins)
 
 
+def unjudged_reason(m, whole, dof=None):
+    """Why steady_off cannot judge a size (m, Point.mean's), or None where it
+    can: no error (no value, no error, or not every seed has one), or an
+    error of fewer than MIN_DOF dof (the spread of two seeds, where some
+    run quotes none)."""
+    if not (whole and np.isfinite(m[0]) and np.isfinite(measured_error(m))):
+        return "no error"
+    if dof is not None and dof < MIN_DOF:
+        return f"{dof:.3g} dof: 3σ's probability would allow {steady_limit(dof):.0f} errors"
+    return None
+
+
 def steady_off(m, whole, dof=None):
     """Whether a size's change over the production (m, Point.mean's) lies
     beyond steady_limit(dof) errors from 0; None where it cannot be judged
-    (no value, no error, not every seed has one, or an error of fewer than
-    MIN_DOF dof: the spread of two seeds, where some run quotes none)."""
-    e = measured_error(m)
-    if not (whole and np.isfinite(m[0]) and np.isfinite(e)) or (dof is not None and dof < MIN_DOF):
+    (unjudged_reason)."""
+    if unjudged_reason(m, whole, dof) is not None:
         return None
-    return abs(m[0]) > steady_limit(dof) * e
-
-
-def unjudged_reason(m, whole, dof=None):
-    """Why steady_off cannot judge a size (for the verdict's text)."""
-    if whole and np.isfinite(m[0]) and np.isfinite(measured_error(m)) and dof is not None and dof < MIN_DOF:
-        return f"{dof:.3g} dof: 3σ's probability would allow {steady_limit(dof):.0f} errors"
-    return "no error"
+    return abs(m[0]) > steady_limit(dof) * measured_error(m)
 
 
 def unsteady(p, cr):
@@ -88,11 +91,11 @@ def steady_verdict(ns, ms, whole, dofs=None):
     for n, m, w, k in zip(ns, ms, whole, dofs or [None] * len(ns)):
         if not np.isfinite(m[0]):
             continue
-        away = steady_off(m, w, k)
-        if away is None:
-            unjudged.setdefault(unjudged_reason(m, w, k), []).append(n)
+        why = unjudged_reason(m, w, k)
+        if why is not None:
+            unjudged.setdefault(why, []).append(n)
             continue
-        (off if away else ok).append((n, m[0], measured_error(m)))
+        (off if steady_off(m, w, k) else ok).append((n, m[0], measured_error(m)))
     tail = "".join(f"; not judged ({why}) at N = {', '.join(str(n) for n in sizes)}" for why, sizes in unjudged.items())
     if not off and not ok:
         return ("no verdict: " + tail[2:]) if tail else "no verdict: no size with every seed's value and an error"

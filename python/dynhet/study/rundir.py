@@ -167,11 +167,8 @@ class StudyDir:
         st = os.stat(self.archive.index_path)
         stamp = (st.st_ino, st.st_size, st.st_mtime_ns)
         if getattr(self, "_index_stamp", None) != stamp:
-            copy = os.path.join(self.archive.dir, "study.toml")
-            if os.path.exists(copy) and not same_toml(open(copy, "rb").read(), self.study.text):
-                raise StudyError(f"{self.archive.dir} archives another study than {self.study.path} ({copy} "
-                                 "differs): give another archive, or restore the study file")
             try:
+                self.archive.check_study(self.study)
                 self._index, self._index_stamp = self.archive.read(), stamp
             except ArchiveError as e:
                 raise StudyError(str(e)) from None
