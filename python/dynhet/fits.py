@@ -118,6 +118,19 @@ def _clean(x, y, sy):
     return x[m], y[m], sy[m]
 
 
+def _too_few(x, points, distinct, what):
+    """Why the points x cannot carry a fit, or None: fewer than `points`
+    points, or fewer than `distinct` different x (a line through points at
+    one x has no slope, and its normal equations are singular). `what`
+    names the fit with its verb: "a power law needs"."""
+    n, d = len(x), len(np.unique(x))
+    if n < points:
+        return f"{n} points with data in the range: {what} {points}"
+    if d < distinct:
+        return f"{n} points at {d} distinct x: {what} {distinct}"
+    return None
+
+
 def _wlin(u, v, w):
     """Weighted straight line v = c0 + c1 u (weights w = 1/sigma^2): (c, cov, chi2)."""
     A = np.vstack([np.ones_like(u), u]).T * np.sqrt(w)[:, None]
@@ -197,8 +210,8 @@ def power(x, y, sy, x_range=None, sx=None):
     m = x > 0
     x, y, sy = x[m], y[m], sy[m]
     sx = sx[m] if sx is not None else None
-    if len(x) < 3:
-        fit.note = f"{len(x)} points with data in the range: a power law needs 3"
+    if (why := _too_few(x, 3, 2, "a power law needs")):
+        fit.note = why
         return fit
     fit.x_range = (float(x.min()), float(x.max()))
     c, cov, chi2 = _wlin(np.log(x), np.log(y), (y / sy) ** 2)
@@ -239,8 +252,8 @@ def _singular(form, names, x, y, sy, x_range, s_max, u, sign):
     sy/y). names: (singular point, k, amplitude)."""
     fit = Fit(form, names)
     x, y, sy = _in_range(x, y, sy, x_range)
-    if len(x) < 4:
-        fit.note = f"{len(x)} points with data in the range: three parameters need 4"
+    if (why := _too_few(x, 4, 3, "three parameters need")):
+        fit.note = why
         return fit
     fit.x_range = (float(x.min()), float(x.max()))
     fit.xs = np.unique(x)
@@ -284,8 +297,8 @@ def critical_fixed(x, y, sy, xc, x_range=None):
         return fit
     m = x < xc
     x, y, sy = x[m], y[m], sy[m]
-    if len(x) < 3:
-        fit.note = f"{len(x)} points below xc = {xc:.4g}: two parameters need 3"
+    if (why := _too_few(x, 3, 2, "two parameters need")):
+        fit.note = f"below xc = {xc:.4g}, {why}"
         return fit
     fit.x_range = (float(x.min()), float(x.max()))
     c, cov, chi2 = _wlin(np.log(xc - x), np.log(y), (y / sy) ** 2)
@@ -335,8 +348,8 @@ def critical_joint(series, x_range=None, xc_max=1.0):
     data = {}
     for k in keys:
         x, y, sy = _in_range(*series[k], x_range)
-        if len(x) < 3:
-            fit.note = f"{k}: {len(x)} points with data in the range; each series needs 3"
+        if (why := _too_few(x, 3, 2, "each series needs")):
+            fit.note = f"{k}: {why}"
             return fit
         data[k] = (x, y, sy)
     allx = np.concatenate([d[0] for d in data.values()])

@@ -38,6 +38,25 @@ def test_refusals_say_why():
     assert not f.ok and "below xc" in f.note                      # 2 points below 0.69 only
 
 
+def test_points_at_too_few_distinct_x_are_refused_not_a_crash():
+    """Seeds of one size, or one density, stacked: a line through one x has
+    no slope (its normal equations are singular), three parameters need
+    three distinct x."""
+    y, sy = [1.0, 1.1, 0.9, 2.0], [0.1] * 4
+    f = sf.power([2, 2, 2], y[:3], sy[:3])
+    assert not f.ok and "1 distinct x" in f.note
+    f = sf.critical_fixed([0.7] * 3, y[:3], sy[:3], 0.8)
+    assert not f.ok and "1 distinct x" in f.note
+    f = sf.critical([0.7, 0.7, 0.7, 0.71], y, sy)
+    assert not f.ok and "2 distinct x" in f.note
+    f = sf.vft([0.7, 0.7, 0.7, 0.71], y, sy)
+    assert not f.ok and "2 distinct x" in f.note
+    f = sf.critical_joint({"tau": ([0.7] * 3, y[:3], sy[:3]), "chi4": (PHI, PHI, 0.1 * PHI)})
+    assert not f.ok and f.note.startswith("tau: ")
+    f = sf.power([2, 2, 3], y[:3], sy[:3])                          # two distinct x: a line
+    assert f.ok and f.dof == 1
+
+
 def test_cannot_judge_an_edge_or_an_improbable_chi2():
     y = 0.05 * (0.7804 - PHI) ** -1.0
     edge = sf.critical(PHI, y, 0.01 * y)
