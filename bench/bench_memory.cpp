@@ -2,24 +2,23 @@
 // memory it lands in: the ceiling on how well an engine whose events land
 // anywhere in the box can keep its rate as N grows.
 //
-// A buffer of S MiB is cut into 64-byte lines linked in one random cycle
-// (each line holds the address of the next). Following the links is a chain
-// of dependent loads: with one chain, each load waits for the one before
-// (the latency); with K chains followed side by side, K loads are in flight
-// at once, as the engine's requests ahead of its events are (the cost per
-// load when the memory system overlaps them). Each case is measured on 4 KiB
+// A walk through a buffer of S MiB reads one 64-byte line after another,
+// each drawn at random from the word read before (a chain of dependent
+// loads): with one walk, each load waits for the one before (the latency);
+// with K walks side by side, K loads are in flight at once, as the engine's
+// requests ahead of its events are (the cost per load when the memory
+// system overlaps them). Each case is measured on 4 KiB
 // pages and on the transparent huge pages the engine advises its big arrays
 // to (dynhet/engine/memory.hpp; the kernel must be in madvise or always
 // mode), --reps times, and the median is printed with the ratio to the
 // size --ref (the footprint of N = 10^5: 21 to 26 MB). The last column,
-// "paged", follows one chain on huge pages that takes every line of a 4 KiB
-// page (in random order) before it moves to the next (pages in random
-// order): the same lines missed, a new translation once every 64 loads. Where
-// it is fast and the random chain is slow, the random chain's cost is the
-// address translation, not the cache.
+// "paged", is one walk on huge pages that stays 63 steps of 64 in the 4 KiB
+// page it is in: the same share of lines from the cache, a new translation
+// once every 64 loads. Where it is fast and the random walk is slow, the
+// random walk's cost is the address translation, not the cache.
 //
-//   bench_memory                       # 1 to 1024 MiB, 1 and 8 chains
-//   bench_memory --mib 24 --mib 256 --chains 16 --reps 5
+//   bench_memory                       # 1 to 1024 MiB, 1 and 8 walks
+//   bench_memory --mib 24 --mib 256 --walks 16 --reps 5
 #include <sys/mman.h>
 
 #include <algorithm>
@@ -50,50 +49,50 @@ struct Buffer {
   Buffer& operator=(const Buffer&) = delete;
 };
 
-struct Xorshift {
-  uint64_t s;
-  uint64_t operator()() { return s ^= s << 13, s ^= s >> 7, s ^= s << 17; }
-};
-
-// One cycle through every line, written as links: in random order
-// (Sattolo's shuffle), or, grouped, the 4 KiB pages in random order and the
-// 64 lines of each page in random order before the next page: the same
-// cache misses, but a new page (a translation) once every 64 loads.
-void link_cycle(Buffer& b, uint64_t seed, bool grouped) {
-  const std::size_t n = b.bytes / 64;
-  std::vector<uint32_t> order(n);
-  Xorshift rnd{seed | 1};
-  if (!grouped) {
-    for (std::size_t i = 0; i < n; ++i) order[i] = static_cast<uint32_t>(i);
-    for (std::size_t i = n - 1; i > 0; --i) std::swap(order[i], order[rnd() % i]);
-  } else {
-    std::vector<uint32_t> pages(n / 64);
-    for (std::size_t k = 0; k < pages.size(); ++k) pages[k] = static_cast<uint32_t>(k);
-    for (std::size_t k = pages.size() - 1; k > 0; --k) std::swap(pages[k], pages[rnd() % (k + 1)]);
-    for (std::size_t k = 0; k < pages.size(); ++k) {
-      uint32_t* line = &order[k * 64];
-      for (uint32_t l = 0; l < 64; ++l) line[l] = pages[k] * 64 + l;
-      for (int l = 63; l > 0; --l) std::swap(line[l], line[rnd() % (l + 1)]);
-    }
+// Each line's first word is random. A walk reads the word of its line and
+// takes its next line from it (a hash of the word and the step), so each
+// load waits for the one before and lands on a line drawn at random anew,
+// as an event's particle is: where the buffer is C / S in the cache, about
+// that share of the loads hit it (a fixed cycle through every line would
+// hit nothing once the buffer outgrows the cache).
+void fill_random(Buffer& b, uint64_t seed) {
+  uint64_t s = seed | 1;
+  for (std::size_t i = 0; i < b.bytes / 64; ++i) {
+    s ^= s << 13, s ^= s >> 7, s ^= s << 17;
+    *reinterpret_cast<uint64_t*>(b.p + i * 64) = s;
   }
-  for (std::size_t i = 0; i < n; ++i)
-    *reinterpret_cast<char**>(b.p + std::size_t{order[i]} * 64) = b.p + std::size_t{order[(i + 1) % n]} * 64;
 }
 
-// ns per load, following `chains` links side by side, `loads` loads in all.
-double chase(const Buffer& b, int chains, std::size_t loads) {
+inline uint64_t mix(uint64_t v) { // a 64-bit finaliser (splitmix64's)
+  v = (v ^ (v >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  v = (v ^ (v >> 27)) * 0x94d049bb133111ebULL;
+  return v ^ (v >> 31);
+}
+inline std::size_t below(uint64_t h, std::size_t n) { // h scaled to [0, n) without a division
+  return static_cast<std::size_t>((static_cast<unsigned __int128>(h) * n) >> 64);
+}
+
+// ns per load, `walks` walks side by side, `loads` loads in all. Paged: 63
+// of every 64 steps stay in the 4 KiB page of the line before (another line
+// of it, at random), the 64th goes to a random page: misses as before
+// where the buffer outgrows the cache, a new page (a translation) once
+// every 64 loads.
+double walk(const Buffer& b, int walks, std::size_t loads, bool paged) {
   const std::size_t n = b.bytes / 64;
-  std::vector<char*> at(chains);
-  for (int c = 0; c < chains; ++c) at[c] = b.p + (n / chains) * c * 64; // starts spread along the cycle's storage
-  const std::size_t rounds = loads / chains;
+  std::vector<std::size_t> at(walks);
+  for (int c = 0; c < walks; ++c) at[c] = below(mix(0x9e3779b97f4a7c15ULL * (c + 1)), n);
+  const std::size_t rounds = loads / walks;
   const auto t0 = std::chrono::steady_clock::now();
   for (std::size_t r = 0; r < rounds; ++r)
-    for (int c = 0; c < chains; ++c) at[c] = *reinterpret_cast<char**>(at[c]);
+    for (int c = 0; c < walks; ++c) {
+      const uint64_t h = mix(*reinterpret_cast<const uint64_t*>(b.p + at[c] * 64) + r);
+      at[c] = !paged || r % 64 == 63 ? below(h, n) : (at[c] & ~std::size_t{63}) + (h & 63);
+    }
   const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  uintptr_t sink = 0;
-  for (char* a : at) sink ^= reinterpret_cast<uintptr_t>(a);
-  if (sink == 1) std::puts(""); // keeps the loads
-  return dt / static_cast<double>(rounds * chains) * 1e9;
+  std::size_t sink = 0;
+  for (const std::size_t a : at) sink ^= a;
+  if (sink == n) std::puts(""); // keeps the loads
+  return dt / static_cast<double>(rounds * walks) * 1e9;
 }
 
 double median(std::vector<double> v) {
@@ -105,12 +104,12 @@ double median(std::vector<double> v) {
 
 int main(int argc, char** argv) {
   CLI::App app{"the cost of a random load against the memory it lands in (4 KiB and huge pages)"};
-  std::vector<std::size_t> mib{1, 2, 4, 8, 16, 24, 64, 256, 1024};
-  std::vector<int> chains{1, 8};
+  std::vector<std::size_t> mib{1, 4, 8, 12, 16, 24, 32, 64, 256, 1024};
+  std::vector<int> walks{1, 8};
   std::size_t ref = 24, loads = 4000000;
   int reps = 3;
   app.add_option("--mib", mib, "buffer sizes in MiB")->check(CLI::Range(std::size_t{1}, std::size_t{16384}));
-  app.add_option("--chains", chains, "loads in flight at once (independent chains)")->check(CLI::Range(1, 64));
+  app.add_option("--walks", walks, "loads in flight at once (independent walks)")->check(CLI::Range(1, 64));
   app.add_option("--ref", ref, "the size (MiB) the ratios are taken against")->check(CLI::Range(std::size_t{1}, std::size_t{16384}));
   app.add_option("--loads", loads, "loads timed per measurement")->check(CLI::Range(std::size_t{1000}, std::size_t{1} << 34));
   app.add_option("--reps", reps, "measurements per case (the median is printed)")->check(CLI::Range(1, 99));
@@ -119,38 +118,33 @@ int main(int argc, char** argv) {
   std::sort(mib.begin(), mib.end());
   mib.erase(std::unique(mib.begin(), mib.end()), mib.end());
 
-  std::vector<double> grouped(mib.size()); // huge pages, one chain, a page's lines together
-  // ns[size][pages][chains]
-  std::vector<std::vector<std::vector<double>>> ns(mib.size(), std::vector<std::vector<double>>(2, std::vector<double>(chains.size())));
+  std::vector<double> grouped(mib.size()); // huge pages, one walk, mostly within a page
+  // ns[size][pages][walks]
+  std::vector<std::vector<std::vector<double>>> ns(mib.size(), std::vector<std::vector<double>>(2, std::vector<double>(walks.size())));
   for (std::size_t s = 0; s < mib.size(); ++s)
     for (int huge = 0; huge < 2; ++huge) {
       Buffer b(mib[s] << 20, huge == 1);
-      link_cycle(b, 0x9e3779b97f4a7c15ULL + mib[s], false);
-      for (std::size_t c = 0; c < chains.size(); ++c) {
-        chase(b, chains[c], std::max<std::size_t>(loads / 8, 1000)); // warm the caches and the TLB
+      fill_random(b, 0x9e3779b97f4a7c15ULL + mib[s]);
+      const auto measure = [&](int k, bool paged) {
+        walk(b, k, std::max<std::size_t>(loads / 8, 1000), paged); // warm the caches and the TLB
         std::vector<double> v;
-        for (int r = 0; r < reps; ++r) v.push_back(chase(b, chains[c], loads));
-        ns[s][huge][c] = median(v);
-      }
-      if (huge == 1) { // the same misses, a page change once every 64 loads
-        link_cycle(b, 0x9e3779b97f4a7c15ULL + mib[s], true);
-        chase(b, 1, std::max<std::size_t>(loads / 8, 1000));
-        std::vector<double> v;
-        for (int r = 0; r < reps; ++r) v.push_back(chase(b, 1, loads));
-        grouped[s] = median(v);
-      }
+        for (int r = 0; r < reps; ++r) v.push_back(walk(b, k, loads, paged));
+        return median(v);
+      };
+      for (std::size_t c = 0; c < walks.size(); ++c) ns[s][huge][c] = measure(walks[c], false);
+      if (huge == 1) grouped[s] = measure(1, true);
       std::fprintf(stderr, "  %zu MiB, %s pages: done\n", mib[s], huge ? "huge" : "4 KiB");
     }
   const std::size_t r = std::find(mib.begin(), mib.end(), ref) - mib.begin();
-  std::printf("ns per load, median of %d; 4kxK / hugexK: 4 KiB or huge pages, K chains in flight; ref/x: the rate against %zu MiB's (the same pages and chains); paged: huge pages, one chain, a page's lines together\n", reps, ref);
+  std::printf("ns per load, median of %d; 4kxK / hugexK: 4 KiB or huge pages, K walks in flight; ref/x: the rate against %zu MiB's (the same pages and walks); paged: huge pages, one walk, 63 steps of 64 within a 4 KiB page\n", reps, ref);
   std::printf("%8s", "MiB");
   for (const char* pg : {"4k", "huge"})
-    for (int k : chains) std::printf(" %9s %7s", (std::string(pg) + "x" + std::to_string(k)).c_str(), "ref/x");
+    for (int k : walks) std::printf(" %9s %7s", (std::string(pg) + "x" + std::to_string(k)).c_str(), "ref/x");
   std::printf(" %9s\n", "paged");
   for (std::size_t s = 0; s < mib.size(); ++s) {
     std::printf("%8zu", mib[s]);
     for (int huge = 0; huge < 2; ++huge)
-      for (std::size_t c = 0; c < chains.size(); ++c) std::printf(" %9.1f %7.2f", ns[s][huge][c], ns[r][huge][c] / ns[s][huge][c]);
+      for (std::size_t c = 0; c < walks.size(); ++c) std::printf(" %9.1f %7.2f", ns[s][huge][c], ns[r][huge][c] / ns[s][huge][c]);
     std::printf(" %9.1f\n", grouped[s]);
   }
   return 0;
