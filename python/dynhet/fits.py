@@ -118,16 +118,20 @@ def _clean(x, y, sy):
     return x[m], y[m], sy[m]
 
 
-def _too_few(x, points, distinct, what):
-    """Why the points x cannot carry a fit, or None: fewer than `points`
-    points, or fewer than `distinct` different x (a line through points at
-    one x has no slope, and its normal equations are singular). `what`
-    names the fit with its verb: "a power law needs"."""
+def _too_few(x, y, sy, points, distinct, what):
+    """Why the points cannot carry a fit, or None: fewer than `points`
+    points, fewer than `distinct` different x (a line through points at one
+    x has no slope, and its normal equations are singular), or a weight
+    (y / sy)^2 beyond the floats' range. `what` names the fit with its verb:
+    "a power law needs"."""
     n, d = len(x), len(np.unique(x))
     if n < points:
         return f"{n} points with data in the range: {what} {points}"
     if d < distinct:
         return f"{n} points at {d} distinct x: {what} {distinct}"
+    with np.errstate(all="ignore"):
+        if not np.all(np.isfinite((np.asarray(y) / np.asarray(sy)) ** 2)):
+            return "a relative error sy / y below 1e-154: its weight is beyond the floats' range"
     return None
 
 
@@ -135,8 +139,13 @@ def _wlin(u, v, w):
     """Weighted straight line v = c0 + c1 u (weights w = 1/sigma^2): (c, cov, chi2)."""
     A = np.vstack([np.ones_like(u), u]).T * np.sqrt(w)[:, None]
     b = v * np.sqrt(w)
+    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):   # weights beyond the floats' range
+        return np.full(2, math.nan), np.full((2, 2), math.nan), math.nan
     c, *_ = np.linalg.lstsq(A, b, rcond=None)
-    cov = np.linalg.inv(A.T @ A)
+    try:
+        cov = np.linalg.inv(A.T @ A)
+    except np.linalg.LinAlgError:   # weights beyond the floats' range: no errors
+        cov = np.full((2, 2), math.nan)
     r = A @ c - b
     return c, cov, float(r @ r)
 
@@ -180,6 +189,15 @@ def _scan_best(n_scan, chi2_of, chi2_all, scale):
     return best
 
 
+def _inside(p0, lo, hi):
+    """A least-squares start moved into its bounds (a scan's line may be
+    steeper than they allow, and least_squares refuses a start outside):
+    the start only, so a fit whose best lies at a bound still ends there."""
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    room = 1e-9 * np.maximum(1.0, hi - lo)
+    return np.clip(np.asarray(p0, float), lo + room, hi - room)
+
+
 def _finish(fit, res, names, n):
     J = res.jac
     try:
@@ -210,7 +228,7 @@ def power(x, y, sy, x_range=None, sx=None):
     m = x > 0
     x, y, sy = x[m], y[m], sy[m]
     sx = sx[m] if sx is not None else None
-    if (why := _too_few(x, 3, 2, "a power law needs")):
+    if (why := _too_few(x, y, sy, 3, 2, "a power law needs")):
         fit.note = why
         return fit
     fit.x_range = (float(x.min()), float(x.max()))
@@ -223,8 +241,13 @@ def power(x, y, sy, x_range=None, sx=None):
         # points' errors taken as they are, as everywhere here).
         c, cov, chi2 = out.beta, out.cov_beta, float(out.sum_square)
         fit.note = "orthogonal distance regression (errors in x and y)"
-    fit.p.update(A=float(math.exp(c[0])), s=float(c[1]))
-    fit.err.update(A=float(math.exp(c[0]) * math.sqrt(cov[0, 0])), s=float(math.sqrt(cov[1, 1])))
+    with np.errstate(over="ignore", invalid="ignore"):
+        amp, e = float(np.exp(c[0])), np.sqrt(np.diag(cov))
+    if not np.isfinite(amp):
+        fit.note = f"ln A = {c[0]:.4g} (slope {c[1]:.4g}): the amplitude is beyond the floats' range"
+        return fit
+    fit.p.update(A=amp, s=float(c[1]))
+    fit.err.update(A=float(amp * e[0]), s=float(e[1]))
     fit.chi2, fit.n, fit.dof = chi2, len(x), len(x) - 2
     return fit
 
@@ -252,12 +275,15 @@ def _singular(form, names, x, y, sy, x_range, s_max, u, sign):
     sy/y). names: (singular point, k, amplitude)."""
     fit = Fit(form, names)
     x, y, sy = _in_range(x, y, sy, x_range)
-    if (why := _too_few(x, 4, 3, "three parameters need")):
+    if (why := _too_few(x, y, sy, 4, 3, "three parameters need")):
         fit.note = why
         return fit
     fit.x_range = (float(x.min()), float(x.max()))
     fit.xs = np.unique(x)
     top = x.max()
+    if not top + 1e-4 < s_max:
+        fit.note = f"the largest x, {top:.4g}, is not below the scan's end ({s_max}): no {names[0]} above it to find"
+        return fit
     scan = top + np.geomspace(1e-4, s_max - top, 400)
     v, w = np.log(y), (y / sy) ** 2
 
@@ -273,7 +299,8 @@ def _singular(form, names, x, y, sy, x_range, s_max, u, sign):
     def res(p):
         return (p[2] + sign * p[1] * u(np.maximum(p[0] - x, 1e-12)) - v) / sl
 
-    r = least_squares(res, [s0, sign * c[1], c[0]], bounds=([top + 1e-6, -50, -200], [s_max + 1.0, 50, 200]))
+    lo, hi = [top + 1e-6, -50, -200], [s_max + 1.0, 50, 200]
+    r = least_squares(res, _inside([s0, sign * c[1], c[0]], lo, hi), bounds=(lo, hi))
     _finish(fit, r, [names[0], names[1], "lnA"], len(x))
     fit.p[names[2]], fit.err[names[2]] = math.exp(fit.p.pop("lnA")), math.exp(r.x[2]) * fit.err.pop("lnA")
     if s0 >= scan[-1] - 1e-12 or fit.p[names[0]] > s_max:
@@ -297,7 +324,7 @@ def critical_fixed(x, y, sy, xc, x_range=None):
         return fit
     m = x < xc
     x, y, sy = x[m], y[m], sy[m]
-    if (why := _too_few(x, 3, 2, "two parameters need")):
+    if (why := _too_few(x, y, sy, 3, 2, "two parameters need")):
         fit.note = f"below xc = {xc:.4g}, {why}"
         return fit
     fit.x_range = (float(x.min()), float(x.max()))
@@ -348,7 +375,7 @@ def critical_joint(series, x_range=None, xc_max=1.0):
     data = {}
     for k in keys:
         x, y, sy = _in_range(*series[k], x_range)
-        if (why := _too_few(x, 3, 2, "each series needs")):
+        if (why := _too_few(x, y, sy, 3, 2, "each series needs")):
             fit.note = f"{k}: {why}"
             return fit
         data[k] = (x, y, sy)
@@ -356,6 +383,9 @@ def critical_joint(series, x_range=None, xc_max=1.0):
     fit.x_range = (float(allx.min()), float(allx.max()))
     fit.xs = np.unique(allx)
     top = allx.max()
+    if not top + 1e-4 < xc_max:
+        fit.note = f"the largest x, {top:.4g}, is not below the scan's end ({xc_max}): no xc above it to find"
+        return fit
     scan = top + np.geomspace(1e-4, xc_max - top, 300)
 
     def lines(i):
@@ -383,7 +413,7 @@ def critical_joint(series, x_range=None, xc_max=1.0):
 
     lo = [top + 1e-6] + [-50] * K + [-200] * K
     hi = [xc_max + 1.0] + [50] * K + [200] * K
-    r = least_squares(res, p0, bounds=(lo, hi))
+    r = least_squares(res, _inside(p0, lo, hi), bounds=(lo, hi))
     lnames = ["xc"] + [f"g_{k}" for k in keys] + [f"lnA_{k}" for k in keys]
     tmp = Fit("tmp", lnames)
     _finish(tmp, r, lnames, len(allx))
