@@ -128,10 +128,10 @@ def _too_few(x, y, sy, points, distinct, what):
     if n < points:
         return f"{n} points with data in the range: {what} {points}"
     if d < distinct:
-        return f"{n} points at {d} distinct x: {what} {distinct}"
+        return f"{n} points at {d} distinct x: {what} {distinct} distinct x"
     with np.errstate(all="ignore"):
         if not np.all(np.isfinite((np.asarray(y) / np.asarray(sy)) ** 2)):
-            return "a relative error sy / y below 1e-154: its weight is beyond the floats' range"
+            return "a relative error sy / y so small (below about 1e-154) that its weight (y / sy)^2 is beyond the floats' range"
     return None
 
 
@@ -191,11 +191,15 @@ def _scan_best(n_scan, chi2_of, chi2_all, scale):
 
 def _inside(p0, lo, hi):
     """A least-squares start moved into its bounds (a scan's line may be
-    steeper than they allow, and least_squares refuses a start outside):
-    the start only, so a fit whose best lies at a bound still ends there."""
-    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
-    room = 1e-9 * np.maximum(1.0, hi - lo)
-    return np.clip(np.asarray(p0, float), lo + room, hi - room)
+    steeper than they allow, and least_squares refuses a start outside
+    them); a start inside them, bounds included, is kept as it is."""
+    return np.clip(np.asarray(p0, float), lo, hi)
+
+
+def _at_bound(res, names):
+    """The names of the parameters the refinement left at a bound (its
+    active_mask), or an empty list."""
+    return [n for n, a in zip(names, res.active_mask) if a != 0]
 
 
 def _finish(fit, res, names, n):
@@ -282,7 +286,7 @@ def _singular(form, names, x, y, sy, x_range, s_max, u, sign):
     fit.xs = np.unique(x)
     top = x.max()
     if not top + 1e-4 < s_max:
-        fit.note = f"the largest x, {top:.4g}, is not below the scan's end ({s_max}): no {names[0]} above it to find"
+        fit.note = f"the largest x, {top:.4g}, is not at least 1e-4 below the scan's end ({s_max}): no {names[0]} above it to find"
         return fit
     scan = top + np.geomspace(1e-4, s_max - top, 400)
     v, w = np.log(y), (y / sy) ** 2
@@ -301,6 +305,10 @@ def _singular(form, names, x, y, sy, x_range, s_max, u, sign):
 
     lo, hi = [top + 1e-6, -50, -200], [s_max + 1.0, 50, 200]
     r = least_squares(res, _inside([s0, sign * c[1], c[0]], lo, hi), bounds=(lo, hi))
+    if (pinned := [n for n in _at_bound(r, [names[0], names[1], f"ln {names[2]}"]) if n != names[0]]):
+        fit.note = (f"{' and '.join(pinned)} at the refinement's bound (|{names[1]}| <= 50, |ln {names[2]}| <= 200):"
+                    " the points are beyond this form's reach")
+        return fit
     _finish(fit, r, [names[0], names[1], "lnA"], len(x))
     fit.p[names[2]], fit.err[names[2]] = math.exp(fit.p.pop("lnA")), math.exp(r.x[2]) * fit.err.pop("lnA")
     if s0 >= scan[-1] - 1e-12 or fit.p[names[0]] > s_max:
@@ -379,12 +387,15 @@ def critical_joint(series, x_range=None, xc_max=1.0):
             fit.note = f"{k}: {why}"
             return fit
         data[k] = (x, y, sy)
+    if max(len(np.unique(d[0])) for d in data.values()) < 3:
+        fit.note = "no series has 3 distinct x: a line per series through 2 x fits any xc"
+        return fit
     allx = np.concatenate([d[0] for d in data.values()])
     fit.x_range = (float(allx.min()), float(allx.max()))
     fit.xs = np.unique(allx)
     top = allx.max()
     if not top + 1e-4 < xc_max:
-        fit.note = f"the largest x, {top:.4g}, is not below the scan's end ({xc_max}): no xc above it to find"
+        fit.note = f"the largest x, {top:.4g}, is not at least 1e-4 below the scan's end ({xc_max}): no xc above it to find"
         return fit
     scan = top + np.geomspace(1e-4, xc_max - top, 300)
 
@@ -415,6 +426,10 @@ def critical_joint(series, x_range=None, xc_max=1.0):
     hi = [xc_max + 1.0] + [50] * K + [200] * K
     r = least_squares(res, _inside(p0, lo, hi), bounds=(lo, hi))
     lnames = ["xc"] + [f"g_{k}" for k in keys] + [f"lnA_{k}" for k in keys]
+    if (pinned := [n for n in _at_bound(r, lnames) if n != "xc"]):
+        fit.note = (f"{' and '.join(pinned)} at the refinement's bound (|g| <= 50, |ln A| <= 200):"
+                    " the points are beyond this form's reach")
+        return fit
     tmp = Fit("tmp", lnames)
     _finish(tmp, r, lnames, len(allx))
     fit.p["xc"], fit.err["xc"] = tmp.p["xc"], tmp.err["xc"]

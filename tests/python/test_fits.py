@@ -63,14 +63,18 @@ def test_data_beyond_the_forms_reach_is_refused_not_a_crash():
     assert not f.ok and "beyond the floats' range" in f.note
     # every x at or above the end of the scan for the singular point (x = N, not phi)
     f = sf.critical([5e5, 6e5, 6e5, 7e5], [1.4, 1.0, 0.6, 0.01], [0.1, 0.1, 0.1, 0.001])
-    assert not f.ok and "not below the scan's end" in f.note
+    assert not f.ok and "below the scan's end" in f.note
     f = sf.critical_joint({"tau": ([7e5, 5.8e5, 7.6e5], [0.09, 5.9, 3.9], [0.01, 0.6, 0.4])})
-    assert not f.ok and "not below the scan's end" in f.note
-    # scattered points whose best line in the scan is steeper than the refinement's bounds:
-    # the refinement starts inside them instead of refusing to start
-    x, y = [0.58, 0.59, 0.75, 0.64, 0.55], np.array([55.7, 0.108, 7.66, 0.202, 5.18])
-    f = sf.critical(x, y, 0.1 * y)
-    assert np.isfinite(f.chi2)
+    assert not f.ok and "below the scan's end" in f.note
+    # a divergence steeper than the refinement's bounds (g = 60 > 50): the scan's line starts
+    # outside them; the refinement starts inside and, ending at the bound, says so
+    y = 0.05 * (0.82 - PHI) ** -60.0
+    for f in (sf.critical(PHI, y, 0.01 * y), sf.critical_joint({"tau": (PHI, y, 0.01 * y)})):
+        assert not f.ok and "at the refinement's bound" in f.note
+    # each series at 2 distinct x: a line through each fits any xc
+    f = sf.critical_joint({"a": ([0.7, 0.7, 0.75], [1.0, 1.1, 2.0], [0.1] * 3),
+                           "b": ([0.7, 0.76, 0.76], [1.0, 2.0, 2.1], [0.1] * 3)})
+    assert not f.ok and "no series has 3 distinct x" in f.note
     # weights (y / sy)^2 beyond the floats' range (errors in the subnormals)
     y, x = np.array([3.5e-152, 5.3e-150, 3.2e-151, 9.6e-152, 3.6e-150]), [0.62, 0.72, 0.63, 0.67, 0.51]
     for f in (sf.power(x, y, np.full(5, 1e-310)), sf.critical(x, y, np.full(5, 1e-310)),
