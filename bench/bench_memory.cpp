@@ -4,21 +4,21 @@
 //
 // A walk through a buffer of S MiB reads one 64-byte line after another,
 // each drawn at random from the word read before (a chain of dependent
-// loads): with one walk, each load waits for the one before (the latency);
-// with K walks side by side, K loads are in flight at once, as the engine's
+// loads, each landing anywhere, as an event's particle does: where a share
+// of the buffer is in the cache, about that share of the loads hits it).
+// With one walk, each load waits for the one before (the latency); with K
+// walks side by side, K loads are in flight at once, as the engine's
 // requests ahead of its events are (the cost per load when the memory
-// system overlaps them). Each case is measured on 4 KiB
-// pages and on the transparent huge pages the engine advises its big arrays
-// to (dynhet/engine/memory.hpp; the kernel must be in madvise or always
-// mode), --reps times, and the median is printed with the ratio to the
-// size --ref (the footprint of N = 10^5: 21 to 26 MB). The last column,
-// "paged", is one walk on huge pages that stays 63 steps of 64 in the 4 KiB
-// page it is in: the same share of lines from the cache, a new translation
-// once every 64 loads. Where it is fast and the random walk is slow, the
-// random walk's cost is the address translation, not the cache.
+// system overlaps them). Each case is measured on 4 KiB pages and on the
+// transparent huge pages the engine advises its big arrays to
+// (dynhet/engine/memory.hpp; the kernel must be in madvise or always mode;
+// the last column says how much of the buffer it gave them), --reps times
+// from other starts, and the median is printed with the ratio to the size
+// --ref (the footprint of N = 10^5: 21 to 26 MB). The hash adds a few ns to
+// every load, at every size.
 //
 //   bench_memory                       # 1 to 1024 MiB, 1 and 8 walks
-//   bench_memory --mib 24 --mib 256 --walks 16 --reps 5
+//   bench_memory --mib 24 --mib 256 --walks 4 --walks 8 --walks 16 --reps 5
 #include <sys/mman.h>
 
 #include <algorithm>
@@ -72,27 +72,37 @@ inline std::size_t below(uint64_t h, std::size_t n) { // h scaled to [0, n) with
   return static_cast<std::size_t>((static_cast<unsigned __int128>(h) * n) >> 64);
 }
 
-// ns per load, `walks` walks side by side, `loads` loads in all. Paged: 63
-// of every 64 steps stay in the 4 KiB page of the line before (another line
-// of it, at random), the 64th goes to a random page: misses as before
-// where the buffer outgrows the cache, a new page (a translation) once
-// every 64 loads.
-double walk(const Buffer& b, int walks, std::size_t loads, bool paged) {
+// ns per load, `walks` walks side by side, `loads` loads in all. Each
+// step hashes the word read with the walk's own step number, so two walks
+// that meet on a line part again at once (the loads in flight stay
+// `walks`); `seed` places the starts, so that repetitions take other paths.
+double walk(const Buffer& b, int walks, std::size_t loads, uint64_t seed) {
   const std::size_t n = b.bytes / 64;
   std::vector<std::size_t> at(walks);
-  for (int c = 0; c < walks; ++c) at[c] = below(mix(0x9e3779b97f4a7c15ULL * (c + 1)), n);
+  for (int c = 0; c < walks; ++c) at[c] = below(mix(seed * 0x9e3779b97f4a7c15ULL + c), n);
   const std::size_t rounds = loads / walks;
   const auto t0 = std::chrono::steady_clock::now();
   for (std::size_t r = 0; r < rounds; ++r)
-    for (int c = 0; c < walks; ++c) {
-      const uint64_t h = mix(*reinterpret_cast<const uint64_t*>(b.p + at[c] * 64) + r);
-      at[c] = !paged || r % 64 == 63 ? below(h, n) : (at[c] & ~std::size_t{63}) + (h & 63);
-    }
+    for (int c = 0; c < walks; ++c)
+      at[c] = below(mix(*reinterpret_cast<const uint64_t*>(b.p + at[c] * 64) + r * walks + c), n);
   const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   std::size_t sink = 0;
   for (const std::size_t a : at) sink ^= a;
   if (sink == n) std::puts(""); // keeps the loads
   return dt / static_cast<double>(rounds * walks) * 1e9;
+}
+
+// The process's memory on transparent huge pages (AnonHugePages of
+// /proc/self/smaps_rollup), in MiB; -1 where it cannot be read.
+long huge_mib() {
+  std::FILE* f = std::fopen("/proc/self/smaps_rollup", "r");
+  if (!f) return -1;
+  char line[256];
+  long kb = -1;
+  while (std::fgets(line, sizeof line, f))
+    if (std::sscanf(line, "AnonHugePages: %ld kB", &kb) == 1) break;
+  std::fclose(f);
+  return kb < 0 ? -1 : kb / 1024;
 }
 
 double median(std::vector<double> v) {
@@ -118,34 +128,35 @@ int main(int argc, char** argv) {
   std::sort(mib.begin(), mib.end());
   mib.erase(std::unique(mib.begin(), mib.end()), mib.end());
 
-  std::vector<double> grouped(mib.size()); // huge pages, one walk, mostly within a page
-  // ns[size][pages][walks]
+  // ns[size][pages][walks]; granted[size]: MiB of the huge-page buffer the kernel gave huge pages
   std::vector<std::vector<std::vector<double>>> ns(mib.size(), std::vector<std::vector<double>>(2, std::vector<double>(walks.size())));
+  std::vector<long> granted(mib.size(), -1);
   for (std::size_t s = 0; s < mib.size(); ++s)
     for (int huge = 0; huge < 2; ++huge) {
       Buffer b(mib[s] << 20, huge == 1);
       fill_random(b, 0x9e3779b97f4a7c15ULL + mib[s]);
-      const auto measure = [&](int k, bool paged) {
-        walk(b, k, std::max<std::size_t>(loads / 8, 1000), paged); // warm the caches and the TLB
+      if (huge == 1) granted[s] = huge_mib();
+      for (std::size_t c = 0; c < walks.size(); ++c) {
+        walk(b, walks[c], std::max<std::size_t>(loads / 8, 1000), 0); // warm the caches and the TLB
         std::vector<double> v;
-        for (int r = 0; r < reps; ++r) v.push_back(walk(b, k, loads, paged));
-        return median(v);
-      };
-      for (std::size_t c = 0; c < walks.size(); ++c) ns[s][huge][c] = measure(walks[c], false);
-      if (huge == 1) grouped[s] = measure(1, true);
+        for (int r = 0; r < reps; ++r) v.push_back(walk(b, walks[c], loads, r + 1));
+        ns[s][huge][c] = median(v);
+      }
       std::fprintf(stderr, "  %zu MiB, %s pages: done\n", mib[s], huge ? "huge" : "4 KiB");
     }
   const std::size_t r = std::find(mib.begin(), mib.end(), ref) - mib.begin();
-  std::printf("ns per load, median of %d; 4kxK / hugexK: 4 KiB or huge pages, K walks in flight; ref/x: the rate against %zu MiB's (the same pages and walks); paged: huge pages, one walk, 63 steps of 64 within a 4 KiB page\n", reps, ref);
+  std::printf("ns per load, median of %d; 4kxK / hugexK: 4 KiB or huge pages, K walks (loads in flight); "
+              "ref/x: %zu MiB's time over this one (the same pages and walks); on huge: MiB of the buffer the kernel "
+              "gave huge pages\n", reps, ref);
   std::printf("%8s", "MiB");
   for (const char* pg : {"4k", "huge"})
     for (int k : walks) std::printf(" %9s %7s", (std::string(pg) + "x" + std::to_string(k)).c_str(), "ref/x");
-  std::printf(" %9s\n", "paged");
+  std::printf(" %8s\n", "on huge");
   for (std::size_t s = 0; s < mib.size(); ++s) {
     std::printf("%8zu", mib[s]);
     for (int huge = 0; huge < 2; ++huge)
       for (std::size_t c = 0; c < walks.size(); ++c) std::printf(" %9.1f %7.2f", ns[s][huge][c], ns[r][huge][c] / ns[s][huge][c]);
-    std::printf(" %9.1f\n", grouped[s]);
+    std::printf(" %8ld\n", granted[s]);
   }
   return 0;
 }
