@@ -245,3 +245,8 @@ set_tests_properties(replay_reanalyse PROPERTIES LABELS process TIMEOUT 300)
 add_test(NAME docs_from_results
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/docs_from_results.sh ${PROJECT_SOURCE_DIR})
 set_tests_properties(docs_from_results PROPERTIES LABELS process TIMEOUT 300)
+# Each archive of results/ analysed on its own, as run_study.sh does when a
+# study's runs are done: no step fails.
+add_test(NAME archives_analyse_alone
+  COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/archives_alone.sh ${PROJECT_SOURCE_DIR})
+set_tests_properties(archives_analyse_alone PROPERTIES LABELS process TIMEOUT 300)

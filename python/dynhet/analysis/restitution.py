@@ -32,7 +32,8 @@ def restitution_results(A):
             ax[0].plot(xx, fv.p["A"] * np.exp(fv.p["B"] / (fv.p["x0"] - xx)), "-", color=col, lw=0.7)
         pc.append((eps, fp, fv, pts))
         p78 = A.nearest(pts, 0.78)
-        if p78 is not None and abs(p78.phi - 0.78) < 1e-9:
+        # the chi4 panel where the study measured chi4 (a study of tau_alpha alone has the other two)
+        if p78 is not None and abs(p78.phi - 0.78) < 1e-9 and "chi4_N" in cut(p78.runs[0]):
             c = cut(p78.runs[0])
             pk = np.array([p78.mean(lambda r, g=g: (cut(r)["chi4_peak"][g], cut(r)["chi4_peak_err"][g])) for g in range(len(c["chi4_N"]))])
             errorbar(ax[2], c["chi4_N"], pk[:, 0], pk[:, 1], fmt="o-", color=col, label=f"ε = {eps:g}")
