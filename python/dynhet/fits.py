@@ -139,12 +139,10 @@ def _wlin(u, v, w):
     """Weighted straight line v = c0 + c1 u (weights w = 1/sigma^2): (c, cov, chi2)."""
     A = np.vstack([np.ones_like(u), u]).T * np.sqrt(w)[:, None]
     b = v * np.sqrt(w)
-    if not (np.all(np.isfinite(A)) and np.all(np.isfinite(b))):   # weights beyond the floats' range
-        return np.full(2, math.nan), np.full((2, 2), math.nan), math.nan
     c, *_ = np.linalg.lstsq(A, b, rcond=None)
     try:
         cov = np.linalg.inv(A.T @ A)
-    except np.linalg.LinAlgError:   # weights beyond the floats' range: no errors
+    except np.linalg.LinAlgError:   # singular normal equations (met with y near 1e-300): no errors
         cov = np.full((2, 2), math.nan)
     r = A @ c - b
     return c, cov, float(r @ r)
@@ -196,10 +194,22 @@ def _inside(p0, lo, hi):
     return np.clip(np.asarray(p0, float), lo, hi)
 
 
-def _at_bound(res, names):
-    """The names of the parameters the refinement left at a bound (its
-    active_mask), or an empty list."""
-    return [n for n, a in zip(names, res.active_mask) if a != 0]
+def _beyond_scan(top, s_max, name):
+    """Why no singular point `name` can be scanned for above the largest x,
+    top, or None."""
+    if top + 1e-4 < s_max:
+        return None
+    return f"the largest x, {top:.4g}, is not at least 1e-4 below the scan's end ({s_max}): no {name} above it to find"
+
+
+def _pinned(res, names, bounds):
+    """Why a refinement cannot be kept, or None: the parameters (names, all
+    but the first, the singular point, whose bound the scan's-end note
+    covers) it left at a bound (least_squares' active_mask)."""
+    pinned = [n for n, a in zip(names[1:], res.active_mask[1:]) if a != 0]
+    if not pinned:
+        return None
+    return f"{' and '.join(pinned)} at the refinement's bound ({bounds}): the points are beyond this form's reach"
 
 
 def _finish(fit, res, names, n):
@@ -285,8 +295,8 @@ def _singular(form, names, x, y, sy, x_range, s_max, u, sign):
     fit.x_range = (float(x.min()), float(x.max()))
     fit.xs = np.unique(x)
     top = x.max()
-    if not top + 1e-4 < s_max:
-        fit.note = f"the largest x, {top:.4g}, is not at least 1e-4 below the scan's end ({s_max}): no {names[0]} above it to find"
+    if (why := _beyond_scan(top, s_max, names[0])):
+        fit.note = why
         return fit
     scan = top + np.geomspace(1e-4, s_max - top, 400)
     v, w = np.log(y), (y / sy) ** 2
@@ -305,9 +315,8 @@ def _singular(form, names, x, y, sy, x_range, s_max, u, sign):
 
     lo, hi = [top + 1e-6, -50, -200], [s_max + 1.0, 50, 200]
     r = least_squares(res, _inside([s0, sign * c[1], c[0]], lo, hi), bounds=(lo, hi))
-    if (pinned := [n for n in _at_bound(r, [names[0], names[1], f"ln {names[2]}"]) if n != names[0]]):
-        fit.note = (f"{' and '.join(pinned)} at the refinement's bound (|{names[1]}| <= 50, |ln {names[2]}| <= 200):"
-                    " the points are beyond this form's reach")
+    if (why := _pinned(r, [names[0], names[1], f"ln {names[2]}"], f"|{names[1]}| <= 50, |ln {names[2]}| <= 200")):
+        fit.note = why
         return fit
     _finish(fit, r, [names[0], names[1], "lnA"], len(x))
     fit.p[names[2]], fit.err[names[2]] = math.exp(fit.p.pop("lnA")), math.exp(r.x[2]) * fit.err.pop("lnA")
@@ -394,8 +403,8 @@ def critical_joint(series, x_range=None, xc_max=1.0):
     fit.x_range = (float(allx.min()), float(allx.max()))
     fit.xs = np.unique(allx)
     top = allx.max()
-    if not top + 1e-4 < xc_max:
-        fit.note = f"the largest x, {top:.4g}, is not at least 1e-4 below the scan's end ({xc_max}): no xc above it to find"
+    if (why := _beyond_scan(top, xc_max, "xc")):
+        fit.note = why
         return fit
     scan = top + np.geomspace(1e-4, xc_max - top, 300)
 
@@ -426,9 +435,8 @@ def critical_joint(series, x_range=None, xc_max=1.0):
     hi = [xc_max + 1.0] + [50] * K + [200] * K
     r = least_squares(res, _inside(p0, lo, hi), bounds=(lo, hi))
     lnames = ["xc"] + [f"g_{k}" for k in keys] + [f"lnA_{k}" for k in keys]
-    if (pinned := [n for n in _at_bound(r, lnames) if n != "xc"]):
-        fit.note = (f"{' and '.join(pinned)} at the refinement's bound (|g| <= 50, |ln A| <= 200):"
-                    " the points are beyond this form's reach")
+    if (why := _pinned(r, lnames, "|g| <= 50, |ln A| <= 200")):
+        fit.note = why
         return fit
     tmp = Fit("tmp", lnames)
     _finish(tmp, r, lnames, len(allx))
