@@ -25,7 +25,6 @@
 #include <chrono>
 #include <cstdint>
 #include <cstdio>
-#include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -41,8 +40,7 @@ struct Buffer {
     void* m = mmap(nullptr, bytes, PROT_READ | PROT_WRITE, MAP_PRIVATE | MAP_ANONYMOUS, -1, 0);
     if (m == MAP_FAILED) throw std::runtime_error("mmap of " + std::to_string(bytes >> 20) + " MiB failed");
     p = static_cast<char*>(m);
-    madvise(p, bytes, huge ? MADV_HUGEPAGE : MADV_NOHUGEPAGE);
-    std::memset(p, 0, bytes); // touch every page before timing
+    madvise(p, bytes, huge ? MADV_HUGEPAGE : MADV_NOHUGEPAGE); // fill_random() then touches every page
   }
   ~Buffer() { munmap(p, bytes); }
   Buffer(const Buffer&) = delete;
